@@ -1,0 +1,10 @@
+// Each subcommand of `octomap-rt` lives in its own file and registers itself here.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace ort::cli {
+
+void register_build_command(CLI::App& app);
+
+}  // namespace ort::cli

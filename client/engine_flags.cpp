@@ -1,0 +1,56 @@
+#include "engine_flags.h"
+
+namespace ort::cli {
+
+void add_engine_flags(CLI::App& cmd, EngineFlags& f, bool require_resolution) {
+  auto* r = cmd.add_option("-r,--resolution", f.resolution, "voxel edge length [m]")
+                ->check(CLI::PositiveNumber);
+  if (require_resolution) r->required();
+  cmd.add_option("--max-range", f.max_range, "cut rays longer than this [m]; < 0: no limit")
+      ->capture_default_str();
+  cmd.add_option("--backend", f.backend, "ray shooting: auto, cpu, vulkan or rt")
+      ->check(CLI::IsMember({"auto", "cpu", "vulkan", "rt"}))
+      ->capture_default_str();
+  cmd.add_option("--device", f.device, "Vulkan device: name substring or index (default: automatic)");
+  cmd.add_option("--traversal", f.traversal, "octomap (OctoMap's exact walk) or exact (closed-box geometry)")
+      ->check(CLI::IsMember({"octomap", "exact"}))
+      ->capture_default_str();
+  cmd.add_option("--octree", f.octree, "octree stage: sequential (updateNode loop) or batched")
+      ->check(CLI::IsMember({"sequential", "batched"}))
+      ->capture_default_str();
+  cmd.add_option("--threads", f.threads, "octree stage threads (0: all hardware threads)")->capture_default_str();
+  cmd.add_option("--prob-hit", f.sensor.prob_hit, "sensor model: P(occupied | hit)")->capture_default_str();
+  cmd.add_option("--prob-miss", f.sensor.prob_miss, "sensor model: P(occupied | miss)")->capture_default_str();
+  cmd.add_option("--clamp-min", f.sensor.clamping_min, "sensor model: lower clamping probability")
+      ->capture_default_str();
+  cmd.add_option("--clamp-max", f.sensor.clamping_max, "sensor model: upper clamping probability")
+      ->capture_default_str();
+  cmd.add_option("--occupancy-threshold", f.sensor.occupancy_threshold, "sensor model: occupied above this")
+      ->capture_default_str();
+}
+
+EngineOptions to_engine_options(const EngineFlags& f) {
+  EngineOptions o;
+  o.resolution = f.resolution;
+  o.max_range = f.max_range;
+  if (!parse_backend(f.backend, o.backend.kind)) throw CLI::ValidationError("--backend", "unknown back end " + f.backend);
+  if (!parse_traversal(f.traversal, o.traversal))
+    throw CLI::ValidationError("--traversal", "unknown traversal " + f.traversal);
+  o.backend.device = f.device;
+  o.octree.mode = f.octree == "batched" ? OctreeUpdateMode::kBatched : OctreeUpdateMode::kSequential;
+  o.octree.threads = f.threads;
+  auto prob = [](double p, const char* name) {
+    if (!(p > 0.0 && p < 1.0)) throw CLI::ValidationError(name, "must lie strictly between 0 and 1");
+  };
+  prob(f.sensor.prob_hit, "--prob-hit");
+  prob(f.sensor.prob_miss, "--prob-miss");
+  prob(f.sensor.clamping_min, "--clamp-min");
+  prob(f.sensor.clamping_max, "--clamp-max");
+  prob(f.sensor.occupancy_threshold, "--occupancy-threshold");
+  if (f.sensor.clamping_min >= f.sensor.clamping_max)
+    throw CLI::ValidationError("--clamp-min", "must be below --clamp-max");
+  o.sensor = f.sensor;
+  return o;
+}
+
+}  // namespace ort::cli

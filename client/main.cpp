@@ -1,0 +1,21 @@
+// octomap-rt: the command-line client of octomap-rt.
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"octomap-rt: GPU-accelerated OctoMap building, and the client of octomap-rt-server"};
+  app.require_subcommand(1);
+  ort::cli::register_build_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::cerr << "octomap-rt: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

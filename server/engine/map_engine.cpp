@@ -1,0 +1,42 @@
+#include "engine/map_engine.h"
+
+#include <chrono>
+
+namespace ort {
+namespace {
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+}  // namespace
+
+MapEngine::MapEngine(const EngineOptions& opts, std::string* log) : opts_(opts) {
+  opts_.backend.resolution = opts.resolution;
+  opts_.backend.max_range = opts.max_range;
+  backend_ = make_backend(opts_.backend, log);
+}
+
+std::unique_ptr<octomap::OcTree> MapEngine::make_tree() const {
+  auto tree = std::make_unique<octomap::OcTree>(opts_.resolution);
+  apply_sensor_model(*tree, opts_.sensor);
+  return tree;
+}
+
+void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range,
+                      ShotScan& out) {
+  out = ShotScan{};
+  const auto t0 = Clock::now();
+  const RayBatch batch = prepare_scan(origin, points, max_range, opts_.resolution, out.prepare);
+  out.shoot.times.prepare_ms = ms_since(t0);
+  if (!out.prepare.origin_ok) return;
+  backend_->shoot(batch, opts_.traversal, out.voxels, out.shoot);
+  for (const VoxelUpdate& v : out.voxels) (v.occupied() ? out.occupied_voxels : out.free_voxels)++;
+}
+
+void MapEngine::apply(ShotScan& scan, octomap::OcTree& tree) const {
+  const auto t0 = Clock::now();
+  apply_updates(tree, scan.voxels, opts_.octree);
+  scan.shoot.times.octree_ms += ms_since(t0);
+}
+
+}  // namespace ort

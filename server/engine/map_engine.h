@@ -1,0 +1,69 @@
+// The engine's one interface: insert a scan into a map.
+//
+// It is split into the two pipeline stages the server runs on two threads:
+//   shoot()  — stage 1 (GPU): prepare rays, shoot them, read back the voxel list;
+//   apply()  — stage 2 (CPU): update the octree with that list.
+// insert() runs both in sequence. shoot() and apply() may run concurrently on different
+// scans; neither may be called from two threads at once.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string>
+
+#include <octomap/OcTree.h>
+
+#include "engine/prepare_scan.h"
+#include "engine/ray_backend.h"
+#include "engine/sensor_model.h"
+#include "octree/octree_update.h"
+
+namespace ort {
+
+struct EngineOptions {
+  double resolution = 0.1;
+  double max_range = -1.0;  // < 0: no limit (OctoMap's default)
+  Traversal traversal = Traversal::kOctomap;
+  BackendOptions backend;   // resolution/max_range are filled in from above
+  OctreeUpdateOptions octree;
+  SensorModel sensor;
+};
+
+// One scan on its way through the pipeline.
+struct ShotScan {
+  PrepareReport prepare;
+  ShootStats shoot;
+  VoxelList voxels;
+  uint64_t free_voxels = 0, occupied_voxels = 0;
+};
+
+class MapEngine {
+ public:
+  // Throws std::runtime_error when the requested back end cannot be made. Messages about
+  // the device choice (or the fallback to cpu) go to `log`.
+  explicit MapEngine(const EngineOptions& opts, std::string* log = nullptr);
+
+  // A fresh map with this engine's resolution and sensor model.
+  std::unique_ptr<octomap::OcTree> make_tree() const;
+
+  // Stage 1. `max_range` overrides the engine's when >= -1 is not wanted: pass opts' value.
+  void shoot(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range,
+             ShotScan& out);
+  // Stage 2. Adds its time to out.shoot.times.octree_ms.
+  void apply(ShotScan& scan, octomap::OcTree& tree) const;
+  // Both stages.
+  void insert(const octomap::point3d& origin, std::span<const octomap::point3d> points, octomap::OcTree& tree,
+              ShotScan& out) {
+    shoot(origin, points, opts_.max_range, out);
+    apply(out, tree);
+  }
+
+  const EngineOptions& options() const { return opts_; }
+  const RayBackend& backend() const { return *backend_; }
+
+ private:
+  EngineOptions opts_;
+  std::unique_ptr<RayBackend> backend_;
+};
+
+}  // namespace ort

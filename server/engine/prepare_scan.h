@@ -1,0 +1,34 @@
+// CPU preparation of one scan (paper Fig. 6 "ray data preparation"): OctoMap's computeUpdate
+// rules applied with OctoMap's own float arithmetic, so every back end sees the same rays.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include <octomap/octomap_types.h>
+
+#include "engine/ray_batch.h"
+
+namespace ort {
+
+// Counts of what preparation did with a scan's points; nothing is dropped uncounted.
+struct PrepareReport {
+  uint64_t points_in = 0;
+  uint64_t rays = 0;            // rays handed to the back end
+  uint64_t nonfinite = 0;       // NaN or inf coordinates: skipped
+  uint64_t out_of_range = 0;    // ray end outside the map's key range: skipped (OctoMap does too)
+  uint64_t cut_at_max_range = 0;// longer than max range: cut, free space only
+  bool origin_ok = true;        // false: origin not finite or outside the key range; no rays
+  std::string error;            // set when origin_ok is false
+};
+
+// Builds the rays of one scan. Points are in the map frame, as OctoMap's insertPointCloud
+// takes them. max_range < 0 means no limit.
+RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::point3d> points,
+                      double max_range, double resolution, PrepareReport& report);
+
+// OctoMap's coordToKeyChecked for a tree of the given resolution (depth 16).
+bool coord_to_key_checked(const octomap::point3d& p, double resolution, octomap::OcTreeKey& key);
+
+}  // namespace ort

@@ -1,0 +1,15 @@
+// The `rt` back end: VK_KHR_ray_tracing_pipeline over a persistent shared BVH of voxel
+// AABBs (one BLAS of k^3 voxels instanced by a TLAS), as in the OctoMap-RT paper.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "engine/ray_backend.h"
+
+namespace ort {
+
+// Throws std::runtime_error naming the missing extensions where the device lacks them.
+std::unique_ptr<RayBackend> make_rt_backend(const BackendOptions& opts, std::string* log);
+
+}  // namespace ort

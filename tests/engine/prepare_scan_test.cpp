@@ -1,0 +1,78 @@
+// Bad input at the engine's door: NaN/inf points are skipped and counted, points outside the
+// key range are counted, an empty scan is fine, a bad origin rejects the scan.
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "engine/map_engine.h"
+#include "engine/prepare_scan.h"
+
+namespace ort {
+namespace {
+
+TEST(PrepareScan, SkipsAndCountsNonFiniteAndOutOfRangePoints) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<octomap::point3d> pts = {{1, 2, 3}, {nan, 0, 0}, {0, inf, 0}, {0, 0, -inf}, {1e6f, 0, 0}, {2, 2, 2}};
+  PrepareReport r;
+  const RayBatch b = prepare_scan({0, 0, 0}, pts, -1.0, 0.1, r);
+  EXPECT_EQ(r.points_in, 6u);
+  EXPECT_EQ(r.nonfinite, 3u);
+  EXPECT_EQ(r.out_of_range, 1u);  // 1e6 m is beyond 32768 * 0.1 m
+  EXPECT_EQ(r.rays, 2u);
+  ASSERT_EQ(b.ends.size(), 2u);
+  EXPECT_EQ(b.ends[0].flags, kRayEndOccupied);
+}
+
+TEST(PrepareScan, CutsAtMaxRangeAsOctomapDoes) {
+  std::vector<octomap::point3d> pts = {{20, 0, 0}, {3, 4, 0}};
+  PrepareReport r;
+  const RayBatch b = prepare_scan({0, 0, 0}, pts, 5.0, 0.1, r);
+  ASSERT_EQ(b.ends.size(), 2u);
+  EXPECT_EQ(r.cut_at_max_range, 1u);
+  EXPECT_EQ(b.ends[0].flags, 0u);  // cut: free space only
+  EXPECT_FLOAT_EQ(b.ends[0].x, 5.0f);
+  EXPECT_EQ(b.ends[1].flags, kRayEndOccupied);  // exactly at max range: kept (<=)
+}
+
+TEST(PrepareScan, BadOriginRejectsTheScan) {
+  std::vector<octomap::point3d> pts = {{1, 1, 1}};
+  PrepareReport r;
+  prepare_scan({std::numeric_limits<float>::quiet_NaN(), 0, 0}, pts, -1.0, 0.1, r);
+  EXPECT_FALSE(r.origin_ok);
+  EXPECT_FALSE(r.error.empty());
+  PrepareReport r2;
+  prepare_scan({5000.0f, 0, 0}, pts, -1.0, 0.1, r2);
+  EXPECT_FALSE(r2.origin_ok);
+}
+
+TEST(MapEngine, EmptyScanIsFine) {
+  EngineOptions o;
+  o.backend.kind = BackendKind::kCpu;
+  MapEngine engine(o);
+  auto tree = engine.make_tree();
+  ShotScan shot;
+  engine.insert({0, 0, 0}, {}, *tree, shot);
+  EXPECT_TRUE(shot.prepare.origin_ok);
+  EXPECT_EQ(shot.voxels.size(), 0u);
+  EXPECT_EQ(tree->size(), 0u);
+}
+
+TEST(CoordToKey, MatchesOctomap) {
+  octomap::OcTree tree(0.1);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-3300.0f, 3300.0f);
+  for (int i = 0; i < 100000; ++i) {
+    const octomap::point3d p(u(rng), u(rng) * 0.001f, -u(rng));
+    octomap::OcTreeKey a, b;
+    const bool ok_a = tree.coordToKeyChecked(p, a);
+    const bool ok_b = coord_to_key_checked(p, 0.1, b);
+    ASSERT_EQ(ok_a, ok_b) << p;
+    if (ok_a) ASSERT_TRUE(a == b) << p;
+  }
+}
+
+}  // namespace
+}  // namespace ort

@@ -1,0 +1,6 @@
+octomap_rt_add_test(engine_cli_parity_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/cli_parity_test.cpp)
+target_compile_definitions(engine_cli_parity_test PRIVATE OCTOMAP_RT_CLI="$<TARGET_FILE:octomap-rt>")
+add_dependencies(engine_cli_parity_test octomap-rt)
+
+octomap_rt_add_test(engine_prepare_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/prepare_scan_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/exact_traversal_test.cpp)
