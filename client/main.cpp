@@ -9,6 +9,7 @@ int main(int argc, char** argv) {
   CLI::App app{"octomap-rt: GPU-accelerated OctoMap building, and the client of octomap-rt-server"};
   app.require_subcommand(1);
   ort::cli::register_build_command(app);
+  ort::cli::register_replay_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

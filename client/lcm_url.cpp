@@ -1,0 +1,13 @@
+#include "lcm_url.h"
+
+#include <cstdlib>
+
+namespace ort::cli {
+
+std::string client_lcm_url(const std::string& requested) {
+  if (!requested.empty()) return requested;
+  if (const char* env = std::getenv("LCM_DEFAULT_URL"); env && *env) return env;
+  return kHostLocalLcmUrl;
+}
+
+}  // namespace ort::cli
