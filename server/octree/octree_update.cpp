@@ -1,5 +1,7 @@
 #include "octree/octree_update.h"
 
+#include "octree/batched_update.h"
+
 namespace ort {
 
 void apply_updates(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
@@ -9,9 +11,9 @@ void apply_updates(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
       apply_updates_sequential(tree, updates);
       return;
     case OctreeUpdateMode::kBatched:
-      break;
+      apply_updates_batched(tree, updates, opts.threads);
+      return;
   }
-  throw std::runtime_error("batched octree update is not built yet");
 }
 
 }  // namespace ort

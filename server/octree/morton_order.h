@@ -1,0 +1,57 @@
+// Morton (Z-order) codes of OcTree keys, and sorting a scan's voxel list into that order.
+//
+// The code interleaves the key bits so that its 3-bit groups, read from the top, are exactly
+// the child indices OctoMap takes on the way from the root to the voxel (computeChildIdx: x is
+// bit 0, y bit 1, z bit 2). Sorted codes therefore list the voxels in depth-first order of the
+// octree, each subtree's voxels contiguous, and two consecutive voxels share the root path
+// down to the depth their codes first differ at.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "engine/voxel_update.h"
+
+namespace ort {
+
+constexpr unsigned kTreeDepth = 16;  // OcTree's depth: 16-bit keys
+
+// 48-bit Morton code of a key.
+uint64_t morton_code(uint16_t x, uint16_t y, uint16_t z);
+// The key back from a Morton code.
+void morton_decode(uint64_t code, uint16_t& x, uint16_t& y, uint16_t& z);
+
+// One voxel of a sorted batch: its Morton code shifted up by one, occupied in bit 0. Keys are
+// unique in a scan's list, so the state bit never changes the order.
+using SortedVoxel = uint64_t;
+
+inline SortedVoxel make_sorted_voxel(const VoxelUpdate& u) {
+  return (morton_code(u.x, u.y, u.z) << 1) | (u.occupied() ? 1u : 0u);
+}
+inline bool sorted_voxel_occupied(SortedVoxel v) { return (v & 1u) != 0; }
+inline uint64_t sorted_voxel_code(SortedVoxel v) { return v >> 1; }
+
+// Child index (0..7) a voxel takes below the node at `depth` (0 = root).
+inline unsigned child_index_at(SortedVoxel v, unsigned depth) {
+  return static_cast<unsigned>(v >> (3 * (kTreeDepth - 1 - depth) + 1)) & 7u;
+}
+
+// Deepest depth whose node lies on both voxels' root paths: the node where the paths part.
+// The voxels must differ (unique keys).
+inline unsigned shared_path_depth(SortedVoxel a, SortedVoxel b) {
+  const uint64_t diff = (a ^ b) >> 1;
+  const unsigned top_bit = 63u - static_cast<unsigned>(__builtin_clzll(diff));
+  return kTreeDepth - 1 - top_bit / 3;
+}
+
+enum class SortMethod {
+  kRadix,  // LSD radix sort, 8-bit digits, digits equal in every voxel skipped
+  kStd,    // std::sort, for comparison (tools/octree_bench)
+};
+
+// Codes of `updates`, sorted ascending. `scratch` is reused storage for the radix passes.
+void sort_voxels(std::span<const VoxelUpdate> updates, std::vector<SortedVoxel>& out,
+                 std::vector<SortedVoxel>& scratch, SortMethod method = SortMethod::kRadix);
+
+}  // namespace ort

@@ -1,0 +1,81 @@
+#include "octree/subtree_update.h"
+
+#include <algorithm>
+#include <array>
+
+namespace ort {
+namespace {
+
+// One node of the current root path.
+struct PathNode {
+  octomap::OcTreeNode* node;
+  bool just_created;  // created on this path and still childless: create, never expand
+  bool changed;       // a voxel below was applied: settle this node when leaving it
+};
+
+}  // namespace
+
+bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, const SubtreeRoot& root,
+                    std::span<const SortedVoxel> voxels) {
+  const float hit = tree.getProbHitLog();
+  const float miss = tree.getProbMissLog();
+
+  std::array<PathNode, kTreeDepth + 1> path;
+  path[root.depth] = PathNode{root.node, root.just_created, false};
+  unsigned depth = root.depth;  // depth of the deepest node on the path
+
+  // Leaves the subtrees below `target`: settles each node that changed, exactly as the last
+  // updateNode through it would have (prune if all 8 children are equal leaves, else max of
+  // the children), and tells its parent.
+  auto leave_down_to = [&](unsigned target) {
+    for (; depth > target; --depth) {
+      PathNode& p = path[depth];
+      if (!p.changed) continue;
+      if (depth < kTreeDepth && !node_ops.pruneNode(p.node)) p.node->updateOccupancyChildren();
+      path[depth - 1].changed = true;
+    }
+  };
+
+  for (size_t i = 0; i < voxels.size(); ++i) {
+    const SortedVoxel v = voxels[i];
+    if (i > 0) leave_down_to(std::min(depth, shared_path_depth(voxels[i - 1], v)));
+    const float update = sorted_voxel_occupied(v) ? hit : miss;
+
+    // Walk down from the shared part of the path, as updateNodeRecurs does.
+    for (;;) {
+      PathNode& p = path[depth];
+      if (depth == kTreeDepth) {
+        // An existing leaf is what updateNode's search finds: at the bound, nothing happens.
+        if (p.just_created || !at_clamping_bound(tree, *p.node, update)) {
+          tree.updateNodeLogOdds(p.node, update);
+          p.changed = true;
+        }
+        break;
+      }
+      const unsigned pos = child_index_at(v, depth);
+      octomap::OcTreeNode* child;
+      bool created = false;
+      if (node_ops.nodeChildExists(p.node, pos)) {
+        child = node_ops.getNodeChild(p.node, pos);
+      } else if (!p.just_created && !node_ops.nodeHasChildren(p.node)) {
+        // A pruned leaf: it is the deepest node search() finds on this voxel's path (its
+        // value is the one the voxel had before this batch: expansions copy it unchanged).
+        if (at_clamping_bound(tree, *p.node, update)) break;
+        node_ops.expandNode(p.node);
+        child = node_ops.getNodeChild(p.node, pos);
+      } else {
+        child = node_ops.createNodeChild(p.node, pos);
+        created = true;
+      }
+      path[++depth] = PathNode{child, created, false};
+    }
+  }
+  leave_down_to(root.depth);
+
+  // The root of the subtree is settled here too; its ancestors are the caller's.
+  PathNode& top = path[root.depth];
+  if (top.changed && root.depth < kTreeDepth && !node_ops.pruneNode(top.node)) top.node->updateOccupancyChildren();
+  return top.changed;
+}
+
+}  // namespace ort

@@ -1,0 +1,49 @@
+// The batched update of one subtree: Morton-sorted voxels applied in one depth-first pass.
+//
+// OctoMap's updateNode walks root to leaf twice per voxel (search, then the update) and on
+// the way back up tries to prune, or re-computes the max of the children, at every level.
+// Here consecutive voxels keep the part of the path they share; a node is settled (pruned
+// or given the max of its children) once, when the pass leaves its subtree, and only when
+// some voxel below it was applied. The result is node for node what the updateNode loop
+// gives (see batched_update.h for why the order of the voxels does not matter).
+#pragma once
+
+#include <span>
+
+#include <octomap/OcTree.h>
+
+#include "octree/morton_order.h"
+
+namespace ort {
+
+// Where the pass starts: a node that exists and the depth it sits at (0 = root).
+struct SubtreeRoot {
+  octomap::OcTreeNode* node = nullptr;
+  unsigned depth = 0;
+  // Created by this batch above the split and still without children: its missing children
+  // are created one by one, not expanded from it (OctoMap's node_just_created).
+  bool just_created = false;
+};
+
+// Applies `voxels` (sorted, all inside the subtree of `root`) to the tree and settles every
+// node of the subtree they touch, `root` included. Returns whether any voxel was applied,
+// i.e. whether root's ancestors must be settled too.
+//
+// Values and the sensor model come from `tree` (updateNodeLogOdds, read only). Nodes are
+// created, expanded and pruned through `node_ops`, which is `tree` itself or, when several
+// threads update one tree, a per-thread OcTree that only counts the nodes (OctoMap's node
+// counter is a plain size_t; see node_count.h).
+bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, const SubtreeRoot& root,
+                    std::span<const SortedVoxel> voxels);
+
+// Whether OctoMap's updateNode would return early for an update of `log_odds_update` that
+// finds `node` as the deepest existing node on its path: already at the clamping bound in
+// the update's direction (OccupancyOcTreeBase::updateNode).
+inline bool at_clamping_bound(const octomap::OcTree& tree, const octomap::OcTreeNode& node,
+                              float log_odds_update) {
+  const float v = node.getLogOdds();
+  return (log_odds_update >= 0 && v >= tree.getClampingThresMaxLog()) ||
+         (log_odds_update <= 0 && v <= tree.getClampingThresMinLog());
+}
+
+}  // namespace ort
