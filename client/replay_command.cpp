@@ -80,8 +80,10 @@ struct ReplayTotals {
   uint64_t bytes = 0;
   size_t publish_errors = 0;
   Clock::time_point start = Clock::now();
+  Clock::time_point first_publish{};
+  // Rate between the first and the last publication: pacing, not start-up, is what it shows.
   std::string detail() const {
-    const double s = std::chrono::duration<double>(Clock::now() - start).count();
+    const double s = std::chrono::duration<double>(Clock::now() - first_publish).count();
     char buf[96];
     std::snprintf(buf, sizeof buf, "%.1f MB, %.2f scans/s", bytes / 1e6, scans > 1 && s > 0 ? (scans - 1) / s : 0.0);
     return buf;
