@@ -1,0 +1,18 @@
+# Integration tests of octomap-rt-server with real processes (daemon, `octomap-rt replay`
+# producers, lcm-logger) talking udpm inside a network namespace each test makes itself.
+# Included from tests.cmake. Label: integration.
+set(ORT_IT_DIR ${CMAKE_CURRENT_LIST_DIR})
+add_library(octomap_rt_integration_harness STATIC ${CMAKE_CURRENT_LIST_DIR}/integration_harness.cpp)
+target_include_directories(octomap_rt_integration_harness PUBLIC ${CMAKE_CURRENT_LIST_DIR})
+target_link_libraries(octomap_rt_integration_harness PUBLIC octomap_rt_lcmtypes octomap_rt_test_support GTest::gtest)
+target_compile_definitions(octomap_rt_integration_harness PRIVATE
+  OCTOMAP_RT_SERVER="$<TARGET_FILE:octomap-rt-server>" OCTOMAP_RT_CLI="$<TARGET_FILE:octomap-rt>")
+
+function(octomap_rt_add_integration_test name timeout)
+  octomap_rt_add_test(${name} SOURCES ${ORT_IT_DIR}/${name}.cpp
+                      LIBS octomap_rt_integration_harness octomap_rt_client octomap_rt_daemon
+                      TIMEOUT ${timeout} LABELS integration)
+  add_dependencies(${name} octomap-rt-server octomap-rt)
+endfunction()
+
+octomap_rt_add_integration_test(server_producers_integration_test 300)
