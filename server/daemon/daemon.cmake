@@ -1,0 +1,16 @@
+# octomap-rt-server: the LCM mapping daemon (included by server/CMakeLists.txt).
+# The daemon's logic is a library (octomap_rt_daemon) so tests run it in-process over
+# memq://; the executable adds only flag parsing, signals and the summary.
+set(DAEMON_DIR ${CMAKE_CURRENT_LIST_DIR})
+file(GLOB DAEMON_SOURCES CONFIGURE_DEPENDS ${DAEMON_DIR}/*.cpp)
+list(FILTER DAEMON_SOURCES EXCLUDE REGEX "/(server_main|server_cli)\\.cpp$")
+add_library(octomap_rt_daemon STATIC ${DAEMON_SOURCES})
+target_include_directories(octomap_rt_daemon PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
+target_link_libraries(octomap_rt_daemon PUBLIC octomap_rt_engine octomap_rt_lcmtypes octomap_rt_lcm Threads::Threads)
+
+# The engine flags (-r, sensor model, back end, ...) are the client's, shared so that
+# `octomap-rt build` and the server take the same names and defaults.
+add_executable(octomap-rt-server ${DAEMON_DIR}/server_main.cpp ${DAEMON_DIR}/server_cli.cpp
+               ${CMAKE_SOURCE_DIR}/client/engine_flags.cpp)
+target_include_directories(octomap-rt-server PRIVATE ${CMAKE_SOURCE_DIR}/client)
+target_link_libraries(octomap-rt-server PRIVATE octomap_rt_daemon CLI11::CLI11)

@@ -1,0 +1,356 @@
+#include "daemon/mapping_server.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <sstream>
+
+#include "daemon/kernel_udp_stats.h"
+#include "daemon/map_store.h"
+#include "daemon/server_lcm_url.h"
+
+namespace ort::daemon {
+namespace {
+
+using Status = octomap_rt::server_status_t;
+
+uint64_t queue_budget(const ServerConfig& c) {
+  return c.queue_budget_bytes ? c.queue_budget_bytes : automatic_queue_budget();
+}
+
+std::string host_name() {
+  char buf[256] = {};
+  if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
+  return buf;
+}
+
+}  // namespace
+
+int64_t now_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+MappingServer::MappingServer(const ServerConfig& cfg, std::ostream& log) : MappingServer(cfg, nullptr, log) {}
+MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM& shared, std::ostream& log)
+    : MappingServer(cfg, &shared, log) {}
+
+MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ostream& log)
+    : cfg_(cfg),
+      log_(log),
+      producers_(literal_prefix(cfg.scan_channels), cfg.max_producers),
+      queue_(queue_budget(cfg), 8 * queue_budget(cfg)) {
+  start_ = std::chrono::steady_clock::now();
+  start_utime_ = now_utime();
+  host_ = host_name();
+  server_id_ = cfg_.server_id.empty() ? "octomap-rt-server@" + host_ : cfg_.server_id;
+  // A queue must hold at least one scan of the largest allowed size.
+  const uint64_t largest = 12 * cfg_.max_points + 4096;
+  if (queue_.per_producer_budget() < largest)
+    throw std::runtime_error("queue budget " + std::to_string(queue_.per_producer_budget() >> 20) +
+                             " MiB per producer cannot hold one scan of --max-points " + std::to_string(cfg_.max_points));
+
+  std::string engine_log;
+  engine_ = std::make_unique<MapEngine>(cfg_.engine, &engine_log);
+  log_ << engine_log;
+  load_or_create_map();
+  if (!cfg_.applied_log.empty()) map_.order.open_live_log(cfg_.applied_log);
+
+  if (shared) {
+    lc_ = shared;
+    url_ = "(shared LCM instance)";
+  } else {
+    const LcmUrlChoice c = choose_lcm_url(cfg_.lcm_url, cfg_.recv_buf_size);
+    url_ = c.url;
+    if (!c.warning.empty()) log_ << c.warning << "\n";
+    own_lcm_ = std::make_unique<lcm::LCM>(url_);
+    if (!own_lcm_->good())
+      throw std::runtime_error("LCM could not start on '" + url_ +
+                               "' (for udpm on one host: ip route add 224.0.0.0/4 dev lo, see LCM's multicast setup)");
+    lc_ = own_lcm_.get();
+  }
+}
+
+MappingServer::~MappingServer() {
+  try {
+    stop();
+  } catch (const std::exception& e) {
+    log_ << "octomap-rt-server: error while stopping: " << e.what() << "\n";
+  }
+}
+
+void MappingServer::load_or_create_map() {
+  const double res = cfg_.engine.resolution;
+  if (!cfg_.map_path.empty() && std::filesystem::exists(cfg_.map_path)) {
+    map_.tree = load_map(cfg_.map_path, res);
+    apply_sensor_model(*map_.tree, cfg_.engine.sensor);
+    std::vector<AppliedEntry> previous;
+    const std::string order_path = cfg_.map_path + ".order";
+    if (std::filesystem::exists(order_path)) {
+      AppliedOrderFile f = read_applied_order(order_path);
+      if (f.map_bytes >= 0 && static_cast<uint64_t>(f.map_bytes) != std::filesystem::file_size(cfg_.map_path))
+        log_ << "octomap-rt-server: warning: " << order_path
+             << " does not belong to this map file (the server stopped between writing the two); its "
+             << f.entries.size() << " entries are kept but may not match the map\n";
+      previous = std::move(f.entries);
+    }
+    map_.order.restore(std::move(previous));
+    map_.version = 0;
+    saved_version_ = 0;
+    log_ << "octomap-rt-server: loaded map " << cfg_.map_path << " (" << map_.tree->size() << " nodes, "
+         << map_.order.size() << " scans applied before)\n";
+  } else {
+    map_.tree = engine_->make_tree();
+    if (!cfg_.map_path.empty()) log_ << "octomap-rt-server: new map, will be saved to " << cfg_.map_path << "\n";
+  }
+}
+
+void MappingServer::start() {
+  if (started_) return;
+  started_ = true;
+  ScanLimits limits;
+  limits.max_points = cfg_.max_points;
+  limits.resolution = cfg_.engine.resolution;
+  pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, cfg_.pipeline);
+  pipeline_->start();
+  intake_ = std::make_unique<ScanIntake>(*lc_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
+  intake_->start();
+  status_thread_ = std::thread([this] { run_status_loop(); });
+  if (!cfg_.map_path.empty() && cfg_.save_interval_s > 0) save_thread_ = std::thread([this] { run_save_loop(); });
+  set_state(Status::STATE_RUNNING, "serving " + cfg_.scan_channels);
+}
+
+void MappingServer::stop() {
+  if (!started_ || stopped_) return;
+  stopped_ = true;
+  set_state(Status::STATE_STOPPING, "stopping: intake closed, draining queued scans");
+  intake_->stop();
+  queue_.close();
+  pipeline_->join();
+  {
+    std::lock_guard lock(state_mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (save_thread_.joinable()) save_thread_.join();
+  if (!cfg_.map_path.empty()) {
+    set_state(Status::STATE_STOPPING, "stopping: saving the map");
+    save(true);
+  }
+  set_state(Status::STATE_STOPPING, "stopped");
+  {
+    std::lock_guard lock(state_mutex_);
+    status_exit_ = true;
+  }
+  wake_.notify_all();
+  if (status_thread_.joinable()) status_thread_.join();
+}
+
+void MappingServer::set_state(int8_t state, std::string message) {
+  {
+    std::lock_guard lock(state_mutex_);
+    state_ = state;
+    message_ = std::move(message);
+    state_changed_ = true;
+  }
+  wake_.notify_all();
+}
+
+void MappingServer::save(bool force) {
+  if (cfg_.map_path.empty()) return;
+  std::lock_guard save_lock(save_mutex_);
+  std::string bytes;
+  size_t scans = 0;
+  uint64_t version = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  double lock_ms = 0;
+  {
+    // Serialize under the lock (a state between two whole scans), write outside it.
+    std::lock_guard lock(map_.mutex);
+    if (!force && map_.version == saved_version_) return;
+    bytes = serialize_map(*map_.tree);
+    scans = map_.order.size();
+    version = map_.version;
+    lock_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  const std::vector<AppliedEntry> order = map_.order.entries(scans);
+  // Map first: if we die between the two renames the order file is the older one, which
+  // the next start detects by its map_bytes line.
+  write_file_atomically(cfg_.map_path, bytes);
+  write_file_atomically(cfg_.map_path + ".order", format_applied_order(order, bytes.size()));
+  saved_version_ = version;
+  saves_++;
+  last_save_utime_ = now_utime();
+  max_save_lock_ms_ = std::max(max_save_lock_ms_, lock_ms);
+  last_save_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void MappingServer::run_save_loop() {
+  const auto period = std::chrono::duration<double>(cfg_.save_interval_s);
+  std::unique_lock lock(state_mutex_);
+  while (!stopping_) {
+    if (wake_.wait_for(lock, period, [&] { return stopping_; })) break;
+    lock.unlock();
+    try {
+      save(false);
+    } catch (const std::exception& e) {
+      log_ << "octomap-rt-server: save failed (the previous map file is intact): " << e.what() << "\n";
+    }
+    lock.lock();
+  }
+}
+
+void MappingServer::run_status_loop() {
+  const auto period = std::chrono::duration<double>(cfg_.status_period_s);
+  std::unique_lock lock(state_mutex_);
+  for (;;) {
+    wake_.wait_for(lock, period, [&] { return state_changed_ || status_exit_; });
+    const bool exit = status_exit_;
+    state_changed_ = false;
+    lock.unlock();
+    try {
+      publish_status();
+    } catch (const std::exception& e) {
+      log_ << "octomap-rt-server: status failed: " << e.what() << "\n";
+    }
+    lock.lock();
+    if (exit) return;
+  }
+}
+
+StatusInputs MappingServer::gather_status() {
+  StatusInputs in;
+  in.utime = now_utime();
+  in.start_utime = start_utime_;
+  in.uptime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  in.pid = static_cast<int32_t>(::getpid());
+  in.server_id = server_id_;
+  in.host = host_;
+  in.backend = to_string(engine_->backend().kind());
+  in.device = engine_->backend().device_name();
+  in.map_path = cfg_.map_path;
+  in.queue_policy = queue_.policy();
+  in.pipelined = cfg_.pipeline;
+  in.resolution = cfg_.engine.resolution;
+  {
+    std::lock_guard lock(map_.mutex);
+    in.num_nodes = static_cast<int64_t>(map_.tree->size());
+    in.num_leaf_nodes = static_cast<int64_t>(map_.tree->getNumLeafNodes());
+    in.memory_bytes = static_cast<int64_t>(map_.tree->memoryUsage());
+  }
+  in.queue_depth = static_cast<int32_t>(queue_.depth());
+  in.queue_bytes = static_cast<int64_t>(queue_.bytes());
+  in.queue_budget_bytes = static_cast<int64_t>(queue_.per_producer_budget());
+  in.shot_depth = pipeline_ ? static_cast<int32_t>(pipeline_->shot_depth()) : 0;
+  in.kernel_rcvbuf_errors = read_udp_rcvbuf_errors();
+  in.map_saves = saves_;
+  in.last_save_utime = last_save_utime_;
+  in.metrics = metrics_.snapshot();
+  in.producers = producers_.snapshot();
+  for (size_t i = 0; i < in.producers.size(); ++i)
+    in.producer_queue_bytes.push_back(static_cast<int64_t>(queue_.producer_bytes(i)));
+  std::lock_guard lock(state_mutex_);
+  in.state = state_;
+  in.message = message_;
+  in.seq = status_seq_;
+  return in;
+}
+
+octomap_rt::server_status_t MappingServer::status() { return make_status(gather_status()); }
+
+void MappingServer::publish_status() {
+  StatusInputs in = gather_status();
+  // Running <-> degraded: degraded while the last period saw drops, rejections or kernel
+  // UDP receive-buffer drops; the message says which.
+  int64_t drops = 0, rejects = 0;
+  for (const ProducerStats& p : in.producers) {
+    drops += p.dropped;
+    rejects += p.rejected;
+  }
+  std::ostringstream why;
+  if (drops > last_drops_) why << (drops - last_drops_) << " scans dropped (queue full); ";
+  if (rejects > last_rejects_) why << (rejects - last_rejects_) << " scans rejected; ";
+  if (last_kernel_errors_ >= 0 && in.kernel_rcvbuf_errors > last_kernel_errors_)
+    why << (in.kernel_rcvbuf_errors - last_kernel_errors_) << " UDP datagrams dropped by the kernel (receive buffer full); ";
+  last_drops_ = drops;
+  last_rejects_ = rejects;
+  last_kernel_errors_ = in.kernel_rcvbuf_errors;
+  {
+    std::lock_guard lock(state_mutex_);
+    if (intake_ && intake_->failed()) {
+      state_ = Status::STATE_ERROR;
+      message_ = "LCM intake failed; no scans are received";
+    } else if (state_ == Status::STATE_RUNNING && !why.str().empty()) {
+      state_ = Status::STATE_DEGRADED;
+      message_ = "degraded: " + why.str();
+    } else if (state_ == Status::STATE_DEGRADED) {
+      if (why.str().empty()) {
+        state_ = Status::STATE_RUNNING;
+        message_ = "serving " + cfg_.scan_channels;
+      } else {
+        message_ = "degraded: " + why.str();
+      }
+    }
+    in.state = state_;
+    in.message = message_;
+    in.seq = status_seq_++;
+  }
+  const octomap_rt::server_status_t msg = make_status(in);
+  lc_->publish(cfg_.status_channel, &msg);
+}
+
+void MappingServer::print_summary(std::ostream& out) {
+  const StatusInputs s = gather_status();
+  const MetricsSnapshot& m = s.metrics;
+  char line[512];
+  out << "octomap-rt-server summary\n";
+  std::snprintf(line, sizeof line, "  ran %.1f s as %s; back end %s on %s; pipeline %s; resolution %g m\n", s.uptime_s,
+                s.server_id.c_str(), s.backend.c_str(), s.device.c_str(), s.pipelined ? "on" : "off", s.resolution);
+  out << line;
+  out << "  producers (received = applied + rejected + dropped):\n";
+  for (const ProducerStats& p : s.producers) {
+    std::snprintf(line, sizeof line,
+                  "    %-16s received %lld = applied %lld + rejected %lld + dropped %lld%s; missed (seq gaps) %lld; "
+                  "points %lld\n",
+                  p.robot_id.c_str(), (long long)p.received, (long long)p.applied, (long long)p.rejected,
+                  (long long)p.dropped, p.in_flight ? (" + in flight " + std::to_string(p.in_flight)).c_str() : "",
+                  (long long)p.missed, (long long)p.points_applied);
+    out << line;
+    std::string reasons;
+    for (size_t k = 0; k < kRejectReasonCount; ++k)
+      if (p.rejects[k]) reasons += std::string(reasons.empty() ? "" : ", ") + to_string(static_cast<Reject>(k)) + " " +
+                                   std::to_string(p.rejects[k]);
+    if (!reasons.empty()) out << "      rejected: " << reasons << "\n";
+  }
+  std::snprintf(line, sizeof line,
+                "  stage times:  shoot (stage 1) p50 %.2f ms p99 %.2f ms, total %.1f ms; octree (stage 2) p50 %.2f ms "
+                "p99 %.2f ms, total %.1f ms; end to end p50 %.2f ms p99 %.2f ms\n",
+                m.shoot_p50, m.shoot_p99, m.shoot_total_ms, m.octree_p50, m.octree_p99, m.octree_total_ms, m.e2e_p50,
+                m.e2e_p99);
+  out << line;
+  std::snprintf(line, sizeof line,
+                "  overlap:      stage 1 busy %.3f s, stage 2 busy %.3f s, both at once %.3f s; %lld of %lld scans "
+                "had their octree update overlap another scan's shoot\n",
+                m.overlap.busy_s[0], m.overlap.busy_s[1], m.overlap.both_s, (long long)m.overlapped_scans,
+                (long long)m.scans_applied);
+  out << line;
+  std::snprintf(line, sizeof line, "  map:          %lld nodes (%lld leaves), %.1f MiB in memory, %zu scans applied in total\n",
+                (long long)s.num_nodes, (long long)s.num_leaf_nodes, s.memory_bytes / 1048576.0, map_.order.size());
+  out << line;
+  if (s.kernel_rcvbuf_errors >= 0) out << "  kernel UDP receive-buffer errors (this namespace): " << s.kernel_rcvbuf_errors << "\n";
+  if (!cfg_.map_path.empty()) {
+    std::snprintf(line, sizeof line,
+                  "  map file:     %s (saved %lld times; last save %.1f ms, map lock held at most %.1f ms)\n"
+                  "  order file:   %s.order\n",
+                  cfg_.map_path.c_str(), (long long)saves_.load(), last_save_ms_, max_save_lock_ms_,
+                  cfg_.map_path.c_str());
+    out << line;
+  } else {
+    out << "  map file:     none (no --map given: the map was not saved)\n";
+  }
+  if (!cfg_.applied_log.empty()) out << "  applied log:  " << cfg_.applied_log << "\n";
+}
+
+}  // namespace ort::daemon

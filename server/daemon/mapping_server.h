@@ -1,0 +1,104 @@
+// octomap-rt-server's logic, as a library so tests can run it in-process over memq://:
+// map (loaded from --map), engine, the LCM intake thread, the two-stage pipeline, status
+// heartbeats, periodic atomic saves, and the orderly stop (intake off, drain, save).
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <ostream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "daemon/map_state.h"
+#include "daemon/pipeline_metrics.h"
+#include "daemon/producer_registry.h"
+#include "daemon/scan_intake.h"
+#include "daemon/scan_pipeline.h"
+#include "daemon/scan_queue.h"
+#include "daemon/server_config.h"
+#include "daemon/status_message.h"
+#include "octomap_rt/server_status_t.hpp"
+
+namespace ort::daemon {
+
+class MappingServer {
+ public:
+  // Own LCM on cfg.lcm_url (default: host-local udpm with a raised receive buffer).
+  // Throws std::runtime_error with a clear message: map unreadable or of another
+  // resolution, back end unavailable, LCM not usable.
+  MappingServer(const ServerConfig& cfg, std::ostream& log);
+  // On a shared LCM (tests: one memq:// instance shared with in-process producers). The
+  // server's thread is the only one that may call handle on it.
+  MappingServer(const ServerConfig& cfg, lcm::LCM& shared, std::ostream& log);
+  ~MappingServer();
+
+  void start();
+  // Intake off, queue drained through the pipeline, final save and status. Idempotent.
+  void stop();
+
+  // Saves now if the map changed since the last save (or `force`). Thread-safe.
+  void save(bool force = false);
+
+  octomap_rt::server_status_t status();
+  std::vector<ProducerStats> producer_stats() const { return producers_.snapshot(); }
+  std::vector<AppliedEntry> applied_order() const { return map_.order.entries(); }
+  // Runs f(const OcTree&) under the map lock: a state between two whole scans.
+  template <class F>
+  auto with_map(F&& f) {
+    std::lock_guard lock(map_.mutex);
+    return f(static_cast<const octomap::OcTree&>(*map_.tree));
+  }
+  const std::string& lcm_url() const { return url_; }
+  // Human-readable end-of-run summary (per producer, stage times, overlap, map, files).
+  void print_summary(std::ostream& out);
+
+ private:
+  MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ostream& log);
+  void load_or_create_map();
+  void set_state(int8_t state, std::string message);
+  StatusInputs gather_status();
+  void publish_status();
+  void run_status_loop();
+  void run_save_loop();
+
+  ServerConfig cfg_;
+  std::ostream& log_;
+  std::string url_;
+  std::unique_ptr<lcm::LCM> own_lcm_;
+  lcm::LCM* lc_ = nullptr;
+  std::unique_ptr<MapEngine> engine_;
+  MapState map_;
+  ProducerRegistry producers_;
+  ScanQueue queue_;
+  PipelineMetrics metrics_;
+  std::unique_ptr<ScanIntake> intake_;
+  std::unique_ptr<ScanPipeline> pipeline_;
+
+  std::string host_, server_id_;
+  int64_t start_utime_ = 0;
+  std::chrono::steady_clock::time_point start_;
+
+  mutable std::mutex state_mutex_;            // state, message, status seq, threads' wake-up
+  std::condition_variable wake_;
+  int8_t state_ = octomap_rt::server_status_t::STATE_STARTING;
+  std::string message_;
+  bool state_changed_ = false, stopping_ = false, status_exit_ = false, started_ = false, stopped_ = false;
+  int64_t status_seq_ = 0;
+  int64_t last_drops_ = 0, last_kernel_errors_ = -1, last_rejects_ = 0;
+  std::thread status_thread_, save_thread_;
+
+  std::mutex save_mutex_;                     // one save at a time
+  uint64_t saved_version_ = UINT64_MAX;
+  std::atomic<int64_t> saves_{0}, last_save_utime_{0};
+  double max_save_lock_ms_ = 0, last_save_ms_ = 0;
+};
+
+// Microseconds since the Unix epoch.
+int64_t now_utime();
+
+}  // namespace ort::daemon

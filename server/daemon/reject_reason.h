@@ -1,0 +1,44 @@
+// Why a scan message was not integrated. Every message on a scan channel ends as applied,
+// dropped (queue over budget) or rejected with exactly one of these reasons; the names are
+// what status messages, logs and tests show.
+#pragma once
+
+#include <cstddef>
+
+namespace ort::daemon {
+
+enum class Reject {
+  kNone = 0,
+  // Wire-level checks, made on the raw bytes BEFORE the generated decode() runs (decode
+  // throws or allocates gigabytes on corrupt lengths; see ../shared/notes/lcm-1.3.1.md §0.8).
+  kTooLarge,            // message larger than the size bound
+  kTruncated,           // shorter than its fixed fields
+  kWrongFingerprint,    // first 8 bytes are not scan_t's fingerprint
+  kNegativeCount,       // num_xyz < 0
+  kCountTooLarge,       // num_xyz above the configured maximum points per scan
+  kCountExceedsData,    // num_xyz (or a string length) needs more bytes than the message has
+  kTrailingBytes,       // the message has more bytes than its counts account for
+  kBadStringLength,     // a string length field < 1 (LCM counts the NUL) or implausibly long
+  kDecodeFailed,        // decode() threw or returned an error despite the checks
+  // Content checks on the decoded message.
+  kCountNotMultipleOf3,
+  kNonFinitePoint,
+  kNonFinitePose,
+  kZeroQuaternion,
+  kNonUnitQuaternion,   // | |q| - 1 | > 1e-3
+  kBadMaxRange,         // NaN or infinite
+  kUnknownPointsFrame,
+  kBadRobotId,          // empty, too long, or outside [A-Za-z0-9_-]
+  kRobotIdMismatch,     // robot_id differs from the channel's suffix
+  kOriginOutsideMap,    // sensor origin outside the map's key range (OctoMap skips the scan)
+  kTooManyProducers,    // more scan channels than --max-producers
+  kEngineError,         // the engine threw while shooting or applying this scan
+  kCount_
+};
+
+inline constexpr std::size_t kRejectReasonCount = static_cast<std::size_t>(Reject::kCount_);
+
+// Stable human-readable name ("truncated", "non-finite point", ...).
+const char* to_string(Reject r);
+
+}  // namespace ort::daemon

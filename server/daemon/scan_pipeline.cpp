@@ -1,0 +1,114 @@
+#include "daemon/scan_pipeline.h"
+
+#include <iostream>
+
+#include "daemon/scan_to_map.h"
+
+namespace ort::daemon {
+namespace {
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+}  // namespace
+
+ScanPipeline::ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, ProducerRegistry& producers,
+                           PipelineMetrics& metrics, bool pipelined)
+    : engine_(engine), map_(map), queue_(queue), producers_(producers), metrics_(metrics), pipelined_(pipelined) {}
+
+ScanPipeline::~ScanPipeline() {
+  queue_.close();
+  join();
+}
+
+void ScanPipeline::start() {
+  if (pipelined_) {
+    stage1_ = std::thread([this] { run_stage1(); });
+    stage2_ = std::thread([this] { run_stage2(); });
+  } else {
+    stage1_ = std::thread([this] { run_sequential(); });
+  }
+}
+
+void ScanPipeline::join() {
+  if (stage1_.joinable()) stage1_.join();
+  if (stage2_.joinable()) stage2_.join();
+}
+
+void ScanPipeline::reject(size_t producer, Reject why, const char* what) {
+  if (why == Reject::kEngineError && engine_errors_++ < 10) std::cerr << "octomap-rt-server: engine error: " << what << "\n";
+  producers_.count_rejected_in_flight(producer, why);
+}
+
+bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
+  const double token = metrics_.overlap().begin(0);
+  const auto t0 = Clock::now();
+  bool ok = true;
+  try {
+    const MapFrameScan scan = to_map_frame(item.msg);
+    const std::span<const octomap::point3d> pts(scan.points.size() ? &scan.points[0] : nullptr, scan.points.size());
+    engine_.shoot(scan.origin, pts, effective_max_range(item.msg.max_range, engine_.options().max_range), job.shot);
+    if (!job.shot.prepare.origin_ok) {
+      reject(item.producer, Reject::kOriginOutsideMap, "");
+      ok = false;
+    }
+  } catch (const std::exception& e) {
+    reject(item.producer, Reject::kEngineError, e.what());
+    ok = false;
+  }
+  metrics_.overlap().end(0, token);
+  job.producer = item.producer;
+  job.robot_id = item.msg.robot_id;
+  job.seq = item.msg.seq;
+  job.utime = item.msg.utime;
+  job.points = item.msg.num_xyz / 3;
+  job.received = item.received;
+  job.shoot_ms = ms_between(t0, Clock::now());
+  return ok;
+}
+
+void ScanPipeline::apply(ShotJob& job) {
+  const double token = metrics_.overlap().begin(1);
+  const auto t0 = Clock::now();
+  try {
+    std::lock_guard lock(map_.mutex);
+    engine_.apply(job.shot, *map_.tree);
+    map_.order.append(AppliedEntry{job.robot_id, job.seq, job.utime});
+    map_.version++;
+    map_.last_scan_utime = std::max(map_.last_scan_utime, job.utime);
+  } catch (const std::exception& e) {
+    metrics_.overlap().end(1, token);
+    reject(job.producer, Reject::kEngineError, e.what());
+    return;
+  }
+  const auto t1 = Clock::now();
+  const double overlap_s = metrics_.overlap().end(1, token);
+  AppliedTiming t;
+  t.shoot_ms = job.shoot_ms;
+  t.octree_ms = ms_between(t0, t1);
+  t.end_to_end_ms = ms_between(job.received, t1);
+  t.points = job.points;
+  t.overlapped = overlap_s > 0;
+  metrics_.record(t);
+  producers_.count_applied(job.producer, job.points, t.end_to_end_ms);
+}
+
+void ScanPipeline::run_stage1() {
+  while (auto item = queue_.pop()) {
+    ShotJob job;
+    if (shoot(*item, job)) handoff_.push(std::move(job));
+  }
+  handoff_.close();
+}
+
+void ScanPipeline::run_stage2() {
+  while (auto job = handoff_.pop()) apply(*job);
+}
+
+void ScanPipeline::run_sequential() {
+  while (auto item = queue_.pop()) {
+    ShotJob job;
+    if (shoot(*item, job)) apply(job);
+  }
+}
+
+}  // namespace ort::daemon

@@ -1,0 +1,26 @@
+// A validated scan_t as the engine takes it: ray origin and points in the map frame, made
+// exactly as OctoMap makes them, so the server's map equals `octomap-rt build` of the same
+// scans: the pose becomes an octomap::pose6d (float components) and sensor-frame points go
+// through octomap::Pointcloud::transform.
+#pragma once
+
+#include <octomap/Pointcloud.h>
+#include <octomap/octomap_types.h>
+
+#include "octomap_rt/scan_t.hpp"
+
+namespace ort::daemon {
+
+octomap::pose6d scan_pose(const octomap_rt::scan_t& msg);
+
+struct MapFrameScan {
+  octomap::point3d origin;
+  octomap::Pointcloud points;
+};
+
+MapFrameScan to_map_frame(const octomap_rt::scan_t& msg);
+
+// Max range for this scan: the message's when > 0, else the server's; the smaller when both.
+double effective_max_range(float scan_max_range, double server_max_range);
+
+}  // namespace ort::daemon

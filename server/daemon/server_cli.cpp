@@ -1,0 +1,55 @@
+#include "daemon/server_cli.h"
+
+#include <regex>
+
+namespace ort::daemon {
+
+void add_server_flags(CLI::App& app, ServerFlags& f) {
+  app.set_config("--config", "", "read flags from this TOML/INI file (keys: the long flag names)");
+  ort::cli::add_engine_flags(app, f.engine, /*require_resolution=*/true);
+  ServerConfig& s = f.server;
+  app.add_option("--map", s.map_path,
+                 "map file (.ot, with log-odds): loaded at start if it exists, saved every --save-interval "
+                 "seconds and at exit (atomically); the applied scan order goes to FILE.order");
+  app.add_option("--save-interval", s.save_interval_s, "seconds between periodic saves; 0: only at exit")
+      ->capture_default_str();
+  app.add_option("--applied-log", s.applied_log, "also append each applied scan's (robot, seq) to this file as it happens");
+  app.add_option("--lcm-url", s.lcm_url,
+                 "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0); udpm URLs get "
+                 "recv_buf_size=min(--recv-buf-size, net.core.rmem_max) unless they set it");
+  app.add_option("--recv-buf-size", s.recv_buf_size, "UDP receive buffer wanted [bytes]")->capture_default_str();
+  app.add_option("--scan-channels", s.scan_channels,
+                 "regex of scan channels; the part after its literal prefix is the robot id")
+      ->capture_default_str();
+  app.add_option("--status-channel", s.status_channel, "channel of server_status_t heartbeats")->capture_default_str();
+  app.add_option("--status-period", s.status_period_s, "seconds between status messages")->capture_default_str();
+  app.add_flag("--no-pipeline", f.no_pipeline, "run the GPU and CPU stages on one thread, one scan after another");
+  app.add_option("--server-id", s.server_id, "name in status messages (default octomap-rt-server@HOST)");
+  app.add_option("--queue-mib", f.queue_mib,
+                 "per-producer queue budget [MiB]; 0: 1/64 of physical memory within [64, 1024]")
+      ->capture_default_str();
+  app.add_option("--max-points", s.max_points, "largest scan accepted [points]")->capture_default_str();
+  app.add_option("--max-producers", s.max_producers, "most scan channels served; more are rejected")
+      ->capture_default_str();
+}
+
+ServerConfig to_server_config(const ServerFlags& f) {
+  ServerConfig c = f.server;
+  c.engine = ort::cli::to_engine_options(f.engine);
+  c.pipeline = !f.no_pipeline;
+  if (f.queue_mib < 0) throw CLI::ValidationError("--queue-mib", "must be >= 0");
+  c.queue_budget_bytes = static_cast<uint64_t>(f.queue_mib * 1048576.0);
+  if (!(c.status_period_s > 0)) throw CLI::ValidationError("--status-period", "must be > 0");
+  if (c.max_points == 0) throw CLI::ValidationError("--max-points", "must be > 0");
+  if (c.max_producers == 0) throw CLI::ValidationError("--max-producers", "must be > 0");
+  try {
+    std::regex check(c.scan_channels);
+  } catch (const std::regex_error& e) {
+    throw CLI::ValidationError("--scan-channels", std::string("not a regular expression: ") + e.what());
+  }
+  if (!c.map_path.empty() && (c.map_path.size() < 4 || c.map_path.compare(c.map_path.size() - 3, 3, ".ot") != 0))
+    throw CLI::ValidationError("--map", "must name an .ot file (OctoMap's full format keeps the log-odds)");
+  return c;
+}
+
+}  // namespace ort::daemon

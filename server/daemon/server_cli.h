@@ -1,0 +1,23 @@
+// octomap-rt-server's command line (CLI11) and optional config file (--config FILE, TOML or
+// INI with the long flag names as keys, e.g. `resolution = 0.1`, `save-interval = 30`).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "daemon/server_config.h"
+#include "engine_flags.h"
+
+namespace ort::daemon {
+
+struct ServerFlags {
+  ort::cli::EngineFlags engine;
+  ServerConfig server;
+  bool no_pipeline = false;
+  double queue_mib = 0;
+};
+
+void add_server_flags(CLI::App& app, ServerFlags& f);
+// Validates and converts (after parsing); throws CLI::ValidationError with a clear message.
+ServerConfig to_server_config(const ServerFlags& f);
+
+}  // namespace ort::daemon

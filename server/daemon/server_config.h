@@ -1,0 +1,32 @@
+// Everything octomap-rt-server is configured with (flags or config file; see server_cli).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "engine/map_engine.h"
+
+namespace ort::daemon {
+
+struct ServerConfig {
+  EngineOptions engine;                        // resolution, sensor model, max range, back end
+  std::string lcm_url;                         // "": $LCM_DEFAULT_URL, else host-local udpm
+  uint64_t recv_buf_size = 16u << 20;          // udpm receive buffer wanted (capped by rmem_max)
+  std::string scan_channels = "OCTOMAP_RT_SCAN_.*";  // regex; its literal prefix + robot id
+  std::string status_channel = "OCTOMAP_RT_STATUS";
+  std::string map_path;                        // .ot; "": no persistence
+  std::string applied_log;                     // live applied-order log; "": none
+  double save_interval_s = 30;                 // <= 0: save only at exit
+  double status_period_s = 1.0;
+  bool pipeline = true;                        // false: both stages on one thread
+  std::string server_id;                       // "": octomap-rt-server@<host>
+  uint64_t queue_budget_bytes = 0;             // per producer; 0: automatic_queue_budget()
+  uint64_t max_points = 4'000'000;             // per scan
+  size_t max_producers = 64;
+  int lcm_queue_capacity = 64;                 // LCM's own per-subscription queue (messages)
+};
+
+// Per-producer queue budget sized by memory: 1/64 of physical memory, within [64 MiB, 1 GiB].
+uint64_t automatic_queue_budget();
+
+}  // namespace ort::daemon

@@ -1,0 +1,77 @@
+#include "daemon/status_message.h"
+
+namespace ort::daemon {
+
+octomap_rt::server_status_t make_status(const StatusInputs& in) {
+  octomap_rt::server_status_t s;
+  s.utime = in.utime;
+  s.seq = in.seq;
+  s.start_utime = in.start_utime;
+  s.uptime_s = in.uptime_s;
+  s.pid = in.pid;
+  s.state = in.state;
+  s.pipelined = in.pipelined;
+  s.resolution = in.resolution;
+  s.num_nodes = in.num_nodes;
+  s.num_leaf_nodes = in.num_leaf_nodes;
+  s.memory_bytes = in.memory_bytes;
+  s.scan_queue_depth = in.queue_depth;
+  s.scan_queue_bytes = in.queue_bytes;
+  s.queue_budget_bytes = in.queue_budget_bytes;
+  s.shot_queue_depth = in.shot_depth;
+  const MetricsSnapshot& m = in.metrics;
+  s.scans_applied = m.scans_applied;
+  s.points_applied = m.points_applied;
+  s.scans_per_s = static_cast<float>(m.scans_per_s);
+  s.points_per_s = static_cast<float>(m.points_per_s);
+  s.shoot_ms_p50 = static_cast<float>(m.shoot_p50);
+  s.shoot_ms_p99 = static_cast<float>(m.shoot_p99);
+  s.octree_ms_p50 = static_cast<float>(m.octree_p50);
+  s.octree_ms_p99 = static_cast<float>(m.octree_p99);
+  s.end_to_end_ms_p50 = static_cast<float>(m.e2e_p50);
+  s.end_to_end_ms_p99 = static_cast<float>(m.e2e_p99);
+  s.stage1_busy_s = m.overlap.busy_s[0];
+  s.stage2_busy_s = m.overlap.busy_s[1];
+  s.overlap_busy_s = m.overlap.both_s;
+  s.overlapped_scans = m.overlapped_scans;
+  s.kernel_rcvbuf_errors = in.kernel_rcvbuf_errors;
+  s.map_saves = in.map_saves;
+  s.last_save_utime = in.last_save_utime;
+  s.latest_snapshot_id = 0;
+  s.requests_served = 0;
+  for (size_t i = 0; i < in.producers.size(); ++i) {
+    const ProducerStats& p = in.producers[i];
+    octomap_rt::robot_stats_t r;
+    r.last_scan_utime = p.last_utime;
+    r.last_seq = p.last_seq;
+    r.scans_received = p.received;
+    r.scans_applied = p.applied;
+    r.scans_rejected = p.rejected;
+    r.scans_dropped = p.dropped;
+    r.scans_missed = p.missed;
+    r.points_applied = p.points_applied;
+    r.queue_depth = static_cast<int32_t>(p.in_flight);
+    r.queue_bytes = i < in.producer_queue_bytes.size() ? in.producer_queue_bytes[i] : 0;
+    r.last_end_to_end_ms = static_cast<float>(p.last_end_to_end_ms);
+    for (size_t k = 0; k < kRejectReasonCount; ++k) {
+      if (p.rejects[k] == 0) continue;
+      r.reject_reason.push_back(to_string(static_cast<Reject>(k)));
+      r.reject_count.push_back(p.rejects[k]);
+    }
+    r.num_reject_reasons = static_cast<int32_t>(r.reject_reason.size());
+    r.robot_id = p.robot_id;
+    r.channel = p.channel;
+    s.robots.push_back(std::move(r));
+  }
+  s.num_robots = static_cast<int32_t>(s.robots.size());
+  s.server_id = in.server_id;
+  s.host = in.host;
+  s.backend = in.backend;
+  s.device = in.device;
+  s.map_path = in.map_path;
+  s.queue_policy = in.queue_policy;
+  s.message = in.message;
+  return s;
+}
+
+}  // namespace ort::daemon
