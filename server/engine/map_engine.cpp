@@ -13,6 +13,7 @@ double ms_since(Clock::time_point t) {
 MapEngine::MapEngine(const EngineOptions& opts, std::string* log) : opts_(opts) {
   opts_.backend.resolution = opts.resolution;
   opts_.backend.max_range = opts.max_range;
+  opts_.backend.traversal = opts.traversal;
   backend_ = make_backend(opts_.backend, log);
 }
 

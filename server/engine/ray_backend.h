@@ -63,6 +63,7 @@ struct BackendOptions {
   double resolution = 0.1;
   double max_range = -1.0;         // sizes the persistent grid; < 0: no limit
   uint64_t grid_budget_bytes = 0;  // 0: automatic (capped by maxStorageBufferRange)
+  Traversal traversal = Traversal::kOctomap;  // rt refuses octomap mode at creation, so auto moves on
   bool verbose = false;
 };
 

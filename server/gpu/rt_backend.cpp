@@ -1,11 +1,15 @@
-// Placeholder until the ray-tracing back end lands (issue 5): refuses cleanly.
+// The engine's entry to the ray-tracing back end (server/gpu/rt/): default knobs (BLAS block
+// k = 4, shared ray space from max range). Where the device lacks the ray-tracing
+// extensions, or for --traversal octomap, it throws "unsupported: ..." and the automatic
+// choice moves on to the vulkan compute back end.
 #include "gpu/rt_backend.h"
 
-#include <stdexcept>
+#include "gpu/rt/rt_ray_backend.h"
 
 namespace ort {
-std::unique_ptr<RayBackend> make_rt_backend(const BackendOptions&, std::string*) {
-  throw std::runtime_error(
-      "unsupported: the rt back end needs VK_KHR_acceleration_structure and VK_KHR_ray_tracing_pipeline");
+
+std::unique_ptr<RayBackend> make_rt_backend(const BackendOptions& opts, std::string* log) {
+  return rt::make_rt_backend(opts, rt::RtOptions{}, log);
 }
+
 }  // namespace ort

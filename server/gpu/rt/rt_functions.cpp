@@ -1,0 +1,25 @@
+#include "gpu/rt/rt_functions.h"
+
+#include <stdexcept>
+#include <string>
+
+namespace ort::rt {
+
+RtFunctions load_rt_functions(VkDevice device) {
+  RtFunctions f;
+  auto load = [&](auto& fn, const char* name) {
+    fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(vkGetDeviceProcAddr(device, name));
+    if (!fn) throw std::runtime_error(std::string("unsupported: the Vulkan driver gives no ") + name);
+  };
+  load(f.create_acceleration_structure, "vkCreateAccelerationStructureKHR");
+  load(f.destroy_acceleration_structure, "vkDestroyAccelerationStructureKHR");
+  load(f.get_build_sizes, "vkGetAccelerationStructureBuildSizesKHR");
+  load(f.get_acceleration_structure_address, "vkGetAccelerationStructureDeviceAddressKHR");
+  load(f.cmd_build_acceleration_structures, "vkCmdBuildAccelerationStructuresKHR");
+  load(f.create_ray_tracing_pipelines, "vkCreateRayTracingPipelinesKHR");
+  load(f.get_shader_group_handles, "vkGetRayTracingShaderGroupHandlesKHR");
+  load(f.cmd_trace_rays, "vkCmdTraceRaysKHR");
+  return f;
+}
+
+}  // namespace ort::rt
