@@ -1,3 +1,17 @@
-# rt back end (issue 5): the GPU-free parts on the CPU; the GPU parity test skips cleanly
-# where the device lacks the ray-tracing extensions (lavapipe).
-octomap_rt_add_test(gpu_rt_space_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/rt_space_test.cpp TIMEOUT 300)
+# GPU back-end tests (vulkan compute). They run on whatever Vulkan device is found:
+# lavapipe in CI; $OCTOMAP_RT_TEST_DEVICE picks one (index or name substring).
+set(GPU_TEST_DIR ${CMAKE_CURRENT_LIST_DIR})
+add_library(octomap_rt_gpu_test_support STATIC ${GPU_TEST_DIR}/gpu_test_support.cpp ${GPU_TEST_DIR}/random_rays.cpp)
+target_include_directories(octomap_rt_gpu_test_support PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
+target_link_libraries(octomap_rt_gpu_test_support PUBLIC octomap_rt_test_support)
+
+octomap_rt_add_test(gpu_traversal_test SOURCES ${GPU_TEST_DIR}/traversal_test.cpp
+                    LIBS octomap_rt_gpu_test_support TIMEOUT 600)
+
+# rt back end (issue 5): the GPU-free parts on the CPU (layout, windows, window frame, a CPU
+# model of the rt shoot against the exact reference).
+octomap_rt_add_test(gpu_rt_space_test SOURCES ${GPU_TEST_DIR}/rt_space_test.cpp TIMEOUT 300)
+# rt against vulkan and the exact reference on the GPU; on a device without ray tracing it
+# checks the clean refusal and skips the comparisons.
+octomap_rt_add_test(gpu_rt_parity_test SOURCES ${GPU_TEST_DIR}/rt_parity_test.cpp
+                    LIBS octomap_rt_gpu_test_support TIMEOUT 900)

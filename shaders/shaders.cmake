@@ -1,0 +1,6 @@
+# The compute back end's shaders (server/gpu/vulkan_backend.cpp). The ray-tracing back end
+# lists its own shaders in rt_shaders.cmake.
+octomap_rt_embed_shader(shoot_octomap.comp shoot_octomap_spv)
+octomap_rt_embed_shader(shoot_exact.comp shoot_exact_spv)
+octomap_rt_embed_shader(compact_touched.comp compact_touched_spv)
+include(${CMAKE_CURRENT_LIST_DIR}/rt_shaders.cmake OPTIONAL)
