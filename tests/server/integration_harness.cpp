@@ -6,6 +6,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -232,11 +236,37 @@ void StatusWatcher::clear() {
   latest_.reset();
 }
 
-const octomap_rt::robot_stats_t* find_robot(const octomap_rt::server_status_t& s, const std::string& robot_id) {
+namespace {
+bool same_ci(const std::string& a, const std::string& b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::toupper(static_cast<unsigned char>(x)) == std::toupper(static_cast<unsigned char>(y));
+         });
+}
+}  // namespace
+
+const octomap_rt::robot_stats_t* find_robot_ci(const octomap_rt::server_status_t& s, const std::string& robot_id) {
   for (const auto& r : s.robots) {
-    if (r.robot_id == robot_id) return &r;
+    if (same_ci(r.robot_id, robot_id)) return &r;
   }
   return nullptr;
+}
+
+int producer_index(const std::string& robot_id, const std::string& prefix, int n) {
+  for (int i = 0; i < n; ++i) {
+    if (same_ci(robot_id, prefix + std::to_string(i))) return i;
+  }
+  return -1;
+}
+
+std::unique_ptr<octomap::OcTree> load_ot(const std::string& path) {
+  std::unique_ptr<octomap::AbstractOcTree> t(octomap::AbstractOcTree::read(path));
+  auto* tree = dynamic_cast<octomap::OcTree*>(t.get());
+  if (!tree) {
+    ADD_FAILURE() << path << " is not a loadable OcTree (.ot)";
+    return nullptr;
+  }
+  t.release();
+  return std::unique_ptr<octomap::OcTree>(tree);
 }
 
 int64_t total_applied(const octomap_rt::server_status_t& s) {

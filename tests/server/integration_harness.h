@@ -22,6 +22,7 @@
 #include <vector>
 
 #include <lcm/lcm-cpp.hpp>
+#include <octomap/OcTree.h>
 
 #include "octomap_rt/server_status_t.hpp"
 
@@ -101,10 +102,16 @@ class StatusWatcher {
   std::thread thread_;
 };
 
-// Producer counters by robot id from a status message; nullptr if the robot is absent.
-const octomap_rt::robot_stats_t* find_robot(const octomap_rt::server_status_t& s, const std::string& robot_id);
+// Producer counters by robot id (case-insensitive: the server names producers by their
+// channel suffix, which is upper case) from a status message; nullptr if absent.
+const octomap_rt::robot_stats_t* find_robot_ci(const octomap_rt::server_status_t& s, const std::string& robot_id);
+// i for robot "<prefix><i>" (case-insensitive) with 0 <= i < n, else -1.
+int producer_index(const std::string& robot_id, const std::string& prefix, int n);
 // Sum of scans_applied over all robots.
 int64_t total_applied(const octomap_rt::server_status_t& s);
+
+// Reads an .ot map; nullptr (and a test failure) if it is not a loadable OcTree.
+std::unique_ptr<octomap::OcTree> load_ot(const std::string& path);
 
 // A fresh temporary directory for one test (kept on failure for inspection).
 std::string make_test_dir(const std::string& tag);
