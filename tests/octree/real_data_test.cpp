@@ -1,0 +1,105 @@
+// The batched stage on real scans: voxel lists shot by the cpu back end (OctoMap's own ray
+// walk) at 0.1 m from ../shared/data, applied by OctoMap's updateNode loop and by the
+// batched stage with 1, 2, 7 and 16 threads; the trees must be the same after every scan.
+// The scans are then replayed, so that voxels saturate and free space gets pruned.
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <octomap/OcTree.h>
+
+#include "engine/map_engine.h"
+#include "octree/batched_update.h"
+#include "scene/scan_set.h"
+#include "support/test_data.h"
+#include "tree_checks.h"
+
+namespace ort {
+namespace {
+
+std::vector<VoxelList> shoot_lists(const std::string& graph, size_t max_scans) {
+  const std::string path = test::data_file(graph);
+  if (path.empty()) return {};
+  const ScanSet set = load_scan_graph(path);
+  EngineOptions opts;
+  opts.resolution = 0.1;
+  opts.backend.kind = BackendKind::kCpu;
+  MapEngine engine(opts);
+  std::vector<VoxelList> lists;
+  for (size_t i = 0; i < set.scans.size() && i < max_scans; ++i) {
+    const octomap::Pointcloud world = world_points(set.scans[i]);
+    ShotScan shot;
+    engine.shoot(sensor_origin(set.scans[i]), std::span<const octomap::point3d>(&world[0], world.size()),
+                 opts.max_range, shot);
+    lists.push_back(std::move(shot.voxels));
+  }
+  return lists;
+}
+
+std::string ot_bytes(const octomap::OcTree& t) {
+  std::ostringstream os;
+  t.write(os);
+  return os.str();
+}
+std::string bt_bytes(const octomap::OcTree& t) {
+  std::ostringstream os;
+  t.writeBinaryConst(os);
+  return os.str();
+}
+
+void check_data_set(const std::string& graph) {
+  const bool quick = test::quick_mode();
+  const std::vector<VoxelList> lists = shoot_lists(graph, quick ? 1 : 1000);
+  ASSERT_FALSE(lists.empty()) << graph;
+  const int passes = quick ? 2 : 3;  // the scans, then replayed: saturation and pruning
+
+  octomap::OcTree reference(0.1);
+  struct Batched {
+    unsigned threads;
+    octomap::OcTree tree{0.1};
+    std::unique_ptr<BatchedOctreeUpdater> updater;
+  };
+  std::vector<std::unique_ptr<Batched>> batched;
+  for (unsigned threads : {1u, 2u, 7u, 16u}) {
+    auto b = std::make_unique<Batched>();
+    b->threads = threads;
+    BatchedUpdateOptions opts;
+    opts.threads = threads;
+    b->updater = std::make_unique<BatchedOctreeUpdater>(opts);
+    batched.push_back(std::move(b));
+  }
+  size_t voxels = 0;
+  for (int pass = 0; pass < passes; ++pass) {
+    for (size_t s = 0; s < lists.size(); ++s) {
+      apply_updates_sequential(reference, lists[s]);
+      voxels += lists[s].size();
+      for (auto& b : batched) {
+        BatchedUpdateStats stats;
+        b->updater->apply(b->tree, lists[s], &stats);
+        if (b->threads > 1) {
+          EXPECT_GT(stats.subtrees, b->threads) << "the scan was not split";
+        }
+        ASSERT_TRUE(test::same_tree(reference, b->tree))
+            << graph << ", " << b->threads << " threads, pass " << pass << ", scan " << s;
+      }
+    }
+  }
+  // Written maps are byte for byte OctoMap's.
+  const std::string ot = ot_bytes(reference), bt = bt_bytes(reference);
+  for (auto& b : batched) {
+    EXPECT_EQ(ot_bytes(b->tree), ot) << b->threads << " threads";
+    EXPECT_EQ(bt_bytes(b->tree), bt) << b->threads << " threads";
+    EXPECT_EQ(b->tree.memoryUsage(), reference.memoryUsage());
+  }
+  std::printf("%s: %zu scans x %d passes, %zu voxel updates, %zu nodes\n", graph.c_str(), lists.size(), passes,
+              voxels, reference.size());
+}
+
+TEST(BatchedUpdateRealData, ThreeDtkThreeScans) { check_data_set("3dtk_dat/3dtk_3scans.graph"); }
+
+TEST(BatchedUpdateRealData, OctomapScanDat) { check_data_set("octomap_share/scan_dat.graph"); }
+
+}  // namespace
+}  // namespace ort
