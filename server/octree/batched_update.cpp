@@ -18,10 +18,6 @@ double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
-// Subtrees are cut no deeper than this: below, one range is a few thousand voxels of a
-// 25 m cube at 0.1 m resolution, already far below any useful grain.
-constexpr unsigned kMaxSplitDepth = 12;
-
 }  // namespace
 
 BatchedOctreeUpdater::BatchedOctreeUpdater(const BatchedUpdateOptions& opts)
@@ -65,7 +61,7 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
   }
 
   const size_t grain = std::max<size_t>(1, voxels.size() / (size_t{workers} * std::max(1u, opts_.subtrees_per_thread)));
-  const std::vector<SubtreeRange> ranges = split_into_subtrees(voxels, grain, kMaxSplitDepth);
+  const std::vector<SubtreeRange> ranges = split_into_subtrees(voxels, grain, std::max(1u, opts_.max_split_depth));
   if (ranges.size() == 1 && ranges.front().depth == 0) {  // nothing to split (tiny grain cannot happen here)
     update_subtree(tree, tree, SubtreeRoot{tree.getRoot(), 0, false}, voxels);
     st.subtrees = 1;

@@ -37,6 +37,9 @@ struct BatchedUpdateOptions {
   unsigned subtrees_per_thread = 8;
   // Below this many voxels a batch is updated on the calling thread alone.
   size_t min_parallel_voxels = 16384;
+  // Subtrees are cut no deeper than this (1..16): at 0.1 m a depth-12 node is a 1.6 m cube,
+  // already far below any useful grain. Tests cut deeper to exercise the split.
+  unsigned max_split_depth = 12;
 };
 
 // Where the time of the last apply() went, for tools/octree_bench.
