@@ -1,1 +1,2 @@
 include(${CMAKE_CURRENT_LIST_DIR}/integration_tests.cmake)
+include(${CMAKE_CURRENT_LIST_DIR}/unit_tests.cmake)

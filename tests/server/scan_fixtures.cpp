@@ -1,0 +1,115 @@
+#include "server/scan_fixtures.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "engine/map_engine.h"
+
+namespace ort::test {
+
+octomap_rt::scan_t scan_message(const PosedScan& scan, const std::string& robot_id, int64_t seq) {
+  octomap_rt::scan_t m;
+  m.utime = 1'700'000'000'000'000 + seq * 100'000;
+  m.seq = seq;
+  for (int i = 0; i < 3; ++i) m.sensor_position[i] = scan.pose.trans()(i);
+  const octomath::Quaternion& q = scan.pose.rot();
+  m.sensor_orientation[0] = q.u();
+  m.sensor_orientation[1] = q.x();
+  m.sensor_orientation[2] = q.y();
+  m.sensor_orientation[3] = q.z();
+  m.max_range = -1;
+  m.points_frame = octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME;
+  for (size_t i = 0; i < scan.points.size(); ++i) {
+    m.xyz.push_back(scan.points[i].x());
+    m.xyz.push_back(scan.points[i].y());
+    m.xyz.push_back(scan.points[i].z());
+  }
+  m.num_xyz = static_cast<int32_t>(m.xyz.size());
+  m.robot_id = robot_id;
+  m.map_frame = "map";
+  return m;
+}
+
+octomap_rt::scan_t small_scan(const std::string& robot_id, int64_t seq, int points) {
+  PosedScan s;
+  s.pose = octomap::pose6d(1.0f, 2.0f, 0.5f, 0.0, 0.0, 0.3);
+  for (int i = 0; i < points; ++i) s.points.push_back(2.0f, 0.05f * static_cast<float>(i - points / 2), 0.1f);
+  return scan_message(s, robot_id, seq);
+}
+
+std::vector<uint8_t> encode(const octomap_rt::scan_t& msg) {
+  std::vector<uint8_t> buf(static_cast<size_t>(msg.getEncodedSize()));
+  if (msg.encode(buf.data(), 0, static_cast<int>(buf.size())) < 0) ADD_FAILURE() << "encode failed";
+  return buf;
+}
+
+void put_be32(std::vector<uint8_t>& buf, size_t offset, int32_t v) {
+  const uint32_t u = static_cast<uint32_t>(v);
+  buf[offset] = uint8_t(u >> 24);
+  buf[offset + 1] = uint8_t(u >> 16);
+  buf[offset + 2] = uint8_t(u >> 8);
+  buf[offset + 3] = uint8_t(u);
+}
+
+daemon::ServerConfig test_config(double res, bool pipelined) {
+  daemon::ServerConfig c;
+  c.engine.resolution = res;
+  c.engine.backend.kind = BackendKind::kCpu;
+  c.pipeline = pipelined;
+  c.save_interval_s = 0;
+  c.status_period_s = 0.2;
+  c.server_id = "test-server";
+  return c;
+}
+
+bool wait_until_done(daemon::MappingServer& server, int64_t messages, std::chrono::seconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    int64_t received = 0, in_flight = 0;
+    for (const auto& p : server.producer_stats()) {
+      received += p.received;
+      in_flight += p.in_flight;
+    }
+    if (received >= messages && in_flight == 0) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
+}
+
+void expect_counts_balance(const std::vector<daemon::ProducerStats>& stats) {
+  for (const auto& p : stats) {
+    EXPECT_EQ(p.in_flight, 0) << p.channel;
+    EXPECT_EQ(p.received, p.applied + p.rejected + p.dropped) << p.channel;
+    int64_t by_reason = 0;
+    for (int64_t n : p.rejects) by_reason += n;
+    EXPECT_EQ(by_reason, p.rejected) << p.channel;
+  }
+}
+
+std::unique_ptr<octomap::OcTree> engine_reference(
+    const daemon::ServerConfig& cfg, const std::vector<daemon::AppliedEntry>& order,
+    const std::function<const PosedScan&(const std::string&, int64_t)>& by_robot_seq) {
+  MapEngine engine(cfg.engine);
+  auto tree = engine.make_tree();
+  for (const auto& e : order) {
+    const PosedScan& s = by_robot_seq(e.robot_id, e.seq);
+    const octomap::Pointcloud world = world_points(s);
+    ShotScan shot;
+    engine.insert(sensor_origin(s), std::span<const octomap::point3d>(world.size() ? &world[0] : nullptr, world.size()),
+                  *tree, shot);
+  }
+  return tree;
+}
+
+std::string temp_dir(const std::string& tag) {
+  const auto dir = std::filesystem::temp_directory_path() / ("octomap-rt-" + tag + "-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+}  // namespace ort::test

@@ -1,0 +1,49 @@
+// What the daemon's in-process tests share: scan_t messages made from posed scans (as a
+// producer makes them), raw encodings to corrupt, a server config for memq://, waiting for
+// the server to finish, and reference maps built in a given order.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "daemon/applied_order.h"
+#include "daemon/mapping_server.h"
+#include "daemon/server_config.h"
+#include "octomap_rt/scan_t.hpp"
+#include "scene/scan_set.h"
+
+namespace ort::test {
+
+// Sensor-frame points + pose (the float pose carried exactly in doubles).
+octomap_rt::scan_t scan_message(const PosedScan& scan, const std::string& robot_id, int64_t seq);
+// A small valid scan: `points` points 2 m in front of a sensor at (1, 2, 0.5).
+octomap_rt::scan_t small_scan(const std::string& robot_id, int64_t seq, int points = 30);
+std::vector<uint8_t> encode(const octomap_rt::scan_t& msg);
+void put_be32(std::vector<uint8_t>& buf, size_t offset, int32_t v);
+
+// cpu back end, resolution `res`, memq-friendly (no map file unless given).
+daemon::ServerConfig test_config(double res, bool pipelined);
+
+// Polls until every producer's messages are all received (sum = `messages`) and none is in
+// flight; false on timeout.
+bool wait_until_done(daemon::MappingServer& server, int64_t messages,
+                     std::chrono::seconds timeout = std::chrono::seconds(120));
+
+// Every producer: received = applied + rejected + dropped (nothing in flight).
+void expect_counts_balance(const std::vector<daemon::ProducerStats>& stats);
+
+// MapEngine (same options) applied to `scans` in `order`: the sequential reference.
+// `by_robot_seq(robot_id, seq)` returns the scan that (robot, seq) names.
+std::unique_ptr<octomap::OcTree> engine_reference(const daemon::ServerConfig& cfg,
+                                                  const std::vector<daemon::AppliedEntry>& order,
+                                                  const std::function<const PosedScan&(const std::string&, int64_t)>& by_robot_seq);
+
+std::string temp_dir(const std::string& tag);
+
+}  // namespace ort::test
