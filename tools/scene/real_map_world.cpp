@@ -81,24 +81,37 @@ World make_world_from_octomap(const std::string& map_path, double sensor_height)
           for (int x = cx; x < cx + span; ++x)
             if (x >= 0 && y >= 0 && z >= 0 && x < g.dims[0] && y < g.dims[1] && z < g.dims[2]) g.set(x, y, z);
     } else if (std::abs(it.getZ() - zs) <= half + 0.3) {
-      const int lx = int((it.getX() - x0) / lattice), ly = int((it.getY() - y0) / lattice);
-      if (lx >= 0 && ly >= 0 && lx < nx && ly < ny) free_votes[size_t(ly) * nx + lx] += span;
+      // a large (pruned) free leaf votes for every lattice cell under it
+      const int lx0 = std::max(0, int((it.getX() - half - x0) / lattice)), lx1 = std::min(nx - 1, int((it.getX() + half - x0) / lattice));
+      const int ly0 = std::max(0, int((it.getY() - half - y0) / lattice)), ly1 = std::min(ny - 1, int((it.getY() + half - y0) / lattice));
+      for (int ly = ly0; ly <= ly1; ++ly)
+        for (int lx = lx0; lx <= lx1; ++lx) free_votes[size_t(ly) * nx + lx] += 1;
     }
   }
-  // Usable lattice cells: seen free at sensor height and 0.4 m away from anything occupied.
+  // Usable lattice cells: seen free at sensor height and 0.2 m away from anything occupied
+  // (FR-079 has narrow passages in its corridor; a wider berth cuts the corridor in two).
   std::vector<char> ok(free_votes.size(), 0);
   for (int ly = 0; ly < ny; ++ly)
     for (int lx = 0; lx < nx; ++lx) {
       if (free_votes[size_t(ly) * nx + lx] == 0) continue;
       const Vec3 p{x0 + (lx + 0.5) * lattice, y0 + (ly + 0.5) * lattice, zs};
-      ok[size_t(ly) * nx + lx] = !inside_solid(w.scene, p, 0.4);
+      ok[size_t(ly) * nx + lx] = !inside_solid(w.scene, p, 0.2);
     }
-  int start = -1;
-  for (size_t c = 0; c < ok.size() && start < 0; ++c)
-    if (ok[c]) start = int(c);
-  if (start < 0) throw std::runtime_error("'" + map_path + "' has no free space at sensor height");
-  // The longest shortest walk (two sweeps of BFS): in a corridor building, the corridor.
+  // Start in the largest connected patch of usable cells (small pockets of seen-free space
+  // lie outside the building), then take the longest shortest walk in it (two BFS sweeps):
+  // in a corridor building, the corridor.
   std::vector<int> dist, parent;
+  int start = -1, best_size = 0;
+  std::vector<char> seen(ok.size(), 0);
+  for (size_t c = 0; c < ok.size(); ++c) {
+    if (!ok[c] || seen[c]) continue;
+    bfs(ok, nx, ny, int(c), dist, parent);
+    int size = 0;
+    for (size_t k = 0; k < dist.size(); ++k)
+      if (dist[k] >= 0) seen[k] = 1, ++size;
+    if (size > best_size) best_size = size, start = int(c);
+  }
+  if (start < 0) throw std::runtime_error("'" + map_path + "' has no free space at sensor height");
   bfs(ok, nx, ny, start, dist, parent);
   const int a = int(std::max_element(dist.begin(), dist.end()) - dist.begin());
   bfs(ok, nx, ny, a, dist, parent);

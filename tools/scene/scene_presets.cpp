@@ -86,10 +86,6 @@ Recipe recipe(const std::string& name, const PresetOptions& o) {
     const std::string dir = o.data_dir.empty() ? std::string("../shared/data") : o.data_dir;
     r.world = scene::make_world_from_octomap(dir + "/octomap_share/geb079.bt", 1.0);
     r.sensor.lidar = fr079_lidar();
-    // The real map has holes (unseen space) through which many beams find nothing; a finer
-    // sensor brings the returns back to ~89K a scan.
-    r.sensor.lidar.beams = 100;
-    r.sensor.lidar.columns = 2200;
     r.scans = 66;
   } else {
     throw std::runtime_error("unknown preset '" + name + "'");
