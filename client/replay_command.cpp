@@ -238,7 +238,11 @@ int run_replay(ReplayArgs a) {
   if (!lc.good()) throw std::runtime_error("cannot open LCM at " + url + " (for udpm on one host: "
                                            "ip route add 224.0.0.0/4 dev lo)");
   if (a.wait_for_server_s > 0) {
-    if (!wait_for_server_status(lc, a.status_channel, a.wait_for_server_s)) {
+    // A separate instance, closed before publishing: a subscribed udpm instance keeps a
+    // receive socket that would take in every robot's multi-MB scans with a small buffer
+    // and fill the kernel's receive-error counters the server reports.
+    lcm::LCM listener(url);
+    if (!wait_for_server_status(listener, a.status_channel, a.wait_for_server_s)) {
       std::cerr << "octomap-rt replay: no message on " << a.status_channel << " within " << a.wait_for_server_s
                 << " s at " << url << ": is octomap-rt-server running there?\n";
       return 2;
