@@ -244,6 +244,8 @@ bool same_ci(const std::string& a, const std::string& b) {
 }
 }  // namespace
 
+bool same_robot(const std::string& a, const std::string& b) { return same_ci(a, b); }
+
 const octomap_rt::robot_stats_t* find_robot_ci(const octomap_rt::server_status_t& s, const std::string& robot_id) {
   for (const auto& r : s.robots) {
     if (same_ci(r.robot_id, robot_id)) return &r;

@@ -105,6 +105,8 @@ class StatusWatcher {
 // Producer counters by robot id (case-insensitive: the server names producers by their
 // channel suffix, which is upper case) from a status message; nullptr if absent.
 const octomap_rt::robot_stats_t* find_robot_ci(const octomap_rt::server_status_t& s, const std::string& robot_id);
+// Robot ids compare case-insensitively (channel suffixes are upper case).
+bool same_robot(const std::string& a, const std::string& b);
 // i for robot "<prefix><i>" (case-insensitive) with 0 <= i < n, else -1.
 int producer_index(const std::string& robot_id, const std::string& prefix, int n);
 // Sum of scans_applied over all robots.

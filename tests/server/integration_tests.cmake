@@ -16,3 +16,5 @@ function(octomap_rt_add_integration_test name timeout)
 endfunction()
 
 octomap_rt_add_integration_test(server_producers_integration_test 300)
+octomap_rt_add_integration_test(server_large_scans_integration_test 400)
+octomap_rt_add_integration_test(server_persistence_integration_test 400)
