@@ -16,7 +16,7 @@ struct EngineFlags {
   std::string backend = "auto";
   std::string device;
   std::string traversal = "octomap";
-  std::string octree = "sequential";
+  std::string octree = "batched";
   unsigned threads = 0;
   SensorModel sensor;
 };

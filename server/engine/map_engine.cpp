@@ -10,7 +10,7 @@ double ms_since(Clock::time_point t) {
 }
 }  // namespace
 
-MapEngine::MapEngine(const EngineOptions& opts, std::string* log) : opts_(opts) {
+MapEngine::MapEngine(const EngineOptions& opts, std::string* log) : opts_(opts), octree_stage_(opts.octree) {
   opts_.backend.resolution = opts.resolution;
   opts_.backend.max_range = opts.max_range;
   opts_.backend.traversal = opts.traversal;
@@ -36,7 +36,7 @@ void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::p
 
 void MapEngine::apply(ShotScan& scan, octomap::OcTree& tree) const {
   const auto t0 = Clock::now();
-  apply_updates(tree, scan.voxels, opts_.octree);
+  octree_stage_.apply(tree, scan.voxels);
   scan.shoot.times.octree_ms += ms_since(t0);
 }
 

@@ -64,6 +64,7 @@ class MapEngine {
  private:
   EngineOptions opts_;
   std::unique_ptr<RayBackend> backend_;
+  mutable OctreeStage octree_stage_;  // keeps the batched stage's threads between scans; only apply() uses it
 };
 
 }  // namespace ort

@@ -16,4 +16,22 @@ void apply_updates(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
   }
 }
 
+OctreeStage::OctreeStage(const OctreeUpdateOptions& opts) : opts_(opts) {}
+OctreeStage::~OctreeStage() = default;
+OctreeStage::OctreeStage(OctreeStage&&) noexcept = default;
+OctreeStage& OctreeStage::operator=(OctreeStage&&) noexcept = default;
+
+void OctreeStage::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates) {
+  if (opts_.mode == OctreeUpdateMode::kSequential) {
+    apply_updates_sequential(tree, updates);
+    return;
+  }
+  if (!batched_) {
+    BatchedUpdateOptions o;
+    o.threads = opts_.threads;
+    batched_ = std::make_unique<BatchedOctreeUpdater>(o);
+  }
+  batched_->apply(tree, updates);
+}
+
 }  // namespace ort

@@ -3,6 +3,7 @@
 // OctoMap's insertPointCloud gives.
 #pragma once
 
+#include <memory>
 #include <span>
 
 #include <octomap/OcTree.h>
@@ -17,14 +18,33 @@ enum class OctreeUpdateMode {
 };
 
 struct OctreeUpdateOptions {
-  OctreeUpdateMode mode = OctreeUpdateMode::kSequential;
+  OctreeUpdateMode mode = OctreeUpdateMode::kBatched;
   unsigned threads = 0;  // batched mode: 0 = hardware threads
 };
 
 // Plain updateNode loop: each voxel updated once, occupied or free.
 void apply_updates_sequential(octomap::OcTree& tree, std::span<const VoxelUpdate> updates);
 
+// One-off: the batched mode starts its threads for this call only (see OctreeStage).
 void apply_updates(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
                    const OctreeUpdateOptions& opts);
+
+class BatchedOctreeUpdater;
+
+// The octree stage as the engine keeps it: in batched mode the updater, its threads and
+// buffers are made on first use and kept from scan to scan. One apply() at a time.
+class OctreeStage {
+ public:
+  explicit OctreeStage(const OctreeUpdateOptions& opts);
+  ~OctreeStage();
+  OctreeStage(OctreeStage&&) noexcept;
+  OctreeStage& operator=(OctreeStage&&) noexcept;
+
+  void apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates);
+
+ private:
+  OctreeUpdateOptions opts_;
+  std::unique_ptr<BatchedOctreeUpdater> batched_;
+};
 
 }  // namespace ort

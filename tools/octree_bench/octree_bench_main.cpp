@@ -1,0 +1,166 @@
+// octomap-rt-octree-bench: times the octree stage alone. The voxel lists of each scan are
+// shot once with the cpu back end (OctoMap's own ray walk); then OctoMap's loop of
+// updateNode(key, occupied, lazy_eval = false) and the batched stage build the map from the
+// same lists, several times, alternating, and the best time of each is compared. Every
+// batched map is checked against OctoMap's (operator==: every node, value and the count).
+//
+// The lists are applied `--passes` times in a row: the first pass makes the map (mostly new
+// nodes), the later ones update a map that exists (saturated voxels, pruned free space),
+// which is what a long mapping run mostly does.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <octomap/OcTree.h>
+
+#include "engine/map_engine.h"
+#include "octree/batched_update.h"
+#include "octree/morton_order.h"
+#include "scene/scan_set.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+struct DataSet {
+  std::string name;
+  std::vector<ort::VoxelList> lists;
+  size_t voxels = 0;
+};
+
+DataSet shoot_lists(const std::string& path, double resolution) {
+  const ort::ScanSet set = ort::load_scan_graph(path);
+  ort::EngineOptions opts;
+  opts.resolution = resolution;
+  opts.backend.kind = ort::BackendKind::kCpu;
+  ort::MapEngine engine(opts);
+  DataSet d;
+  d.name = path.substr(path.find_last_of('/') + 1);
+  for (const ort::PosedScan& scan : set.scans) {
+    const octomap::Pointcloud world = ort::world_points(scan);
+    ort::ShotScan shot;
+    engine.shoot(ort::sensor_origin(scan), std::span<const octomap::point3d>(&world[0], world.size()), -1.0, shot);
+    d.voxels += shot.voxels.size();
+    d.lists.push_back(std::move(shot.voxels));
+  }
+  return d;
+}
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  return "unknown";
+}
+
+struct Timing {
+  double best_ms = 1e300;
+  ort::BatchedUpdateStats stats;  // summed over the lists of the best run
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Octree stage benchmark: batched stage vs OctoMap's updateNode loop on the same voxel lists"};
+  std::string data_dir = OCTOMAP_RT_DATA_DIR;
+  std::vector<std::string> graphs{"3dtk_dat/3dtk_3scans.graph", "octomap_share/scan_dat.graph"};
+  std::vector<unsigned> threads;
+  double resolution = 0.1;
+  int repeat = 5, passes = 3;
+  app.add_option("--data", data_dir, "data folder")->capture_default_str();
+  app.add_option("--graph", graphs, "ScanGraph files below the data folder")->capture_default_str();
+  app.add_option("--threads", threads, "thread counts of the batched stage (default: 1, 2, ..., hardware)");
+  app.add_option("-r,--resolution", resolution, "voxel size [m]")->capture_default_str();
+  app.add_option("--repeat", repeat, "runs of each, best taken")->capture_default_str();
+  app.add_option("--passes", passes, "times the scan lists are applied in a row per run")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  if (threads.empty()) {
+    for (unsigned t = 1; t < hw; t *= 2) threads.push_back(t);
+    threads.push_back(hw);
+  }
+  std::printf("octree stage benchmark: %u hardware threads, %s\n", hw, cpu_model().c_str());
+  std::printf("resolution %.3g m, %d pass(es) over each data set's lists, best of %d runs\n\n", resolution, passes,
+              repeat);
+
+  int failures = 0;
+  for (const std::string& g : graphs) {
+    const DataSet d = shoot_lists(data_dir + "/" + g, resolution);
+    std::printf("%s: %zu scans, %zu voxel updates per pass\n", d.name.c_str(), d.lists.size(), d.voxels);
+
+    // Sorting alone: radix vs std::sort on the same lists.
+    {
+      std::vector<ort::SortedVoxel> out, scratch;
+      double radix = 1e300, standard = 1e300;
+      for (int r = 0; r < repeat; ++r) {
+        auto t = Clock::now();
+        for (const auto& l : d.lists) ort::sort_voxels(l, out, scratch, ort::SortMethod::kRadix);
+        radix = std::min(radix, ms_since(t));
+        t = Clock::now();
+        for (const auto& l : d.lists) ort::sort_voxels(l, out, scratch, ort::SortMethod::kStd);
+        standard = std::min(standard, ms_since(t));
+      }
+      std::printf("  Morton sort per pass: radix %.2f ms, std::sort %.2f ms (%.1fx)\n", radix, standard,
+                  standard / radix);
+    }
+
+    std::vector<std::unique_ptr<ort::BatchedOctreeUpdater>> batched;
+    for (unsigned t : threads) {
+      ort::BatchedUpdateOptions o;
+      o.threads = t;
+      batched.push_back(std::make_unique<ort::BatchedOctreeUpdater>(o));
+    }
+    Timing octomap_time;
+    std::vector<Timing> batched_time(threads.size());
+    size_t nodes = 0;
+    for (int r = 0; r < repeat; ++r) {
+      octomap::OcTree reference(resolution);
+      auto t = Clock::now();
+      for (int p = 0; p < passes; ++p)
+        for (const auto& l : d.lists) ort::apply_updates_sequential(reference, l);
+      octomap_time.best_ms = std::min(octomap_time.best_ms, ms_since(t));
+      nodes = reference.size();
+      for (size_t i = 0; i < threads.size(); ++i) {
+        octomap::OcTree tree(resolution);
+        ort::BatchedUpdateStats sum, one;
+        t = Clock::now();
+        for (int p = 0; p < passes; ++p)
+          for (const auto& l : d.lists) {
+            batched[i]->apply(tree, l, &one);
+            sum.sort_ms += one.sort_ms;
+            sum.top_ms += one.top_ms;
+            sum.subtrees_ms += one.subtrees_ms;
+            sum.settle_ms += one.settle_ms;
+            sum.subtrees += one.subtrees;
+            sum.node_count_change += one.node_count_change;
+          }
+        const double ms = ms_since(t);
+        if (ms < batched_time[i].best_ms) batched_time[i] = Timing{ms, sum};
+        if (!(tree == reference)) {
+          std::printf("  MISMATCH: batched map with %u threads differs from OctoMap's\n", threads[i]);
+          ++failures;
+        }
+      }
+    }
+    const double passes_voxels = double(d.voxels) * passes;
+    std::printf("  OctoMap updateNode loop: %9.1f ms  (%.0f ns/voxel), %zu nodes\n", octomap_time.best_ms,
+                octomap_time.best_ms * 1e6 / passes_voxels, nodes);
+    for (size_t i = 0; i < threads.size(); ++i) {
+      const Timing& b = batched_time[i];
+      std::printf("  batched, %2u thread(s):   %9.1f ms  (%.0f ns/voxel)  %6.1fx   [sort %.1f, top %.1f, "
+                  "subtrees %.1f, settle+count %.1f ms; %zu subtrees, %lld nodes counted in]\n",
+                  threads[i], b.best_ms, b.best_ms * 1e6 / passes_voxels, octomap_time.best_ms / b.best_ms,
+                  b.stats.sort_ms, b.stats.top_ms, b.stats.subtrees_ms, b.stats.settle_ms, b.stats.subtrees,
+                  b.stats.node_count_change);
+    }
+    std::printf("\n");
+  }
+  return failures == 0 ? 0 : 1;
+}
