@@ -45,7 +45,8 @@ struct BenchArgs {
   std::string device;
   int warmup = 1, repeat = 1;
   bool no_octomap_breakdown = false;
-  std::string csv, png_dir, markdown, replot;
+  std::string csv, png_dir, markdown;
+  std::vector<std::string> replot;
 };
 
 uint64_t current_rss_bytes() {
@@ -241,7 +242,11 @@ void save_outputs(const std::vector<BenchRow>& rows, const BenchArgs& a) {
 
 int run_bench(const BenchArgs& a) {
   if (!a.replot.empty()) {  // chart and table a CSV measured elsewhere (the GPU machine)
-    const auto rows = bench::read_csv(a.replot);
+    std::vector<BenchRow> rows;
+    for (const auto& path : a.replot) {
+      auto more = bench::read_csv(path);
+      rows.insert(rows.end(), more.begin(), more.end());
+    }
     save_outputs(rows, a);
     if (a.markdown.empty()) bench::write_markdown(rows, std::cout);
     return 0;
@@ -376,7 +381,8 @@ void register_bench_command(CLI::App& app) {
   cmd->add_option("--csv", a->csv, "write the results as CSV");
   cmd->add_option("--markdown", a->markdown, "write the tables as Markdown (default: to stdout)");
   cmd->add_option("--png", a->png_dir, "write a stage chart per data set (gnuplot) into this folder");
-  cmd->add_option("--replot", a->replot, "measure nothing: table and chart this CSV (from another machine)");
+  cmd->add_option("--replot", a->replot, "measure nothing: table and chart these CSV files (e.g. from the GPU machine)")
+      ->delimiter(',');
   cmd->callback([a] {
     const int rc = run_bench(*a);
     if (rc != 0) throw CLI::RuntimeError(rc);
