@@ -20,9 +20,11 @@ uint64_t auto_grid_budget(uint64_t max_storage_buffer_range, uint64_t device_loc
 // With a max range (>= 0) the grid is a cube of side 2 * (ceil(max_range / res) + 3) + 1
 // voxels: any ray space of one scan then fits in one window. Either way it is capped by
 // `budget_bytes` (and by max_buffer_bytes); without a max range it is the budget. The output
-// holds every voxel of a full grid where that is small, else a few voxels a word, bounded by
-// max_buffer_bytes and 512 MiB; larger scans are compacted in several chunks.
+// holds every voxel of a full grid up to 16M voxels (128 MiB), else 4 voxels a word, bounded
+// by max_buffer_bytes and 512 MiB; larger scans are compacted in several chunks.
+// `output_voxels` > 0 replaces the automatic output capacity (tests use a small one to make
+// compaction run in chunks).
 RaySpaceSizing size_ray_space(double max_range, double resolution, uint64_t budget_bytes,
-                              uint64_t max_buffer_bytes, uint32_t max_dispatch_groups);
+                              uint64_t max_buffer_bytes, uint32_t max_dispatch_groups, uint64_t output_voxels = 0);
 
 }  // namespace ort::gpu

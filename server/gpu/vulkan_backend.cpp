@@ -46,7 +46,7 @@ enum Stamp : uint32_t { kStampStart, kStampUploaded, kStampShot, kStampCompacted
 
 class VulkanBackend final : public RayBackend {
  public:
-  VulkanBackend(const BackendOptions& opts, std::string* log) {
+  VulkanBackend(const BackendOptions& opts, const VulkanTuning& tuning, std::string* log) {
     vk::ContextOptions co;
     co.device = opts.device;
     co.need_float64 = true;  // OctoMap's tMax/tDelta are doubles
@@ -57,7 +57,8 @@ class VulkanBackend final : public RayBackend {
     const uint64_t budget = opts.grid_budget_bytes
                                 ? opts.grid_budget_bytes
                                 : gpu::auto_grid_budget(limits.maxStorageBufferRange, ctx_->device_local_bytes());
-    sizing_ = gpu::size_ray_space(opts.max_range, opts.resolution, budget, limits.maxStorageBufferRange, max_groups_);
+    sizing_ = gpu::size_ray_space(opts.max_range, opts.resolution, budget, limits.maxStorageBufferRange, max_groups_,
+                                  tuning.output_voxels);
 
     // Unified memory (lavapipe, integrated GPUs): everything host-visible, read and written
     // in place. Discrete GPUs: device-local working buffers, host-visible staging.
@@ -91,7 +92,7 @@ class VulkanBackend final : public RayBackend {
 
     name_ = ctx_->device_name() + " (" + vk::device_type_name(ctx_->properties().deviceType) + ")";
     if (log) {
-      *log += "vulkan: " + name_ + ", grid " + std::to_string(sizing_.grid_words * 4 >> 20) + " MiB (" +
+      *log += "vulkan: " + name_ + ", grid " + std::to_string((sizing_.grid_words * 4 + 1023) >> 10) + " KiB (" +
               std::to_string(sizing_.grid_words * gpu::kVoxelsPerWord) + " voxels), " +
               (unified_ ? "unified memory" : "device-local memory with staging") + "\n";
     }
@@ -283,8 +284,13 @@ class VulkanBackend final : public RayBackend {
 
 }  // namespace
 
+std::unique_ptr<RayBackend> make_vulkan_backend(const BackendOptions& opts, const VulkanTuning& tuning,
+                                                std::string* log) {
+  return std::make_unique<VulkanBackend>(opts, tuning, log);
+}
+
 std::unique_ptr<RayBackend> make_vulkan_backend(const BackendOptions& opts, std::string* log) {
-  return std::make_unique<VulkanBackend>(opts, log);
+  return make_vulkan_backend(opts, VulkanTuning{}, log);
 }
 
 }  // namespace ort

@@ -15,3 +15,5 @@ octomap_rt_add_test(gpu_rt_space_test SOURCES ${GPU_TEST_DIR}/rt_space_test.cpp 
 # checks the clean refusal and skips the comparisons.
 octomap_rt_add_test(gpu_rt_parity_test SOURCES ${GPU_TEST_DIR}/rt_parity_test.cpp
                     LIBS octomap_rt_gpu_test_support TIMEOUT 900)
+octomap_rt_add_test(gpu_ray_space_test SOURCES ${GPU_TEST_DIR}/ray_space_test.cpp
+                    LIBS octomap_rt_gpu_test_support TIMEOUT 600)
