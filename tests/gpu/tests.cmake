@@ -17,3 +17,5 @@ octomap_rt_add_test(gpu_rt_parity_test SOURCES ${GPU_TEST_DIR}/rt_parity_test.cp
                     LIBS octomap_rt_gpu_test_support TIMEOUT 900)
 octomap_rt_add_test(gpu_ray_space_test SOURCES ${GPU_TEST_DIR}/ray_space_test.cpp
                     LIBS octomap_rt_gpu_test_support TIMEOUT 600)
+octomap_rt_add_test(gpu_device_test SOURCES ${GPU_TEST_DIR}/device_choice_test.cpp TIMEOUT 300)
+octomap_rt_add_test(gpu_no_device_test SOURCES ${GPU_TEST_DIR}/no_device_test.cpp TIMEOUT 120)
