@@ -188,18 +188,20 @@ void compare_on_real_data(const rt::RtOptions& knobs, bool check_reference_on_fi
         EXPECT_TRUE(same(got, want)) << c.file << " @" << c.resolution << " scan " << scan << ": "
                                  << diff_voxels(got, want, batch, Traversal::kExact);
       }
+      bool equal_vk = false;
       if (vk) {
         VoxelList other;
         ShootStats vs;
         vk->shoot(batch, Traversal::kExact, other, vs);
         sort_voxels(other);
-        EXPECT_TRUE(same(got, other)) << c.file << " @" << c.resolution << " scan " << scan << ": rt " << got.size()
+        equal_vk = same(got, other);
+        EXPECT_TRUE(equal_vk) << c.file << " @" << c.resolution << " scan " << scan << ": rt " << got.size()
                                   << " voxels, vulkan " << other.size();
       }
       std::printf("%s res %.2f max_range %.0f scan %d: %zu rays, %zu voxels, %llu window(s), k=%d space %dx%dx%d%s\n",
                   c.file, c.resolution, c.max_range, scan, batch.ends.size(), got.size(),
                   (unsigned long long)stats.windows, info.layout.block, info.layout.voxels(0), info.layout.voxels(1),
-                  info.layout.voxels(2), vk ? ", equal to vulkan" : "");
+                  info.layout.voxels(2), equal_vk ? ", equal to vulkan" : (vk ? ", DIFFERENT from vulkan" : ""));
       ++scan;
     }
   }

@@ -133,20 +133,40 @@ TEST(RtSpace, WindowFrameIsVoxelUnitsFromTheLowKey) {
 // ---- CPU model of the rt shoot ----------------------------------------------------------
 
 // What a ray-tracing implementation at least reports: float ray vs float AABB, slab test.
+// Written the way fast traversal kernels write it (reciprocal direction, box * inv - o * inv,
+// comparisons that fail on NaN), which is what makes exactly-zero components dangerous.
 bool float_ray_hits_box(const float o[3], const float d[3], float tmax, const float lo[3], const float hi[3]) {
   float t0 = 0.0f, t1 = tmax;
   for (int i = 0; i < 3; ++i) {
-    if (d[i] == 0.0f) {
-      if (o[i] < lo[i] || o[i] > hi[i]) return false;
-      continue;
-    }
-    float ta = (lo[i] - o[i]) / d[i], tb = (hi[i] - o[i]) / d[i];
+    const float inv = 1.0f / d[i];
+    float ta = lo[i] * inv - o[i] * inv, tb = hi[i] * inv - o[i] * inv;
     if (ta > tb) std::swap(ta, tb);
+    if (!(ta <= t1) || !(tb >= t0)) return false;  // NaN: not hit
     t0 = std::max(t0, ta);
     t1 = std::min(t1, tb);
-    if (t0 > t1) return false;
   }
   return true;
+}
+
+TEST(RtSpace, TraceDirectionHasNoZeroComponents) {
+  const float o[3] = {3.0f, 5.0f, 7.0f}, f[3] = {3.0f, 9.5f, 7.0f - 1e-9f};
+  float d[3];
+  trace_direction(o, f, d);
+  EXPECT_EQ(d[0], kMinDirection);
+  EXPECT_EQ(d[1], 4.5f);
+  EXPECT_EQ(d[2], kMinDirection);  // 7 - 1e-9 rounds to 7 in float
+  const float g[3] = {3.0f - 1e-6f, 5.0f, 7.0f};
+  trace_direction(o, g, d);
+  EXPECT_EQ(d[0], -kMinDirection);  // the sign of a tiny component is kept
+  // A ray in the plane y = 5 (a voxel face) meets the boxes on both sides of the face...
+  const float below_lo[3] = {2.0f - kAabbMargin, 4.0f - kAabbMargin, 6.0f - kAabbMargin};
+  const float below_hi[3] = {3.0f + kAabbMargin, 5.0f + kAabbMargin, 7.0f + kAabbMargin};
+  const float ray_end[3] = {9.0f, 5.0f, 7.0f};
+  trace_direction(o, ray_end, d);
+  EXPECT_TRUE(float_ray_hits_box(o, d, 1.0f, below_lo, below_hi));
+  // ...which the raw direction (zero y and z) loses to inf - inf in this arithmetic.
+  const float raw[3] = {6.0f, 0.0f, 0.0f};
+  EXPECT_FALSE(float_ray_hits_box(o, raw, 1.0f, below_lo, below_hi));
 }
 
 // The rt back end's algorithm, in C++: windows, float frame, enlarged AABBs as candidates,
@@ -163,7 +183,7 @@ VoxelList model_rt_shoot(const RayBatch& batch, const SpaceLayout& s, uint64_t* 
       float o[3], f[3], d[3];
       to_window_frame(a, res, w.lo, o);
       to_window_frame(b, res, w.lo, f);
-      for (int i = 0; i < 3; ++i) d[i] = f[i] - o[i];
+      trace_direction(o, f, d);
       // Enumerate the voxels of this window near the float segment (the BVH's job).
       int vlo[3], vhi[3];
       for (int i = 0; i < 3; ++i) {
@@ -183,9 +203,7 @@ VoxelList model_rt_shoot(const RayBatch& batch, const SpaceLayout& s, uint64_t* 
               lo[i] = boxes[prim].min[i] + t[i];
               hi[i] = boxes[prim].max[i] + t[i];
             }
-            const bool zero = d[0] == 0.0f && d[1] == 0.0f && d[2] == 0.0f;
-            const float dz[3] = {1.0f, 0.0f, 0.0f};
-            if (!float_ray_hits_box(o, zero ? dz : d, zero ? 0.0f : 1.0f, lo, hi)) continue;
+            if (!float_ray_hits_box(o, d, 1.0f, lo, hi)) continue;
             if (candidates) ++*candidates;
             int key[3];
             voxel_key(s, w.lo, inst, prim, key);

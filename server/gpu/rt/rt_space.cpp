@@ -99,7 +99,15 @@ std::vector<KeyBox> plan_windows(const KeyBox& keys, const SpaceLayout& s, int m
 }
 
 void to_window_frame(const double p[3], double resolution, const int lo[3], float out[3]) {
-  for (int i = 0; i < 3; ++i) out[i] = float(p[i] / resolution - double(lo[i] - kTreeMaxVal));
+  const double factor = 1.0 / resolution;
+  for (int i = 0; i < 3; ++i) out[i] = float(p[i] * factor - double(lo[i] - kTreeMaxVal));
+}
+
+void trace_direction(const float o[3], const float f[3], float out[3]) {
+  for (int i = 0; i < 3; ++i) {
+    const float d = f[i] - o[i];
+    out[i] = std::fabs(d) >= kMinDirection ? d : (d < 0.0f ? -kMinDirection : kMinDirection);
+  }
 }
 
 }  // namespace ort::rt

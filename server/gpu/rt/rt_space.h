@@ -77,8 +77,20 @@ void voxel_key(const SpaceLayout& s, const int lo[3], uint64_t instance, uint32_
 // exactly one window.
 std::vector<KeyBox> plan_windows(const KeyBox& keys, const SpaceLayout& s, int margin = 0);
 
-// A map-frame point in window `lo`'s frame, voxel units: p / res - (lo - 32768), in double
-// then rounded to float (as the ray generation shader does).
+// The smallest direction component a traced ray gets (voxel units over t in [0, 1]). WHY:
+// with an exactly zero component, a slab test written as box * (1/d) - o * (1/d) computes
+// inf - inf = NaN and drops boxes the ray runs along: measured on NVIDIA's driver, which
+// missed the voxels beside rays that lie in voxel faces. A component below this is set to
+// +-kMinDirection; the ray then drifts by at most 2^-20 voxel, far inside kAabbMargin, and
+// the exact test still uses the true segment.
+constexpr float kMinDirection = 1.0f / 1048576.0f;
+
+// The direction traced from o to f in the window frame (f - o, small components lifted as
+// above); the ray is traced over t in [0, 1]. The ray generation shader does the same.
+void trace_direction(const float o[3], const float f[3], float out[3]);
+
+// A map-frame point in window `lo`'s frame, voxel units: p * (1 / res) - (lo - 32768), in
+// double then rounded to float (as the ray generation shader does).
 void to_window_frame(const double p[3], double resolution, const int lo[3], float out[3]);
 
 }  // namespace ort::rt
