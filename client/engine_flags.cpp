@@ -8,8 +8,10 @@ void add_engine_flags(CLI::App& cmd, EngineFlags& f, bool require_resolution) {
   if (require_resolution) r->required();
   cmd.add_option("--max-range", f.max_range, "cut rays longer than this [m]; < 0: no limit")
       ->capture_default_str();
-  cmd.add_option("--backend", f.backend, "ray shooting: auto, cpu, vulkan or rt")
-      ->check(CLI::IsMember({"auto", "cpu", "vulkan", "rt"}))
+  cmd.add_option("--backend", f.backend,
+                 "ray shooting: auto, cpu (OctoMap's own walk, the reference), cpu-grid (native threads "
+                 "into the 2-bit grid), vulkan (compute shaders) or rt (ray-tracing pipeline)")
+      ->check(CLI::IsMember({"auto", "cpu", "cpu-grid", "vulkan", "rt"}))
       ->capture_default_str();
   cmd.add_option("--device", f.device, "Vulkan device: name substring or index (default: automatic)");
   cmd.add_option("--traversal", f.traversal, "octomap (OctoMap's exact walk) or exact (closed-box geometry)")
@@ -18,7 +20,7 @@ void add_engine_flags(CLI::App& cmd, EngineFlags& f, bool require_resolution) {
   cmd.add_option("--octree", f.octree, "octree stage: sequential (updateNode loop) or batched")
       ->check(CLI::IsMember({"sequential", "batched"}))
       ->capture_default_str();
-  cmd.add_option("--threads", f.threads, "octree stage threads (0: all hardware threads)")->capture_default_str();
+  cmd.add_option("--threads", f.threads, "threads of the CPU stages (octree, cpu-grid rays); 0: all hardware threads")->capture_default_str();
   cmd.add_option("--prob-hit", f.sensor.prob_hit, "sensor model: P(occupied | hit)")->capture_default_str();
   cmd.add_option("--prob-miss", f.sensor.prob_miss, "sensor model: P(occupied | miss)")->capture_default_str();
   cmd.add_option("--clamp-min", f.sensor.clamping_min, "sensor model: lower clamping probability")
@@ -37,6 +39,7 @@ EngineOptions to_engine_options(const EngineFlags& f) {
   if (!parse_traversal(f.traversal, o.traversal))
     throw CLI::ValidationError("--traversal", "unknown traversal " + f.traversal);
   o.backend.device = f.device;
+  o.backend.threads = f.threads;
   o.octree.mode = f.octree == "batched" ? OctreeUpdateMode::kBatched : OctreeUpdateMode::kSequential;
   o.octree.threads = f.threads;
   auto prob = [](double p, const char* name) {

@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "engine/cpu_backend.h"
+#include "engine/cpu_grid_backend.h"
 #include "engine/ray_backend.h"
 #include "gpu/rt_backend.h"
 #include "gpu/vulkan_backend.h"
@@ -15,6 +16,7 @@ const char* to_string(BackendKind b) {
   switch (b) {
     case BackendKind::kAuto: return "auto";
     case BackendKind::kCpu: return "cpu";
+    case BackendKind::kCpuGrid: return "cpu-grid";
     case BackendKind::kVulkan: return "vulkan";
     case BackendKind::kRt: return "rt";
   }
@@ -31,6 +33,7 @@ bool parse_traversal(const std::string& s, Traversal& out) {
 bool parse_backend(const std::string& s, BackendKind& out) {
   if (s == "auto") out = BackendKind::kAuto;
   else if (s == "cpu") out = BackendKind::kCpu;
+  else if (s == "cpu-grid") out = BackendKind::kCpuGrid;
   else if (s == "vulkan") out = BackendKind::kVulkan;
   else if (s == "rt") out = BackendKind::kRt;
   else return false;
@@ -43,6 +46,7 @@ std::unique_ptr<RayBackend> make_backend(const BackendOptions& opts, std::string
   };
   switch (opts.kind) {
     case BackendKind::kCpu: return make_cpu_backend(opts.resolution);
+    case BackendKind::kCpuGrid: return make_cpu_grid_backend({opts.resolution, opts.grid_budget_bytes, opts.threads});
     case BackendKind::kVulkan: return make_vulkan_backend(opts, log);
     case BackendKind::kRt: return make_rt_backend(opts, log);
     case BackendKind::kAuto: break;

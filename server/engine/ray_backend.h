@@ -17,7 +17,13 @@ enum class Traversal {
   kExact,    // every voxel whose closed box the segment touches (the paper's geometry)
 };
 
-enum class BackendKind { kAuto, kCpu, kVulkan, kRt };
+enum class BackendKind {
+  kAuto,
+  kCpu,      // OctoMap's computeRayKeys + KeySets: the reference
+  kCpuGrid,  // native threads into the 2-bit shared ray space (engine/cpu_grid_backend.h)
+  kVulkan,   // compute shaders (gpu/vulkan_backend.h)
+  kRt,       // ray-tracing pipeline (gpu/rt_backend.h)
+};
 
 const char* to_string(Traversal t);
 const char* to_string(BackendKind b);
@@ -64,6 +70,7 @@ struct BackendOptions {
   double max_range = -1.0;         // sizes the persistent grid; < 0: no limit
   uint64_t grid_budget_bytes = 0;  // 0: automatic (capped by maxStorageBufferRange)
   Traversal traversal = Traversal::kOctomap;  // rt refuses octomap mode at creation, so auto moves on
+  unsigned threads = 0;            // cpu-grid: ray threads, 0 = hardware threads
   bool verbose = false;
 };
 

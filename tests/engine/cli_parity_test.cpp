@@ -78,6 +78,7 @@ std::vector<ParityCase> cases() {
       p = q == std::string::npos ? q : q + 1;
     }
   } else {
+    backends.push_back("cpu-grid");
     backends.push_back("vulkan");
   }
   for (const std::string& b : backends) {

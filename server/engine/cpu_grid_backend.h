@@ -1,0 +1,22 @@
+// The `cpu-grid` back end: the paper's shared ray space, on the CPU. Worker threads walk the
+// rays (OctoMap's exact DDA, or the exact closed-box traversal) into a persistent grid of
+// 2-bit voxel states with atomic OR, list the words they touch first, and compact those words
+// into the voxel list, clearing them as they go. It replaces OctoMap's hash-set inserts
+// (~30 ns a voxel visit) with a bit set in a dense word, for machines without a GPU.
+#pragma once
+
+#include <memory>
+
+#include "engine/ray_backend.h"
+
+namespace ort {
+
+struct CpuGridOptions {
+  double resolution = 0.1;
+  uint64_t grid_budget_bytes = 256ull << 20;  // the persistent grid; 0 = 256 MiB
+  unsigned threads = 0;                       // 0 = hardware threads
+};
+
+std::unique_ptr<RayBackend> make_cpu_grid_backend(const CpuGridOptions& opts);
+
+}  // namespace ort
