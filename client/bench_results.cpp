@@ -248,11 +248,23 @@ void write_markdown(const std::vector<BenchRow>& rows, std::ostream& out) {
   bool any_failed = false;
   for (const BenchRow& r : rows) any_failed = any_failed || r.status != "ok";
   if (any_failed) {
+    // One line per (mapper, reason), with the runs it covers: the same reason repeats for
+    // every data set and resolution.
+    std::vector<std::pair<std::string, std::string>> reasons;  // (mapper, status)
+    std::map<std::pair<std::string, std::string>, std::string> runs;
+    for (const BenchRow& r : rows) {
+      if (r.status == "ok") continue;
+      const auto key = std::make_pair(label(r) + " (" + r.traversal + ")", r.status);
+      if (!runs.count(key)) reasons.push_back(key);
+      runs[key] += (runs[key].empty() ? "" : ", ") + r.dataset + " @ " + num(r.resolution) + " m";
+    }
     out << "\n**Not measured**\n\n";
-    for (const BenchRow& r : rows)
-      if (r.status != "ok")
-        out << "- " << r.dataset << " @ " << num(r.resolution) << " m, " << label(r) << " (" << r.traversal
-            << "): " << r.status << "\n";
+    for (const auto& key : reasons) {
+      std::string why = key.second;
+      for (char& c : why)
+        if (c == '\n') c = ' ';
+      out << "- " << key.first << ": " << why << " [" << runs[key] << "]\n";
+    }
   }
 }
 
