@@ -35,6 +35,7 @@ octomap_rt::server_status_t make_status(const StatusInputs& in) {
   s.overlap_busy_s = m.overlap.both_s;
   s.overlapped_scans = m.overlapped_scans;
   s.kernel_rcvbuf_errors = in.kernel_rcvbuf_errors;
+  s.socket_rcvbuf_drops = in.socket_rcvbuf_drops;
   s.map_saves = in.map_saves;
   s.last_save_utime = in.last_save_utime;
   s.latest_snapshot_id = 0;

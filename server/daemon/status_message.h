@@ -23,7 +23,7 @@ struct StatusInputs {
   int64_t num_nodes = 0, num_leaf_nodes = 0, memory_bytes = 0;
   int32_t queue_depth = 0, shot_depth = 0;
   int64_t queue_bytes = 0, queue_budget_bytes = 0;
-  int64_t kernel_rcvbuf_errors = -1;
+  int64_t kernel_rcvbuf_errors = -1, socket_rcvbuf_drops = -1;
   int64_t map_saves = 0, last_save_utime = 0;
   MetricsSnapshot metrics;
   std::vector<ProducerStats> producers;

@@ -143,5 +143,14 @@ TEST(KernelUdpStats, ParsesRcvbufErrors) {
   EXPECT_GE(daemon::read_udp_rcvbuf_errors(), 0);  // this machine's /proc/net/snmp
 }
 
+TEST(KernelUdpStats, ParsesOwnSocketDrops) {
+  std::istringstream udp(
+      "   sl  local_address rem_address   st tx_queue rx_queue tr tm->when retrnsmt   uid  timeout inode ref pointer drops\n"
+      "  1: 00000000:1DF3 00000000:0000 07 00000000:00000000 00:00000000 00000000     0        0 4242 2 0000000000000000 17\n"
+      "  2: 00000000:1DF3 00000000:0000 07 00000000:00000000 00:00000000 00000000     0        0 777 2 0000000000000000 5\n");
+  EXPECT_EQ(daemon::parse_udp_socket_drops(udp, {4242}), 17);
+  EXPECT_GE(daemon::read_own_udp_drops(), 0);
+}
+
 }  // namespace
 }  // namespace ort::test
