@@ -15,9 +15,9 @@
 #   . .device-bundle/env.sh .device-bundle; tools/bench/device-bench.sh accuracy
 #
 # Suites:
-#   headline [PRESET...]  0.1 m; each preset at its DEVICE scale below; all back ends, batched
-#                         octree, plus vulkan with the sequential updateNode stage (the Amdahl
-#                         reference); both traversals
+#   headline [PRESET...]  0.1 m; each preset at the scale below; all back ends, batched octree,
+#                         both traversals (rt does exact only). One preset per call is safest.
+#   sequential [PRESET...] vulkan with OctoMap's updateNode loop as the octree stage (Amdahl)
 #   sweep PRESET...       0.1, 0.2, 0.4, 0.8 m for the Fig. 6 chart; octomap traversal
 #   accuracy              exact traversal against OctoMap at 0.1 m (Fig. 10)
 #   real                  the real data sets in .device-data (3dtk, scan_dat, fr079-real)
@@ -44,6 +44,9 @@ case $suite in
   headline)
     for p in "${presets[@]}"; do
       bench "$p" headline --resolutions 0.1 --backends cpu-grid,vulkan,rt --traversals octomap,exact --octree batched
+    done ;;
+  sequential)
+    for p in "${presets[@]}"; do
       bench "$p" sequential --resolutions 0.1 --backends vulkan --traversals octomap --octree sequential \
         --no-octomap-breakdown
     done ;;
@@ -60,6 +63,6 @@ case $suite in
     "$bin" bench --preset none --data .device-data --scan-scale "${FR079_SCALE:-1}" --resolutions 0.1,0.2 \
       --backends cpu-grid,vulkan,rt --traversals octomap,exact --octree batched ${EXTRA:-} \
       --csv "$out/real.csv" --markdown "$out/real.md" || echo "device-bench: real exited with $?" >&2 ;;
-  *) echo "device-bench: unknown suite '$suite' (headline, sweep, accuracy, real)" >&2; exit 2 ;;
+  *) echo "device-bench: unknown suite '$suite' (headline, sequential, sweep, accuracy, real)" >&2; exit 2 ;;
 esac
 ls -l "$out" >&2
