@@ -23,7 +23,8 @@
 #   real                  the real data sets in .device-data (3dtk, scan_dat, fr079-real)
 # Environment: BIN (default .device-bundle/bin/octomap-rt), OUT (default ./bench-out),
 # FR079_SCALE, CAMPUS_SCALE, SKT_SCALE (scan shares; defaults keep each preset's OctoMap run
-# around a minute on one core), EXTRA (more flags for bench).
+# around a minute on one core), POINT_SCALE (share of points per scan, default 1), EXTRA
+# (more flags for bench).
 set -euo pipefail
 suite=${1:-headline}; shift || true
 bin=${BIN:-.device-bundle/bin/octomap-rt}
@@ -37,7 +38,7 @@ presets=("$@")
 bench() {  # preset, tag, flags...
   local p=$1 tag=$2; shift 2
   echo "== $suite $p (scan scale ${scale[$p]}) ==" >&2
-  "$bin" bench --preset "$p" --scan-scale "${scale[$p]}" --point-scale 1 --warmup 1 "$@" ${EXTRA:-} \
+  "$bin" bench --preset "$p" --scan-scale "${scale[$p]}" --point-scale "${POINT_SCALE:-1}" --warmup 1 "$@" ${EXTRA:-} \
     --csv "$out/$tag-$p.csv" --markdown "$out/$tag-$p.md" || echo "device-bench: $p exited with $?" >&2
 }
 case $suite in
