@@ -52,10 +52,10 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ost
     throw std::runtime_error("queue budget " + std::to_string(queue_.per_producer_budget() >> 20) +
                              " MiB per producer cannot hold one scan of --max-points " + std::to_string(cfg_.max_points));
 
+  load_or_create_map();  // first: a wrong map file fails before any device is opened
   std::string engine_log;
   engine_ = std::make_unique<MapEngine>(cfg_.engine, &engine_log);
   log_ << engine_log;
-  load_or_create_map();
   if (!cfg_.applied_log.empty()) map_.order.open_live_log(cfg_.applied_log);
 
   if (shared) {
@@ -102,7 +102,8 @@ void MappingServer::load_or_create_map() {
     log_ << "octomap-rt-server: loaded map " << cfg_.map_path << " (" << map_.tree->size() << " nodes, "
          << map_.order.size() << " scans applied before)\n";
   } else {
-    map_.tree = engine_->make_tree();
+    map_.tree = std::make_unique<octomap::OcTree>(res);
+    apply_sensor_model(*map_.tree, cfg_.engine.sensor);
     if (!cfg_.map_path.empty()) log_ << "octomap-rt-server: new map, will be saved to " << cfg_.map_path << "\n";
   }
 }
