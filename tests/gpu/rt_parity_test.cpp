@@ -7,6 +7,7 @@
 // and the GPU comparisons are skipped.
 #include <cstdio>
 #include <cstdlib>
+#include <array>
 #include <map>
 #include <random>
 #include <string>
@@ -216,6 +217,68 @@ TEST(RtBackend, RealDataInManySmallWindowsEqualsVulkan) {
   small.wanted[1] = 64;
   small.wanted[2] = 32;
   compare_on_real_data(small, false);
+}
+
+}  // namespace
+}  // namespace ort::test
+
+namespace ort::test {
+namespace {
+
+// Single rays that lie in voxel faces, printed in full: the rt list against the exact
+// reference, with the default BVH, with every traversal candidate marked (no exact test),
+// and with wide AABB margins. Asserts equality for the default; prints the rest.
+TEST(RtBackend, FaceRaysInDetail) {
+  struct Case {
+    const char* name;
+    double res;
+    octomap::point3d origin;
+    std::vector<octomap::point3d> ends;
+  };
+  const Case cases[] = {
+      {"along -y in faces x=42,z=23", 1.0, {42.0f, 4.38980627f, 23.0f}, {{42.0f, 2.8411088f, 23.0f}}},
+      {"same, window lowered", 1.0, {42.0f, 4.38980627f, 23.0f}, {{42.0f, 2.8411088f, 23.0f}, {30.5f, 1.5f, 10.5f}}},
+      {"along -y from the origin", 0.1, {0.0f, 0.0f, 0.0f}, {{0.0f, -0.913f, 0.0f}}},
+      {"along +z in faces x=-16,y=5", 0.5, {-16.0f, 5.0f, 4.0f}, {{-16.0f, 5.0f, 18.1849651f}}},
+  };
+  struct Variant {
+    const char* name;
+    float margin;
+    bool candidates;
+  };
+  const Variant variants[] = {{"default", rt::kAabbMargin, false},
+                              {"candidates", rt::kAabbMargin, true},
+                              {"margin 0.25", 0.25f, false},
+                              {"margin 0.25 candidates", 0.25f, true}};
+  for (const Variant& v : variants) {
+    rt::RtOptions knobs;
+    knobs.aabb_margin = v.margin;
+    knobs.mark_candidates = v.candidates;
+    std::string why;
+    auto rt = try_rt(0.1, -1.0, knobs, &why);
+    if (!rt) GTEST_SKIP() << why;
+    for (const Case& c : cases) {
+      PrepareReport report;
+      const RayBatch batch = prepare_scan(c.origin, c.ends, -1.0, c.res, report);
+      VoxelList got;
+      ShootStats stats;
+      rt->shoot(batch, Traversal::kExact, got, stats);
+      sort_voxels(got);
+      const VoxelList want = reference_states(batch, Traversal::kExact);
+      std::printf("[%s] %s: window lo (%d %d %d), rt %zu voxels, reference %zu\n", v.name, c.name, batch.keys.lo[0] - 1,
+                  batch.keys.lo[1] - 1, batch.keys.lo[2] - 1, got.size(), want.size());
+      auto key = [](const VoxelUpdate& u) { return std::array<int, 3>{u.x, u.y, u.z}; };
+      std::map<std::array<int, 3>, int> seen;
+      for (const auto& u : got) seen[key(u)] |= 1;
+      for (const auto& u : want) seen[key(u)] |= 2;
+      int shown = 0;
+      for (const auto& [k, m] : seen) {
+        if (m == 3 || ++shown > 6) continue;
+        std::printf("    %s (%d %d %d)\n", m == 1 ? "extra  " : "missing", k[0], k[1], k[2]);
+      }
+      if (!v.candidates && v.margin == rt::kAabbMargin) EXPECT_TRUE(same(got, want)) << c.name;
+    }
+  }
 }
 
 }  // namespace

@@ -84,7 +84,7 @@ TEST(RtSpace, InstancesAndPrimitivesNameEveryVoxelOfTheWindowOnce) {
       const Aabb box = block_aabbs(s.block)[p];
       for (int a = 0; a < 3; ++a) {
         // The instance's box in the window frame is [key - lo, key - lo + 1] (+ margin).
-        EXPECT_EQ(double(box.min[a]) + t[a], double(k[a] - lo[a]) - double(kAabbMargin));
+        EXPECT_EQ(double(box.min[a]) + t[a], double(k[a] - lo[a]) + double(kFrameOffset) - double(kAabbMargin));
         EXPECT_GE(k[a], lo[a]);
         EXPECT_LT(k[a], lo[a] + s.voxels(a));
       }
@@ -125,9 +125,9 @@ TEST(RtSpace, WindowFrameIsVoxelUnitsFromTheLowKey) {
   const double p[3] = {0.25, -0.05, 723.2};
   float f[3];
   to_window_frame(p, 0.1, lo, f);
-  EXPECT_NEAR(f[0], 2.5, 1e-5);
-  EXPECT_NEAR(f[1], 67.5, 1e-5);
-  EXPECT_NEAR(f[2], 7232.0 - (40000 - 32768), 1e-3);
+  EXPECT_NEAR(f[0], 2.5 + kFrameOffset, 1e-5);
+  EXPECT_NEAR(f[1], 67.5 + kFrameOffset, 1e-5);
+  EXPECT_NEAR(f[2], 7232.0 - (40000 - 32768) + kFrameOffset, 1e-3);
 }
 
 // ---- CPU model of the rt shoot ----------------------------------------------------------
@@ -187,13 +187,14 @@ VoxelList model_rt_shoot(const RayBatch& batch, const SpaceLayout& s, uint64_t* 
       // Enumerate the voxels of this window near the float segment (the BVH's job).
       int vlo[3], vhi[3];
       for (int i = 0; i < 3; ++i) {
-        vlo[i] = std::max(0, int(std::floor(std::min(o[i], f[i]))) - 1);
-        vhi[i] = std::min(s.voxels(i) - 1, int(std::floor(std::max(o[i], f[i]))) + 1);
+        const float fo = kFrameOffset;
+        vlo[i] = std::max(0, int(std::floor(std::min(o[i], f[i]) - fo)) - 1);
+        vhi[i] = std::min(s.voxels(i) - 1, int(std::floor(std::max(o[i], f[i]) - fo)) + 1);
       }
       for (int z = vlo[2]; z <= vhi[2]; ++z)
         for (int y = vlo[1]; y <= vhi[1]; ++y)
           for (int x = vlo[0]; x <= vhi[0]; ++x) {
-            const int v[3] = {x, y, z};
+            const int v[3] = {x, y, z};  // window-local voxel; its box is at v + kFrameOffset
             const uint64_t inst = uint64_t(x / s.block) +
                                   uint64_t(s.blocks[0]) * (uint64_t(y / s.block) + uint64_t(s.blocks[1]) * uint64_t(z / s.block));
             const uint32_t prim = uint32_t(x % s.block) + k * (uint32_t(y % s.block) + k * uint32_t(z % s.block));

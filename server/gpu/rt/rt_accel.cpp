@@ -82,7 +82,7 @@ VkDeviceAddress AccelerationStructure::address() const {
 }
 
 SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const SpaceLayout& layout,
-                           vk::CommandRunner& runner) {
+                           vk::CommandRunner& runner, float aabb_margin) {
   const auto t0 = std::chrono::steady_clock::now();
   SharedBvh bvh;
   const VkDevice dev = ctx.device();
@@ -92,7 +92,7 @@ SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const 
       VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
 
   // --- BLAS: the k^3 voxel boxes of one block (enlarged by kAabbMargin).
-  const std::vector<Aabb> boxes = block_aabbs(layout.block);
+  const std::vector<Aabb> boxes = block_aabbs(layout.block, aabb_margin);
   vk::Buffer aabb_buffer(ctx, boxes.size() * sizeof(Aabb), input_usage, host);
   std::memcpy(aabb_buffer.mapped(), boxes.data(), boxes.size() * sizeof(Aabb));
 

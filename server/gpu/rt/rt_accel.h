@@ -52,6 +52,6 @@ struct SharedBvh {
 // Builds the BLAS and the TLAS for this layout and waits for them. The AABB, instance and
 // scratch buffers are released before it returns: only blas + tlas stay on the GPU.
 SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const SpaceLayout& layout,
-                           vk::CommandRunner& runner);
+                           vk::CommandRunner& runner, float aabb_margin = kAabbMargin);
 
 }  // namespace ort::rt

@@ -20,7 +20,7 @@ uint32_t align_up(uint32_t v, uint32_t a) { return a ? (v + a - 1) / a * a : v; 
 }  // namespace
 
 RayTracingPipeline::RayTracingPipeline(const vk::Context& ctx, const RtFunctions& fn, const SpaceLayout& layout,
-                                       uint32_t push_bytes)
+                                       uint32_t push_bytes, bool mark_candidates)
     : fn_(&fn), device_(ctx.device()), push_bytes_(push_bytes) {
   try {
     std::array<VkDescriptorSetLayoutBinding, 5> b{};
@@ -43,9 +43,10 @@ RayTracingPipeline::RayTracingPipeline(const vk::Context& ctx, const RtFunctions
 
     vk::ShaderModule rgen(device_, rt_shoot_rgen_spv), rmiss(device_, rt_miss_rmiss_spv),
         rint(device_, rt_voxel_rint_spv);
-    const uint32_t spec_values[3] = {uint32_t(layout.block), uint32_t(layout.blocks[0]), uint32_t(layout.blocks[1])};
-    const VkSpecializationMapEntry spec_entries[3] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}};
-    const VkSpecializationInfo spec{3, spec_entries, sizeof(spec_values), spec_values};
+    const uint32_t spec_values[4] = {uint32_t(layout.block), uint32_t(layout.blocks[0]), uint32_t(layout.blocks[1]),
+                                     mark_candidates ? 1u : 0u};
+    const VkSpecializationMapEntry spec_entries[4] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}};
+    const VkSpecializationInfo spec{4, spec_entries, sizeof(spec_values), spec_values};
     std::array<VkPipelineShaderStageCreateInfo, 3> stages{};
     const VkShaderStageFlagBits stage_bits[3] = {VK_SHADER_STAGE_RAYGEN_BIT_KHR, VK_SHADER_STAGE_MISS_BIT_KHR,
                                                  VK_SHADER_STAGE_INTERSECTION_BIT_KHR};

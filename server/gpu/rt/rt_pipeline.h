@@ -20,7 +20,8 @@ class RayTracingPipeline {
  public:
   // The layout's k and block counts are baked into the intersection shader as
   // specialization constants.
-  RayTracingPipeline(const vk::Context& ctx, const RtFunctions& fn, const SpaceLayout& layout, uint32_t push_bytes);
+  RayTracingPipeline(const vk::Context& ctx, const RtFunctions& fn, const SpaceLayout& layout, uint32_t push_bytes,
+                     bool mark_candidates = false);
   ~RayTracingPipeline();
   RayTracingPipeline(const RayTracingPipeline&) = delete;
   RayTracingPipeline& operator=(const RayTracingPipeline&) = delete;

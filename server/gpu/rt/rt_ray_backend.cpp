@@ -85,8 +85,9 @@ class RtBackend final : public RayBackend {
     if (wanted[0] <= 0 || wanted[1] <= 0 || wanted[2] <= 0) wanted_from_range(opts.resolution, opts.max_range, 512, wanted);
     layout_ = choose_layout(rt.block, wanted, device_limits(*ctx_, opts, rt.limits));
     runner_ = std::make_unique<vk::CommandRunner>(*ctx_);
-    bvh_ = build_shared_bvh(*ctx_, fn_, layout_, *runner_);
-    pipeline_ = std::make_unique<RayTracingPipeline>(*ctx_, fn_, layout_, uint32_t(sizeof(gpu::ShootPush)));
+    bvh_ = build_shared_bvh(*ctx_, fn_, layout_, *runner_, rt.aabb_margin);
+    pipeline_ = std::make_unique<RayTracingPipeline>(*ctx_, fn_, layout_, uint32_t(sizeof(gpu::ShootPush)),
+                                                     rt.mark_candidates);
     compact_ = std::make_unique<vk::ComputePipeline>(*ctx_, compact_touched_spv, 4, uint32_t(sizeof(gpu::CompactPush)));
     stamps_ = std::make_unique<vk::TimestampQueries>(*ctx_, 3);
 

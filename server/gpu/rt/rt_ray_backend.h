@@ -13,6 +13,8 @@ struct RtOptions {
   int block = 4;                // k: voxels along a BLAS edge (2..8; the paper's 2^3..2^9 boxes)
   int wanted[3] = {0, 0, 0};    // shared ray space, voxels per axis; 0: from max range (or 512)
   SpaceLimits limits;           // caps on grid voxels and TLAS instances (windows beyond)
+  float aabb_margin = kAabbMargin;  // enlargement of the BLAS boxes (rt_space.h says why)
+  bool mark_candidates = false;     // diagnosis: mark every box the traversal reports, no exact test
 };
 
 // What start-up built, for status output and the Table III benchmark.

@@ -36,7 +36,7 @@ void wanted_from_range(double resolution, double max_range, int fallback, int wa
   for (int i = 0; i < 3; ++i) wanted[i] = side;
 }
 
-std::vector<Aabb> block_aabbs(int block) {
+std::vector<Aabb> block_aabbs(int block, float margin) {
   std::vector<Aabb> out;
   out.reserve(size_t(block) * block * block);
   for (int z = 0; z < block; ++z)
@@ -45,8 +45,8 @@ std::vector<Aabb> block_aabbs(int block) {
         const int v[3] = {x, y, z};
         Aabb b;
         for (int i = 0; i < 3; ++i) {
-          b.min[i] = float(v[i]) - kAabbMargin;
-          b.max[i] = float(v[i] + 1) + kAabbMargin;
+          b.min[i] = float(v[i]) - margin;
+          b.max[i] = float(v[i] + 1) + margin;
         }
         out.push_back(b);
       }
@@ -62,7 +62,7 @@ void instance_block(const SpaceLayout& s, uint64_t instance, int out[3]) {
 void instance_translation(const SpaceLayout& s, uint64_t instance, float out[3]) {
   int b[3];
   instance_block(s, instance, b);
-  for (int i = 0; i < 3; ++i) out[i] = float(b[i] * s.block);  // exact: integers < 2^24
+  for (int i = 0; i < 3; ++i) out[i] = float(b[i] * s.block) + kFrameOffset;  // exact: integers < 2^24
 }
 
 void voxel_key(const SpaceLayout& s, const int lo[3], uint64_t instance, uint32_t primitive, int out[3]) {
@@ -100,7 +100,7 @@ std::vector<KeyBox> plan_windows(const KeyBox& keys, const SpaceLayout& s, int m
 
 void to_window_frame(const double p[3], double resolution, const int lo[3], float out[3]) {
   const double factor = 1.0 / resolution;
-  for (int i = 0; i < 3; ++i) out[i] = float(p[i] * factor - double(lo[i] - kTreeMaxVal));
+  for (int i = 0; i < 3; ++i) out[i] = float(p[i] * factor - double(lo[i] - kTreeMaxVal) + double(kFrameOffset));
 }
 
 void trace_direction(const float o[3], const float f[3], float out[3]) {
