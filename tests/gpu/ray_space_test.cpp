@@ -12,6 +12,7 @@
 #include "engine/prepare_scan.h"
 #include "gpu/gpu_test_support.h"
 #include "gpu/ray_space_sizing.h"
+#include "gpu/ray_space_windows.h"
 #include "gpu/vulkan_backend.h"
 #include "scene/synthetic_scene.h"
 
@@ -149,7 +150,9 @@ TEST(VulkanRaySpace, OccupiedWinsOverFreeInsideOneScan) {
     EXPECT_EQ(state_of(49), int(kStateFree)) << to_string(mode);
     EXPECT_EQ(state_of(51), int(kStateFree)) << to_string(mode);  // ray 2 only, up to the cut
     EXPECT_EQ(state_of(59), int(kStateFree)) << to_string(mode);
-    if (mode == Traversal::kOctomap) EXPECT_EQ(state_of(60), 0);  // the cut end voxel: no update
+    if (mode == Traversal::kOctomap) {
+      EXPECT_EQ(state_of(60), 0);  // the cut end voxel: no update
+    }
     EXPECT_EQ(state_of(61), 0) << to_string(mode);
     for (const VoxelUpdate& v : got) EXPECT_TRUE(v.state == kStateFree || v.state == kStateOccupied);
   }
@@ -189,6 +192,53 @@ TEST(RaySpaceSizing, MaxRangeCubeBudgetAndChunks) {
   EXPECT_EQ(gpu::auto_grid_budget(128u << 20, uint64_t(16) << 30), 128u << 20);
   EXPECT_EQ(gpu::auto_grid_budget(uint64_t(4) << 30, uint64_t(80) << 30), uint64_t(1) << 30);
   EXPECT_EQ(gpu::auto_grid_budget(uint64_t(4) << 30, uint64_t(2) << 30), uint64_t(256) << 20);
+}
+
+bool overlap(const KeyBox& a, const KeyBox& b) {
+  for (int i = 0; i < 3; ++i) {
+    if (a.hi[i] < b.lo[i] || b.hi[i] < a.lo[i]) return false;
+  }
+  return true;
+}
+
+TEST(RaySpaceWindows, DisjointCoverWithinCapacity) {
+  std::mt19937_64 rng(3);
+  std::uniform_int_distribution<int> key(0, 65535), extent(0, 400);
+  for (int trial = 0; trial < 300; ++trial) {
+    KeyBox keys;
+    for (int i = 0; i < 3; ++i) {
+      keys.lo[i] = key(rng);
+      keys.hi[i] = std::min(65535, keys.lo[i] + extent(rng));
+    }
+    const uint64_t capacity = std::uniform_int_distribution<uint64_t>(1, 5000000)(rng);
+    const std::vector<KeyBox> w = gpu::plan_ray_space_windows(keys, capacity, 2);
+    KeyBox wide;
+    for (int i = 0; i < 3; ++i) {
+      wide.lo[i] = std::max(0, keys.lo[i] - 2);
+      wide.hi[i] = std::min(65535, keys.hi[i] + 2);
+    }
+    uint64_t covered = 0;
+    for (size_t a = 0; a < w.size(); ++a) {
+      ASSERT_FALSE(w[a].empty());
+      ASSERT_LE(w[a].voxel_count(), capacity);
+      for (int i = 0; i < 3; ++i) {
+        ASSERT_GE(w[a].lo[i], wide.lo[i]);
+        ASSERT_LE(w[a].hi[i], wide.hi[i]);
+      }
+      covered += w[a].voxel_count();
+      if (w.size() < 300) {
+        for (size_t b = a + 1; b < w.size(); ++b) ASSERT_FALSE(overlap(w[a], w[b]));
+      }
+    }
+    ASSERT_EQ(covered, wide.voxel_count());  // disjoint + inside + same volume = exact cover
+  }
+  // A box 2.3 times the capacity along its long axis takes 3 windows, not 4.
+  KeyBox k;
+  k.lo[0] = k.lo[1] = k.lo[2] = 1000;
+  k.hi[0] = 1000 + 225;
+  k.hi[1] = k.hi[2] = 1000 + 5;
+  EXPECT_EQ(gpu::plan_ray_space_windows(k, 230 * 10 * 10 / 2.3 + 1, 2).size(), 3u);
+  EXPECT_TRUE(gpu::plan_ray_space_windows(KeyBox{}, 100).empty());
 }
 
 }  // namespace

@@ -21,7 +21,7 @@ void check_random_rays(Traversal mode) {
   // One back end for every resolution: the batch carries its own. A small budget keeps
   // lavapipe's start-up clear of the grid short.
   auto gpu = make_vulkan(0.1, -1.0, 16u << 20);
-  uint64_t rays = 0, scans = 0, voxels = 0, failures = 0;
+  uint64_t rays = 0, scans = 0, voxels = 0, failures = 0, differing = 0;
   std::map<std::string, uint64_t> rays_by_kind;
   while (rays < kMinRays) {
     const RandomScan s = random_scan(rng);
@@ -33,7 +33,9 @@ void check_random_rays(Traversal mode) {
     gpu->shoot(batch, mode, got, stats);
     sort_voxels(got);
     const VoxelList want = reference_states(batch, mode);
-    if (!same_voxels(got, want) && failures < 5) {
+    const bool same = same_voxels(got, want);
+    differing += same ? 0 : 1;
+    if (!same && failures < 5) {
       ++failures;
       ADD_FAILURE() << to_string(mode) << " scan " << scans << " (" << s.kind << ", seed " << seed
                     << "): " << diff_voxels(got, want, batch, mode);
@@ -44,12 +46,12 @@ void check_random_rays(Traversal mode) {
     voxels += want.size();
     ++scans;
   }
-  EXPECT_EQ(failures, 0u);
+  EXPECT_EQ(differing, 0u);
   std::string kinds;
   for (const auto& [k, n] : rays_by_kind) kinds += " " + k + "=" + std::to_string(n);
-  std::printf("%s: %llu rays in %llu scans, %llu voxels, all equal to the reference (seed %llu);%s\n", to_string(mode),
-              (unsigned long long)rays, (unsigned long long)scans, (unsigned long long)voxels,
-              (unsigned long long)seed, kinds.c_str());
+  std::printf("%s: %llu rays in %llu scans, %llu voxels, %llu scans differ from the reference (seed %llu);%s\n",
+              to_string(mode), (unsigned long long)rays, (unsigned long long)scans, (unsigned long long)voxels,
+              (unsigned long long)differing, (unsigned long long)seed, kinds.c_str());
   for (const char* k : {"axis", "face", "corner", "short", "key_edge", "far", "max_range", "random"}) {
     EXPECT_GT(rays_by_kind[k], 1000u) << k;
   }
