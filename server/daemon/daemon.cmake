@@ -14,3 +14,8 @@ add_executable(octomap-rt-server ${DAEMON_DIR}/server_main.cpp ${DAEMON_DIR}/ser
                ${CMAKE_SOURCE_DIR}/client/engine_flags.cpp)
 target_include_directories(octomap-rt-server PRIVATE ${CMAKE_SOURCE_DIR}/client)
 target_link_libraries(octomap-rt-server PRIVATE octomap_rt_daemon CLI11::CLI11)
+
+# Pipeline vs --no-pipeline throughput, in-process over memq:// (prints ratios).
+add_executable(octomap-rt-server-bench ${DAEMON_DIR}/bench/pipeline_bench.cpp ${CMAKE_SOURCE_DIR}/client/engine_flags.cpp)
+target_include_directories(octomap-rt-server-bench PRIVATE ${CMAKE_SOURCE_DIR}/client)
+target_link_libraries(octomap-rt-server-bench PRIVATE octomap_rt_daemon octomap_rt_scene CLI11::CLI11)
