@@ -42,6 +42,7 @@ struct ReplayArgs {
   std::string part;
   ScanSelection sel;
   int64_t first_seq = 0;
+  size_t decimate = 1;
   double wait_for_server_s = 0.0;
   bool quiet = false;
 };
@@ -111,6 +112,7 @@ int replay_scan_set(const ReplayArgs& a, lcm::LCM& lc) {
   f.robot_id = a.robot;
   f.max_range = static_cast<float>(a.max_range);
   f.frame = a.points_frame == "map" ? PointsFrame::kMap : PointsFrame::kSensor;
+  f.stride = a.decimate;
 
   Pacer pacer(a.rate > 0 ? 1.0 / a.rate : 0.0);
   ProgressBar bar("replay " + a.robot, order.size(), !a.quiet);
@@ -128,7 +130,7 @@ int replay_scan_set(const ReplayArgs& a, lcm::LCM& lc) {
     if (t.scans == 0) t.first_publish = Clock::now();
     if (lc.publish(channel, buf.data(), static_cast<unsigned>(buf.size())) != 0) ++t.publish_errors;
     ++t.scans;
-    t.points += scan.points.size();
+    t.points += msg.xyz.size() / 3;
     t.bytes += buf.size();
     bar.update(t.scans, t.detail());
   }
@@ -286,6 +288,10 @@ void register_replay_command(CLI::App& app) {
   cmd->add_option("--first-seq", args->first_seq, "seq of the first scan; +1 per scan")->capture_default_str();
   cmd->add_option("--wait-for-server", args->wait_for_server_s,
                   "wait up to this many seconds for the server's status before publishing (0: don't)")
+      ->capture_default_str();
+  cmd->add_option("--decimate", args->decimate,
+                  "send every N-th point only (e.g. to keep scans under one UDP datagram for lcm-spy)")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", args->quiet, "no progress bar");
   cmd->callback([args, rate] {

@@ -20,11 +20,12 @@ octomap_rt::scan_t make_scan_message(const PosedScan& scan, const ScanMessageFie
   m.points_frame = map_frame ? octomap_rt::scan_t::POINTS_IN_MAP_FRAME : octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME;
   const octomap::Pointcloud world = map_frame ? world_points(scan) : octomap::Pointcloud();
   const octomap::Pointcloud& pts = map_frame ? world : scan.points;
-  m.xyz.resize(3 * pts.size());
-  for (size_t i = 0; i < pts.size(); ++i) {
-    m.xyz[3 * i + 0] = pts[i].x();
-    m.xyz[3 * i + 1] = pts[i].y();
-    m.xyz[3 * i + 2] = pts[i].z();
+  const size_t stride = f.stride > 0 ? f.stride : 1;
+  m.xyz.reserve(3 * (pts.size() / stride + 1));
+  for (size_t i = 0; i < pts.size(); i += stride) {
+    m.xyz.push_back(pts[i].x());
+    m.xyz.push_back(pts[i].y());
+    m.xyz.push_back(pts[i].z());
   }
   m.num_xyz = static_cast<int32_t>(m.xyz.size());
   m.robot_id = f.robot_id;
