@@ -176,7 +176,7 @@ void write_markdown(const std::vector<BenchRow>& rows, std::ostream& out) {
   // Mapper labels of octomap-traversal runs, in order of appearance: the headline columns.
   std::vector<std::string> mappers;
   for (const BenchRow& r : rows) {
-    if (r.backend == "octomap" || r.traversal != "octomap") continue;
+    if (r.backend == "octomap" || r.traversal != "octomap" || r.status != "ok") continue;  // failures: listed below
     const std::string l = label(r);
     if (std::find(mappers.begin(), mappers.end(), l) == mappers.end()) mappers.push_back(l);
   }
