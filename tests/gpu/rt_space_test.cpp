@@ -84,7 +84,7 @@ TEST(RtSpace, InstancesAndPrimitivesNameEveryVoxelOfTheWindowOnce) {
       const Aabb box = block_aabbs(s.block)[p];
       for (int a = 0; a < 3; ++a) {
         // The instance's box in the window frame is [key - lo, key - lo + 1] (+ margin).
-        EXPECT_EQ(double(box.min[a]) + t[a], double(k[a] - lo[a]) + double(kFrameOffset) - double(kAabbMargin));
+        EXPECT_EQ(double(box.min[a]) + t[a], double(k[a] - lo[a]) - double(kAabbMargin));
         EXPECT_GE(k[a], lo[a]);
         EXPECT_LT(k[a], lo[a] + s.voxels(a));
       }
@@ -125,9 +125,9 @@ TEST(RtSpace, WindowFrameIsVoxelUnitsFromTheLowKey) {
   const double p[3] = {0.25, -0.05, 723.2};
   float f[3];
   to_window_frame(p, 0.1, lo, f);
-  EXPECT_NEAR(f[0], 2.5 + kFrameOffset, 1e-5);
-  EXPECT_NEAR(f[1], 67.5 + kFrameOffset, 1e-5);
-  EXPECT_NEAR(f[2], 7232.0 - (40000 - 32768) + kFrameOffset, 1e-3);
+  EXPECT_NEAR(f[0], 2.5, 1e-5);
+  EXPECT_NEAR(f[1], 67.5, 1e-5);
+  EXPECT_NEAR(f[2], 7232.0 - (40000 - 32768), 1e-3);
 }
 
 // ---- CPU model of the rt shoot ----------------------------------------------------------
@@ -187,14 +187,13 @@ VoxelList model_rt_shoot(const RayBatch& batch, const SpaceLayout& s, uint64_t* 
       // Enumerate the voxels of this window near the float segment (the BVH's job).
       int vlo[3], vhi[3];
       for (int i = 0; i < 3; ++i) {
-        const float fo = kFrameOffset;
-        vlo[i] = std::max(0, int(std::floor(std::min(o[i], f[i]) - fo)) - 1);
-        vhi[i] = std::min(s.voxels(i) - 1, int(std::floor(std::max(o[i], f[i]) - fo)) + 1);
+        vlo[i] = std::max(0, int(std::floor(std::min(o[i], f[i]))) - 1);
+        vhi[i] = std::min(s.voxels(i) - 1, int(std::floor(std::max(o[i], f[i]))) + 1);
       }
       for (int z = vlo[2]; z <= vhi[2]; ++z)
         for (int y = vlo[1]; y <= vhi[1]; ++y)
           for (int x = vlo[0]; x <= vhi[0]; ++x) {
-            const int v[3] = {x, y, z};  // window-local voxel; its box is at v + kFrameOffset
+            const int v[3] = {x, y, z};  // window-local voxel
             const uint64_t inst = uint64_t(x / s.block) +
                                   uint64_t(s.blocks[0]) * (uint64_t(y / s.block) + uint64_t(s.blocks[1]) * uint64_t(z / s.block));
             const uint32_t prim = uint32_t(x % s.block) + k * (uint32_t(y % s.block) + k * uint32_t(z % s.block));
@@ -229,6 +228,11 @@ VoxelList model_rt_shoot(const RayBatch& batch, const SpaceLayout& s, uint64_t* 
     out.push_back(make_update(octomap::OcTreeKey(key[0], key[1], key[2]), (st & 1u) != 0));
   }
   return out;
+}
+
+const int* wanted_cube() {
+  static const int w[3] = {64, 64, 64};
+  return w;
 }
 
 std::vector<std::array<int, 4>> sorted(const VoxelList& l) {
@@ -285,6 +289,26 @@ TEST(RtSpace, ModelOfTheRtShootEqualsTheExactCpuReference) {
     rays += ends.size();
   }
   EXPECT_GE(rays, 12000u);
+}
+
+TEST(RtSpace, ModelCoversVoxelsJustBelowTheKeyBox) {
+  // Every ray lies in the planes x = -16 and y = 5 (voxel faces at 0.5 m), so the voxels on
+  // their low sides have keys below the scan's key box: the window margin must hold them.
+  const double res = 0.5;
+  const octomap::point3d origin(-16.0f, 5.0f, 4.0f);
+  const std::vector<octomap::point3d> ends = {{-16.0f, 5.0f, 18.1849651f}, {-16.0f, 5.0f, 4.34148407f},
+                                              {1.25694466f, 5.0f, 4.0f}, {-16.0f, 5.0f, 4.0f}};
+  const RayBatch batch = make_batch(origin, ends, res);
+  auto cpu = make_cpu_backend(res);
+  VoxelList want;
+  ShootStats st;
+  cpu->shoot(batch, Traversal::kExact, want, st);
+  for (int k : {2, 4, 8}) {
+    const int wanted[3] = {64, 64, 64};
+    EXPECT_EQ(sorted(model_rt_shoot(batch, choose_layout(k, wanted, SpaceLimits{}))), sorted(want)) << "k " << k;
+  }
+  const KeyBox w = plan_windows(batch.keys, choose_layout(4, wanted_cube(), SpaceLimits{}))[0];
+  EXPECT_EQ(w.lo[0], batch.keys.lo[0] - 1);
 }
 
 TEST(RtSpace, MarginCostsFewExtraCandidates) {

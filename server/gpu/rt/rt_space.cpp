@@ -62,7 +62,7 @@ void instance_block(const SpaceLayout& s, uint64_t instance, int out[3]) {
 void instance_translation(const SpaceLayout& s, uint64_t instance, float out[3]) {
   int b[3];
   instance_block(s, instance, b);
-  for (int i = 0; i < 3; ++i) out[i] = float(b[i] * s.block) + kFrameOffset;  // exact: integers < 2^24
+  for (int i = 0; i < 3; ++i) out[i] = float(b[i] * s.block);  // exact: integers < 2^24
 }
 
 void voxel_key(const SpaceLayout& s, const int lo[3], uint64_t instance, uint32_t primitive, int out[3]) {
@@ -100,7 +100,7 @@ std::vector<KeyBox> plan_windows(const KeyBox& keys, const SpaceLayout& s, int m
 
 void to_window_frame(const double p[3], double resolution, const int lo[3], float out[3]) {
   const double factor = 1.0 / resolution;
-  for (int i = 0; i < 3; ++i) out[i] = float(p[i] * factor - double(lo[i] - kTreeMaxVal) + double(kFrameOffset));
+  for (int i = 0; i < 3; ++i) out[i] = float(p[i] * factor - double(lo[i] - kTreeMaxVal));
 }
 
 void trace_direction(const float o[3], const float f[3], float out[3]) {

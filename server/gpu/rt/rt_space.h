@@ -63,8 +63,7 @@ void wanted_from_range(double resolution, double max_range, int fallback, int wa
 // The BLAS's k^3 AABBs; primitive p = x + k * (y + k * z) is the box [x, x+1] x ... (enlarged).
 std::vector<Aabb> block_aabbs(int block, float margin = kAabbMargin);
 
-// TLAS instance i covers block (bx, by, bz) with x fastest; its translation is
-// block * k + kFrameOffset.
+// TLAS instance i covers block (bx, by, bz) with x fastest; its translation is block * k.
 void instance_block(const SpaceLayout& s, uint64_t instance, int out[3]);
 void instance_translation(const SpaceLayout& s, uint64_t instance, float out[3]);
 
@@ -76,30 +75,22 @@ void voxel_key(const SpaceLayout& s, const int lo[3], uint64_t instance, uint32_
 // on a voxel face touches the voxel beyond it) and clamped to the key range. Windows tile
 // that box in a regular grid; each is at most the space's size per axis, so each key lies in
 // exactly one window.
-std::vector<KeyBox> plan_windows(const KeyBox& keys, const SpaceLayout& s, int margin = 0);
-
-// The window frame starts this many voxels from the BVH's origin: the window's lowest key
-// is at kFrameOffset, block b of the TLAS at b * k + kFrameOffset. WHY: measured on
-// NVIDIA's driver 580 (H100, no RT cores): voxel boxes touching the frame's origin planes
-// (window-local coordinate 0, box [-margin, 1 + margin]) were never reported to the
-// intersection shader for rays running along one of their faces, while the same boxes one
-// block further in were. Keeping every box at positive coordinates avoids that.
-constexpr float kFrameOffset = 16.0f;
+std::vector<KeyBox> plan_windows(const KeyBox& keys, const SpaceLayout& s, int margin = 1);
 
 // The smallest direction component a traced ray gets (voxel units over t in [0, 1]). WHY:
 // with an exactly zero component, a slab test written as box * (1/d) - o * (1/d) computes
-// inf - inf = NaN and drops boxes the ray runs along: measured on NVIDIA's driver, which
-// missed the voxels beside rays that lie in voxel faces. A component below this is set to
-// +-kMinDirection; the ray then drifts by at most 2^-20 voxel, far inside kAabbMargin, and
-// the exact test still uses the true segment.
+// inf - inf = NaN, and the Vulkan spec leaves it to the implementation how that resolves.
+// A component below this is set to +-kMinDirection: the ray drifts by at most 2^-20 voxel,
+// far inside kAabbMargin, and the exact test still uses the true segment. (Defensive: no
+// driver was seen to need it; it costs nothing.)
 constexpr float kMinDirection = 1.0f / 1048576.0f;
 
 // The direction traced from o to f in the window frame (f - o, small components lifted as
 // above); the ray is traced over t in [0, 1]. The ray generation shader does the same.
 void trace_direction(const float o[3], const float f[3], float out[3]);
 
-// A map-frame point in window `lo`'s frame, voxel units: p * (1 / res) - (lo - 32768) +
-// kFrameOffset, in double then rounded to float (as the ray generation shader does).
+// A map-frame point in window `lo`'s frame, voxel units: p * (1 / res) - (lo - 32768), in
+// double then rounded to float (as the ray generation shader does).
 void to_window_frame(const double p[3], double resolution, const int lo[3], float out[3]);
 
 }  // namespace ort::rt
