@@ -63,12 +63,40 @@ void main() {
     current[dim] += step_dir[dim];
     t_max[dim] = t_max[dim] + t_delta[dim];
     const int u = (dim + 1) % 3, v = (dim + 2) % 3;
+    const int layer = current[dim] + step_dir[dim];
+    // Pre-filter (speed only): the part of the segment inside the new layer's slab, widened
+    // by `slack`, spans these u and v coordinates; a candidate whose box lies beyond them
+    // cannot touch the segment. The slack (1e-6 voxel, plus 1e-12 of the coordinates'
+    // magnitude) dwarfs the rounding of either computation, so the exact predicate below
+    // still decides every voxel that could possibly touch.
+    const double slack = 1.0e-6LF * resolution + 1.0e-12LF * (abs(a[dim]) + abs(b[dim]) + abs(a[u]) + abs(b[u]) +
+                                                               abs(a[v]) + abs(b[v]));
+    const double slab_lo = double(layer - kTreeMaxVal) * resolution - slack;
+    const double slab_hi = double(layer - kTreeMaxVal + 1) * resolution + slack;
+    double s0 = (slab_lo - a[dim]) / d[dim];
+    double s1 = (slab_hi - a[dim]) / d[dim];
+    if (s0 > s1) {
+      const double s = s0;
+      s0 = s1;
+      s1 = s;
+    }
+    s0 = max(s0, 0.0LF);
+    s1 = min(s1, 1.0LF);
+    if (s0 > s1) continue;
+    const double u0 = a[u] + s0 * d[u], u1 = a[u] + s1 * d[u];
+    const double v0 = a[v] + s0 * d[v], v1 = a[v] + s1 * d[v];
+    const double u_lo = min(u0, u1) - slack, u_hi = max(u0, u1) + slack;
+    const double v_lo = min(v0, v1) - slack, v_hi = max(v0, v1) + slack;
     for (int du = -1; du <= 1; ++du) {
+      const int ku = current[u] + du;
+      if (double(ku - kTreeMaxVal + 1) * resolution < u_lo || double(ku - kTreeMaxVal) * resolution > u_hi) continue;
       for (int dv = -1; dv <= 1; ++dv) {
-        ivec3 k = current;
-        k[dim] += step_dir[dim];
-        k[u] += du;
-        k[v] += dv;
+        const int kv = current[v] + dv;
+        if (double(kv - kTreeMaxVal + 1) * resolution < v_lo || double(kv - kTreeMaxVal) * resolution > v_hi) continue;
+        ivec3 k;
+        k[dim] = layer;
+        k[u] = ku;
+        k[v] = kv;
         test_and_mark(a, b, k);
       }
     }
