@@ -146,5 +146,40 @@ TEST(ServerProducersIntegration, ThreeProducersSplitRealScansGiveTheMapOfTheAppl
   if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
 }
 
+// Producers may also send points already in the map frame (--points-frame map: OctoMap's
+// Pointcloud::transform done by the producer); the map is the same as from sensor-frame
+// scans with poses, which the daemon transforms itself.
+TEST(ServerProducersIntegration, MapFramePointsGiveTheSameMapAsSensorFramePoints) {
+  const std::string graph = data_file("3dtk_dat/3dtk_3scans.graph");
+  if (graph.empty()) return;
+  const ScanSet scans = load_scan_graph(graph);
+  NetworkNamespace ns("mapframe");
+  ASSERT_TRUE(ns.ok()) << ns.error();
+  const std::string dir = make_test_dir("mapframe");
+  const std::string url = test_lcm_url(4, ns.rmem_max());
+  StatusWatcher status(url);
+  ASSERT_TRUE(status.good());
+  const std::string map_path = dir + "/map.ot";
+  ChildProcess server({server_program(), "-r", std::to_string(kResolution), "--map", map_path, "--lcm-url", url,
+                       "--save-interval", "0"},
+                      dir + "/server.log");
+  ASSERT_TRUE(status.wait_for([](const auto&) { return true; }, 60)) << server.log();
+  ChildProcess robot({client_program(), "replay", graph, "--robot", "mapper", "--points-frame", "map", "--rate", "4",
+                      "--lcm-url", url, "-q"},
+                     dir + "/robot.log");
+  EXPECT_EQ(robot.wait(120), 0) << robot.log();
+  ASSERT_TRUE(status.wait_for([&](const auto& s) { return total_applied(s) == 3 && s.scan_queue_depth == 0; }, 240))
+      << server.log();
+  server.signal(SIGTERM);
+  ASSERT_EQ(server.wait(120), 0) << server.log();
+  const auto served = load_ot(map_path);
+  ASSERT_TRUE(served);
+  const TreeDiff d = compare_leaves(*served, *octomap_reference(scans, kResolution, -1.0));
+  EXPECT_GT(d.leaves_a, 1000u);
+  EXPECT_EQ(d.differing_voxels, 0u) << d.first_difference;
+  EXPECT_EQ(d.differing_logodds, 0u) << d.first_difference;
+  if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace ort::test
