@@ -240,10 +240,21 @@ StatusInputs MappingServer::gather_status() {
   in.pipelined = cfg_.pipeline;
   in.resolution = cfg_.engine.resolution;
   {
+    // size() is O(1); the leaf count (and memoryUsage(), which needs it) walks the whole
+    // tree under the map lock, stalling stage 2. So on big maps it is refreshed at most
+    // every 10 s and memory is computed from the cached leaf count with OctoMap's formula.
     std::lock_guard lock(map_.mutex);
-    in.num_nodes = static_cast<int64_t>(map_.tree->size());
-    in.num_leaf_nodes = static_cast<int64_t>(map_.tree->getNumLeafNodes());
-    in.memory_bytes = static_cast<int64_t>(map_.tree->memoryUsage());
+    const octomap::OcTree& t = *map_.tree;
+    const auto now = std::chrono::steady_clock::now();
+    if (t.size() <= 1'000'000 || now - leaves_time_ > std::chrono::seconds(10)) {
+      cached_leaves_ = t.getNumLeafNodes();
+      leaves_time_ = now;
+    }
+    const size_t leaves = std::min(cached_leaves_, t.size());
+    in.num_nodes = static_cast<int64_t>(t.size());
+    in.num_leaf_nodes = static_cast<int64_t>(leaves);
+    in.memory_bytes = static_cast<int64_t>(sizeof(octomap::OcTree) + t.memoryUsageNode() * t.size() +
+                                           (t.size() - leaves) * sizeof(octomap::OcTreeNode* [8]));
   }
   in.queue_depth = static_cast<int32_t>(queue_.depth());
   in.queue_bytes = static_cast<int64_t>(queue_.bytes());

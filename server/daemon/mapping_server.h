@@ -89,6 +89,8 @@ class MappingServer {
   std::string message_;
   bool state_changed_ = false, stopping_ = false, status_exit_ = false, started_ = false, stopped_ = false;
   int64_t status_seq_ = 0;
+  size_t cached_leaves_ = 0;                  // map's leaf count (under the map lock)
+  std::chrono::steady_clock::time_point leaves_time_;
   int64_t last_drops_ = 0, last_kernel_errors_ = -1, last_rejects_ = 0;
   std::thread status_thread_, save_thread_;
 

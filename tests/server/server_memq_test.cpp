@@ -280,6 +280,15 @@ TEST(ServerMemq, StopDrainsQueuedScans) {
   expect_counts_balance(st);
   EXPECT_EQ(st[0].applied, 6);
   EXPECT_EQ(server.applied_order().size(), 6u);
+  // The status's map numbers are OctoMap's own.
+  const auto status = server.status();
+  server.with_map([&](const octomap::OcTree& t) {
+    EXPECT_EQ(status.num_nodes, static_cast<int64_t>(t.size()));
+    EXPECT_EQ(status.num_leaf_nodes, static_cast<int64_t>(t.getNumLeafNodes()));
+    EXPECT_NEAR(static_cast<double>(status.memory_bytes), static_cast<double>(t.memoryUsage()), 1024.0);
+    return 0;
+  });
+  EXPECT_EQ(status.scans_applied, 6);
 }
 
 // Status heartbeats reach an LCM subscriber on the status channel.
