@@ -47,7 +47,7 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
   }
 
   const auto t0 = Clock::now();
-  sort_voxels(updates, sorted_, sort_scratch_, opts_.sort);
+  sort_voxels(updates, sorted_, sort_scratch_, opts_.sort, &pool_);
   const std::span<const SortedVoxel> voxels(sorted_);
   const auto t1 = Clock::now();
   st.sort_ms = ms_between(t0, t1);

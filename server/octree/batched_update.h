@@ -26,6 +26,7 @@
 
 #include "engine/voxel_update.h"
 #include "octree/morton_order.h"
+#include "octree/voxel_sort.h"
 #include "octree/worker_pool.h"
 
 namespace ort {

@@ -1,4 +1,4 @@
-// Morton (Z-order) codes of OcTree keys, and sorting a scan's voxel list into that order.
+// Morton (Z-order) codes of OcTree keys (voxel_sort.h sorts a scan's list by them).
 //
 // The code interleaves the key bits so that its 3-bit groups, read from the top, are exactly
 // the child indices OctoMap takes on the way from the root to the voxel (computeChildIdx: x is
@@ -8,8 +8,6 @@
 #pragma once
 
 #include <cstdint>
-#include <span>
-#include <vector>
 
 #include "engine/voxel_update.h"
 
@@ -17,8 +15,22 @@ namespace ort {
 
 constexpr unsigned kTreeDepth = 16;  // OcTree's depth: 16-bit keys
 
-// 48-bit Morton code of a key.
-uint64_t morton_code(uint16_t x, uint16_t y, uint16_t z);
+namespace detail {
+// Spreads the 16 bits of v to every third bit (bit i -> bit 3i).
+inline uint64_t spread_bits(uint64_t v) {
+  v &= 0xffffu;
+  v = (v | (v << 16)) & 0x0000ff0000ffull;
+  v = (v | (v << 8)) & 0x00f00f00f00full;
+  v = (v | (v << 4)) & 0x0c30c30c30c3ull;
+  v = (v | (v << 2)) & 0x249249249249ull;
+  return v;
+}
+}  // namespace detail
+
+// 48-bit Morton code of a key (inline: it is computed for every voxel of every scan).
+inline uint64_t morton_code(uint16_t x, uint16_t y, uint16_t z) {
+  return detail::spread_bits(x) | (detail::spread_bits(y) << 1) | (detail::spread_bits(z) << 2);
+}
 // The key back from a Morton code.
 void morton_decode(uint64_t code, uint16_t& x, uint16_t& y, uint16_t& z);
 
@@ -44,14 +56,5 @@ inline unsigned shared_path_depth(SortedVoxel a, SortedVoxel b) {
   const unsigned top_bit = 63u - static_cast<unsigned>(__builtin_clzll(diff));
   return kTreeDepth - 1 - top_bit / 3;
 }
-
-enum class SortMethod {
-  kRadix,  // LSD radix sort, 8-bit digits, digits equal in every voxel skipped
-  kStd,    // std::sort, for comparison (tools/octree_bench)
-};
-
-// Codes of `updates`, sorted ascending. `scratch` is reused storage for the radix passes.
-void sort_voxels(std::span<const VoxelUpdate> updates, std::vector<SortedVoxel>& out,
-                 std::vector<SortedVoxel>& scratch, SortMethod method = SortMethod::kRadix);
 
 }  // namespace ort

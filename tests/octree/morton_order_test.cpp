@@ -6,6 +6,7 @@
 #include <octomap/OcTreeKey.h>
 
 #include "octree/morton_order.h"
+#include "octree/voxel_sort.h"
 #include "octree/subtree_split.h"
 
 namespace ort {
@@ -75,14 +76,18 @@ VoxelList random_unique_list(std::mt19937& rng, size_t n, int lo, int hi) {
 
 TEST(MortonOrder, RadixSortEqualsStdSort) {
   std::mt19937 rng(3);
+  WorkerPool pool(3);
   for (auto [n, lo, hi] : {std::tuple{0, 0, 1}, {1, 0, 65535}, {1000, 32700, 32800}, {200000, 0, 65535},
-                           {100000, 32000, 33000}}) {
+                           {100000, 32000, 33000}, {60000, 32760, 32800}, {50000, 0, 40}}) {
     const VoxelList list = random_unique_list(rng, n, lo, hi);
-    std::vector<SortedVoxel> radix, standard, scratch;
+    std::vector<SortedVoxel> radix, pooled, standard, scratch;
     sort_voxels(list, radix, scratch, SortMethod::kRadix);
+    sort_voxels(list, pooled, scratch, SortMethod::kRadix, &pool);
     sort_voxels(list, standard, scratch, SortMethod::kStd);
     ASSERT_EQ(radix, standard) << n << " voxels in [" << lo << "," << hi << "]";
+    ASSERT_EQ(pooled, standard) << n << " voxels in [" << lo << "," << hi << "], 3 threads";
     ASSERT_TRUE(std::is_sorted(radix.begin(), radix.end()));
+    ASSERT_EQ(radix.size(), list.size());
   }
 }
 

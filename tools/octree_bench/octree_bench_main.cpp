@@ -21,6 +21,7 @@
 #include "engine/map_engine.h"
 #include "octree/batched_update.h"
 #include "octree/morton_order.h"
+#include "octree/voxel_sort.h"
 #include "scene/scan_set.h"
 
 namespace {
@@ -95,20 +96,25 @@ int main(int argc, char** argv) {
     const DataSet d = shoot_lists(data_dir + "/" + g, resolution);
     std::printf("%s: %zu scans, %zu voxel updates per pass\n", d.name.c_str(), d.lists.size(), d.voxels);
 
-    // Sorting alone: radix vs std::sort on the same lists.
+    // Sorting alone: radix (1 thread and all) vs std::sort on the same lists.
     {
       std::vector<ort::SortedVoxel> out, scratch;
-      double radix = 1e300, standard = 1e300;
+      ort::WorkerPool pool(hw);
+      double radix = 1e300, radix_pool = 1e300, standard = 1e300;
       for (int r = 0; r < repeat; ++r) {
         auto t = Clock::now();
         for (const auto& l : d.lists) ort::sort_voxels(l, out, scratch, ort::SortMethod::kRadix);
         radix = std::min(radix, ms_since(t));
         t = Clock::now();
+        for (const auto& l : d.lists) ort::sort_voxels(l, out, scratch, ort::SortMethod::kRadix, &pool);
+        radix_pool = std::min(radix_pool, ms_since(t));
+        t = Clock::now();
         for (const auto& l : d.lists) ort::sort_voxels(l, out, scratch, ort::SortMethod::kStd);
         standard = std::min(standard, ms_since(t));
       }
-      std::printf("  Morton sort per pass: radix %.2f ms, std::sort %.2f ms (%.1fx)\n", radix, standard,
-                  standard / radix);
+      std::printf("  Morton sort per pass: std::sort %.2f ms, radix 1 thread %.2f ms (%.1fx), radix %u threads "
+                  "%.2f ms (%.1fx)\n",
+                  standard, radix, standard / radix, hw, radix_pool, standard / radix_pool);
     }
 
     std::vector<std::unique_ptr<ort::BatchedOctreeUpdater>> batched;
