@@ -10,11 +10,13 @@ void add_engine_flags(CLI::App& cmd, EngineFlags& f, bool require_resolution) {
       ->capture_default_str();
   cmd.add_option("--backend", f.backend,
                  "ray shooting: auto, cpu (OctoMap's own walk, the reference), cpu-grid (native threads "
-                 "into the 2-bit grid), vulkan (compute shaders) or rt (ray-tracing pipeline)")
+                 "into the 2-bit grid), vulkan (compute shaders) or rt (ray-tracing pipeline: --traversal exact "
+                 "only; needs VK_KHR_ray_tracing_pipeline, else it reports unsupported)")
       ->check(CLI::IsMember({"auto", "cpu", "cpu-grid", "vulkan", "rt"}))
       ->capture_default_str();
   cmd.add_option("--device", f.device, "Vulkan device: name substring or index (default: automatic)");
-  cmd.add_option("--traversal", f.traversal, "octomap (OctoMap's exact walk) or exact (closed-box geometry)")
+  cmd.add_option("--traversal", f.traversal,
+                 "octomap (OctoMap's exact walk) or exact (closed-box geometry; the only mode of --backend rt)")
       ->check(CLI::IsMember({"octomap", "exact"}))
       ->capture_default_str();
   cmd.add_option("--octree", f.octree, "octree stage: sequential (updateNode loop) or batched")
