@@ -252,6 +252,32 @@ TEST(ServerMemq, FullQueueDropsNewestAndCountsIt) {
   EXPECT_NE(st.queue_policy.find("newest scan is dropped"), std::string::npos);
 }
 
+// More scan channels than --max-producers: the extra ones share one "*" entry whose scans
+// are all rejected (bounded memory whatever the channel names), and are still counted.
+TEST(ServerMemq, ProducersBeyondTheLimitAreRejectedAndCounted) {
+  lcm::LCM lc("memq://");
+  auto cfg = test_config(0.1, true);
+  cfg.max_producers = 2;
+  std::ostringstream log;
+  daemon::MappingServer server(cfg, lc, log);
+  server.start();
+  for (const char* robot : {"a1", "a2", "a3", "a4"}) {
+    const auto msg = small_scan(robot, 0, 10);
+    lc.publish(channel_of(robot), &msg);
+  }
+  ASSERT_TRUE(wait_until_done(server, 4));
+  const auto stats = server.producer_stats();
+  expect_counts_balance(stats);
+  ASSERT_EQ(stats.size(), 3u);
+  const auto* other = find(stats, "*");
+  ASSERT_NE(other, nullptr);
+  EXPECT_EQ(other->received, 2);
+  EXPECT_EQ(reason_count(*other, Reject::kTooManyProducers), 2);
+  EXPECT_EQ(find(stats, "OCTOMAP_RT_SCAN_A1")->applied, 1);
+  EXPECT_EQ(find(stats, "OCTOMAP_RT_SCAN_A2")->applied, 1);
+  server.stop();
+}
+
 // stop() right after the scans arrived: intake closes, and every queued scan is still
 // applied (drained), not lost.
 TEST(ServerMemq, StopDrainsQueuedScans) {
