@@ -19,3 +19,7 @@ octomap_rt_add_test(gpu_ray_space_test SOURCES ${GPU_TEST_DIR}/ray_space_test.cp
                     LIBS octomap_rt_gpu_test_support TIMEOUT 600)
 octomap_rt_add_test(gpu_device_test SOURCES ${GPU_TEST_DIR}/device_choice_test.cpp TIMEOUT 300)
 octomap_rt_add_test(gpu_no_device_test SOURCES ${GPU_TEST_DIR}/no_device_test.cpp TIMEOUT 120)
+# `octomap-rt build --backend rt`: builds, or refuses cleanly without ray tracing.
+octomap_rt_add_test(gpu_rt_cli_test SOURCES ${GPU_TEST_DIR}/rt_cli_test.cpp TIMEOUT 300)
+target_compile_definitions(gpu_rt_cli_test PRIVATE OCTOMAP_RT_CLI="$<TARGET_FILE:octomap-rt>")
+add_dependencies(gpu_rt_cli_test octomap-rt)
