@@ -1,6 +1,7 @@
 // lcm-logger records two robots streaming into a daemon; the log then replays into fresh
-// daemons, once through `octomap-rt replay LOG` and once through Debian's lcm-logplayer, and
-// each builds the map OctoMap builds from the same scans in the order that daemon applied.
+// daemons, through `octomap-rt replay LOG` (as recorded, and renamed to one robot) and
+// through Debian's lcm-logplayer, and each builds the map OctoMap builds from the same scans
+// in the order that daemon applied.
 #include <gtest/gtest.h>
 
 #include <signal.h>
@@ -10,6 +11,7 @@
 #include "daemon/applied_order.h"
 #include "integration_harness.h"
 #include "lcm_log_scans.h"
+#include "octomap_rt/scan_t.hpp"
 #include "scan_selection.h"
 #include "scene/scan_set.h"
 #include "support/octomap_reference.h"
@@ -138,6 +140,39 @@ TEST(ServerLogReplayIntegration, ALoggedSessionReplaysIntoTheDaemonByReplayAndBy
     ASSERT_EQ(server.wait(120), 0) << server.log();
   }
   expect_map_of_applied_order(run.dir + "/by_logplayer.ot", scans, shares, expected);
+
+  // 4. `octomap-rt replay LOG --robot solo`: every logged scan renamed to one robot and
+  // renumbered, in log order; the map is OctoMap's of the scans in that order.
+  ScanSet log_order;
+  cli::for_each_log_scan(log, "OCTOMAP_RT_SCAN_", [&](const cli::LogScanEvent& e) {
+    octomap_rt::scan_t m;
+    EXPECT_GE(m.decode(e.data, 0, static_cast<int>(e.size)), 0);
+    const int p = producer_index(m.robot_id, "prod", kProducers);
+    EXPECT_GE(p, 0);
+    if (p >= 0) log_order.scans.push_back(scans.scans[shares[p][m.seq]]);
+    return true;
+  });
+  {
+    const std::string map = run.dir + "/renamed.ot";
+    ChildProcess server(server_args(map), run.dir + "/renamed_server.log");
+    ASSERT_TRUE(started(server.pid())) << server.log();
+    ChildProcess player({client_program(), "replay", log, "--robot", "solo", "--rate", "4", "--lcm-url", run.url},
+                        run.dir + "/renamed.log");
+    EXPECT_EQ(player.wait(120), 0) << player.log();
+    ASSERT_TRUE(run.wait_applied(server.pid(), expected, 240)) << server.log();
+    const auto st = watcher.latest();
+    const auto* r = find_robot_ci(*st, "solo");
+    ASSERT_NE(r, nullptr);
+    EXPECT_EQ(r->scans_applied, static_cast<int64_t>(expected));
+    EXPECT_EQ(r->last_seq, static_cast<int64_t>(expected) - 1);
+    EXPECT_EQ(r->scans_missed, 0);
+    server.signal(SIGTERM);
+    ASSERT_EQ(server.wait(120), 0) << server.log();
+    const auto served = load_ot(map);
+    ASSERT_TRUE(served);
+    const TreeDiff d = compare_leaves(*served, *octomap_reference(log_order, kResolution, -1.0));
+    EXPECT_TRUE(d.maps_equal()) << d.differing_voxels << " voxels, " << d.differing_logodds << " log-odds differ";
+  }
 
   if (!::testing::Test::HasFailure()) std::filesystem::remove_all(run.dir);
 }
