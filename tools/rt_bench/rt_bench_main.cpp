@@ -193,7 +193,6 @@ int main(int argc, char** argv) {
           bool equal = true;
           if (have_vk)
             for (size_t i = 0; i < scans.size(); ++i) equal = equal && same(t.lists[i], vk.lists[i]);
-          const double mb = double(info.blas_bytes + info.tlas_bytes) / (1024.0 * 1024.0);
           if (!equal) {
             std::printf("| %s | %.1f | rt | %d | DIFFERENT VOXELS FROM VULKAN: no time reported |\n", name.c_str(), res, k);
             continue;
@@ -205,7 +204,6 @@ int main(int argc, char** argv) {
                       t.per_scan_ms, t.trace_ms,
                       have_vk ? (std::to_string(t.per_scan_ms / vk.per_scan_ms).substr(0, 5) + "x").c_str() : "-",
                       octomap_ms);
-          (void)mb;
         } catch (const std::exception& e) {
           std::printf("| %s | %.1f | rt | %d | unavailable: %s |\n", name.c_str(), res, k, one_line(e.what()).c_str());
         }

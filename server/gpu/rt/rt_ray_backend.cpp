@@ -92,7 +92,6 @@ class RtBackend final : public RayBackend {
     stamps_ = std::make_unique<vk::TimestampQueries>(*ctx_, 3);
 
     const VkMemoryPropertyFlags local = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-    const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
     const uint64_t words = layout_.grid_words();
     grid_ = vk::Buffer(*ctx_, words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, local);
     touched_ = vk::Buffer(*ctx_, words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, local);
@@ -114,7 +113,6 @@ class RtBackend final : public RayBackend {
     VkCommandBuffer cmd = runner_->begin();  // the grid starts clean; compaction keeps it so
     vkCmdFillBuffer(cmd, grid_.handle(), 0, VK_WHOLE_SIZE, 0);
     runner_->submit_and_wait();
-    (void)host;
 
     if (info) {
       info->layout = layout_;
