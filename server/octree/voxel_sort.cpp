@@ -9,6 +9,7 @@ namespace {
 
 constexpr unsigned kBucketBits = 11;     // first pass: 2048 buckets
 constexpr size_t kParallelMin = 32768;   // below this the threads cost more than they save
+constexpr size_t kInCacheVoxels = 8192;  // 64 KiB: LSD passes stay in L2
 
 // Runs body(worker) on the pool's workers, or once on this thread without a pool.
 template <class F>
@@ -29,9 +30,13 @@ uint64_t varying_bits(const SortedVoxel* data, size_t n) {
   return acc;
 }
 
-// LSD radix sort of a small range on its varying bits, 8 at a time; `tmp` is as long as
-// `data`. The result ends in `data`.
-void sort_small(SortedVoxel* data, SortedVoxel* tmp, size_t n) {
+// Sorts a range on its varying bits; `tmp` is as long as `data`; the result ends in
+// `data`. Ranges that fit in cache, or have few varying bits, get LSD passes of 8 bits.
+// Larger ones are first split on their own top 11 varying bits and each part sorted the
+// same way: a scan crossing the map origin varies in every key bit (0x7fff -> 0x8000), so
+// the top bits of the whole list only separate the 8 octants around the origin, and each
+// octant has to be split again on the bits that vary inside it.
+void sort_range(SortedVoxel* data, SortedVoxel* tmp, size_t n) {
   if (n < 64) {
     std::sort(data, data + n);
     return;
@@ -39,6 +44,19 @@ void sort_small(SortedVoxel* data, SortedVoxel* tmp, size_t n) {
   const uint64_t varying = varying_bits(data, n);
   if (varying == 0) return;
   const unsigned bits = 64u - static_cast<unsigned>(__builtin_clzll(varying));
+  if (n > kInCacheVoxels && bits > 16) {
+    const unsigned shift = bits - std::min(kBucketBits, bits);
+    const uint64_t mask = (uint64_t{1} << (bits - shift)) - 1;
+    std::vector<size_t> begin((mask + 2), 0);
+    for (size_t i = 0; i < n; ++i) ++begin[((data[i] >> shift) & mask) + 1];
+    for (size_t b = 1; b < begin.size(); ++b) begin[b] += begin[b - 1];
+    std::vector<size_t> next(begin.begin(), begin.end() - 1);
+    for (size_t i = 0; i < n; ++i) tmp[next[(data[i] >> shift) & mask]++] = data[i];
+    std::copy(tmp, tmp + n, data);
+    for (size_t b = 0; b + 1 < begin.size(); ++b)
+      if (begin[b + 1] - begin[b] > 1) sort_range(data + begin[b], tmp + begin[b], begin[b + 1] - begin[b]);
+    return;
+  }
   SortedVoxel* src = data;
   SortedVoxel* dst = tmp;
   for (unsigned shift = 0; shift < bits; shift += 8) {
@@ -123,7 +141,7 @@ void sort_voxels(std::span<const VoxelUpdate> updates, std::vector<SortedVoxel>&
   run_on(pool, workers, [&](unsigned) {
     for (size_t b; (b = next_bucket.fetch_add(1, std::memory_order_relaxed)) < buckets;) {
       const size_t begin = bucket_begin[b], len = bucket_begin[b + 1] - begin;
-      if (len > 1) sort_small(out.data() + begin, scratch.data() + begin, len);
+      if (len > 1) sort_range(out.data() + begin, scratch.data() + begin, len);
     }
   });
 }

@@ -1,10 +1,9 @@
 // Sorting one scan's voxel list into Morton order, on the octree stage's threads.
 //
-// The codes of a scan differ only in their low bits (a scan covers a small part of the
-// 2^16 keys per axis), so the sort looks at the bits that vary only: one parallel
-// most-significant-digit pass on the top 11 of them scatters the list into up to 2048
-// buckets, and each bucket, small enough to stay in cache, is finished by a least-
-// significant-digit radix sort on the rest, buckets spread over the threads.
+// The sort looks only at the bits that vary: one parallel most-significant-digit pass on
+// the top 11 of them scatters the list into up to 2048 buckets; the buckets, spread over the
+// threads, are split the same way on their own varying bits until a part fits in cache,
+// which least-significant-digit radix passes finish.
 #pragma once
 
 #include <span>
