@@ -20,8 +20,9 @@ inline int64_t window_index(const KeyBox& w, int x, int y, int z) {
   return (x - w.lo[0]) + nx * ((y - w.lo[1]) + ny * int64_t(z - w.lo[2]));
 }
 
-// Splits `space` (widened by `margin` voxels, clamped to the key range) into windows of at
-// most `capacity_voxels` voxels each, halving along the longest axis.
+// Widens `space` by `margin` voxels a side (a DDA may step one voxel past its end key),
+// clamps it to [0, 65535] and cuts it into disjoint windows of at most `capacity_voxels`
+// voxels that cover the widened box exactly. Used by the cpu-grid and vulkan back ends.
 std::vector<KeyBox> plan_windows(const KeyBox& space, uint64_t capacity_voxels, int margin = 2);
 
 }  // namespace ort

@@ -16,7 +16,7 @@
 #include <stdexcept>
 
 #include "gpu/ray_space_sizing.h"
-#include "gpu/ray_space_windows.h"
+#include "engine/ray_space.h"
 #include "gpu/shader_interface.h"
 #include "gpu/vk/vk_buffer.h"
 #include "gpu/vk/vk_check.h"
@@ -116,7 +116,7 @@ class VulkanBackend final : public RayBackend {
     stats.times.upload_ms += ms_since(t_upload);
 
     const std::vector<KeyBox> windows =
-        gpu::plan_ray_space_windows(batch.keys, sizing_.grid_words * gpu::kVoxelsPerWord, kWindowMargin);
+        plan_windows(batch.keys, sizing_.grid_words * gpu::kVoxelsPerWord, kWindowMargin);
     vk::ComputePipeline& shoot = mode == Traversal::kOctomap ? *shoot_octomap_ : *shoot_exact_;
     for (size_t w = 0; w < windows.size(); ++w) {
       run_window(batch, shoot, windows[w], w == 0 ? ray_bytes : 0, out, stats);

@@ -12,7 +12,7 @@
 #include "engine/prepare_scan.h"
 #include "gpu/gpu_test_support.h"
 #include "gpu/ray_space_sizing.h"
-#include "gpu/ray_space_windows.h"
+#include "engine/ray_space.h"
 #include "gpu/vulkan_backend.h"
 #include "scene/synthetic_scene.h"
 
@@ -211,7 +211,7 @@ TEST(RaySpaceWindows, DisjointCoverWithinCapacity) {
       keys.hi[i] = std::min(65535, keys.lo[i] + extent(rng));
     }
     const uint64_t capacity = std::uniform_int_distribution<uint64_t>(1, 5000000)(rng);
-    const std::vector<KeyBox> w = gpu::plan_ray_space_windows(keys, capacity, 2);
+    const std::vector<KeyBox> w = plan_windows(keys, capacity, 2);
     KeyBox wide;
     for (int i = 0; i < 3; ++i) {
       wide.lo[i] = std::max(0, keys.lo[i] - 2);
@@ -237,8 +237,8 @@ TEST(RaySpaceWindows, DisjointCoverWithinCapacity) {
   k.lo[0] = k.lo[1] = k.lo[2] = 1000;
   k.hi[0] = 1000 + 225;
   k.hi[1] = k.hi[2] = 1000 + 5;
-  EXPECT_EQ(gpu::plan_ray_space_windows(k, 230 * 10 * 10 / 2.3 + 1, 2).size(), 3u);
-  EXPECT_TRUE(gpu::plan_ray_space_windows(KeyBox{}, 100).empty());
+  EXPECT_EQ(plan_windows(k, 230 * 10 * 10 / 2.3 + 1, 2).size(), 3u);
+  EXPECT_TRUE(plan_windows(KeyBox{}, 100).empty());
 }
 
 }  // namespace
