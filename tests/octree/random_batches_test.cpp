@@ -213,12 +213,14 @@ void expect_all_cases(const CaseCounts& c) {
   std::printf("cases: %ld created, %ld saturated leaves, %ld saturated pruned, %ld expanded, %ld batches pruning, "
               "%ld edge voxels\n",
               c.created, c.saturated_leaf, c.saturated_pruned, c.expanded, c.batches_pruning, c.edge_voxels);
-  EXPECT_GT(c.created, 1000);
-  EXPECT_GT(c.saturated_leaf, 1000);
-  EXPECT_GT(c.saturated_pruned, 100);
-  EXPECT_GT(c.expanded, 100);
-  EXPECT_GT(c.batches_pruning, 5);
-  EXPECT_GT(c.edge_voxels, 1000);
+  // The quick variant (fewer batches, under TSan) sees fewer of the rarer cases.
+  const long scale = test::quick_mode() ? 10 : 1;
+  EXPECT_GT(c.created, 1000 / scale);
+  EXPECT_GT(c.saturated_leaf, 1000 / scale);
+  EXPECT_GT(c.saturated_pruned, 100 / scale);
+  EXPECT_GT(c.expanded, 100 / scale);
+  EXPECT_GT(c.batches_pruning, 5 / scale);
+  EXPECT_GT(c.edge_voxels, 1000 / scale);
 }
 
 TEST(BatchedUpdate, RandomBatchesDefaultSensorModel) {
