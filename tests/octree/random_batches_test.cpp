@@ -214,7 +214,7 @@ void expect_all_cases(const CaseCounts& c) {
               "%ld edge voxels\n",
               c.created, c.saturated_leaf, c.saturated_pruned, c.expanded, c.batches_pruning, c.edge_voxels);
   // The quick variant (fewer batches, under TSan) sees fewer of the rarer cases.
-  const long scale = test::quick_mode() ? 10 : 1;
+  const long scale = test::quick_mode() ? 20 : 1;
   EXPECT_GT(c.created, 1000 / scale);
   EXPECT_GT(c.saturated_leaf, 1000 / scale);
   EXPECT_GT(c.saturated_pruned, 100 / scale);
