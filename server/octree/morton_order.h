@@ -49,10 +49,12 @@ inline unsigned child_index_at(SortedVoxel v, unsigned depth) {
   return static_cast<unsigned>(v >> (3 * (kTreeDepth - 1 - depth) + 1)) & 7u;
 }
 
-// Deepest depth whose node lies on both voxels' root paths: the node where the paths part.
-// The voxels must differ (unique keys).
+// Deepest depth whose node lies on both voxels' root paths: the node where the paths part;
+// kTreeDepth for the same key (a scan's list should never repeat a key, but if it does the
+// key is updated twice, as OctoMap's loop would).
 inline unsigned shared_path_depth(SortedVoxel a, SortedVoxel b) {
   const uint64_t diff = (a ^ b) >> 1;
+  if (diff == 0) return kTreeDepth;
   const unsigned top_bit = 63u - static_cast<unsigned>(__builtin_clzll(diff));
   return kTreeDepth - 1 - top_bit / 3;
 }

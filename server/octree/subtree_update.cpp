@@ -49,6 +49,7 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
         if (p.just_created || !at_clamping_bound(tree, *p.node, update)) {
           tree.updateNodeLogOdds(p.node, update);
           p.changed = true;
+          p.just_created = false;  // a repeated key finds this leaf as it is now
         }
         break;
       }
