@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "engine/map_frame.h"
+
 namespace ort::daemon {
 
 octomap::pose6d scan_pose(const octomap_rt::scan_t& m) {
@@ -18,7 +20,7 @@ MapFrameScan to_map_frame(const octomap_rt::scan_t& m) {
   s.origin = pose.trans();
   s.points.reserve(m.xyz.size() / 3);
   for (size_t i = 0; i + 2 < m.xyz.size(); i += 3) s.points.push_back(m.xyz[i], m.xyz[i + 1], m.xyz[i + 2]);
-  if (m.points_frame == octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME) s.points.transform(pose);
+  if (m.points_frame == octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME) transform_to_map_frame(s.points, pose);
   return s;
 }
 

@@ -76,3 +76,28 @@ TEST(CoordToKey, MatchesOctomap) {
 
 }  // namespace
 }  // namespace ort
+
+#include "engine/map_frame.h"
+
+namespace ort {
+namespace {
+
+TEST(MapFrame, ParallelTransformEqualsPointcloudTransformBitForBit) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-30.0f, 30.0f);
+  octomap::Pointcloud pc;
+  for (int i = 0; i < 100000; ++i) pc.push_back(u(rng), u(rng), u(rng));
+  const octomap::pose6d pose(1.5, -2.25, 0.3, 0.1, -0.2, 2.9);
+  octomap::Pointcloud reference(pc), ours(pc);
+  reference.transform(pose);
+  transform_to_map_frame(ours, pose, 7);
+  ASSERT_EQ(ours.size(), reference.size());
+  for (size_t i = 0; i < pc.size(); ++i) {
+    ASSERT_EQ(ours[i].x(), reference[i].x());
+    ASSERT_EQ(ours[i].y(), reference[i].y());
+    ASSERT_EQ(ours[i].z(), reference[i].z());
+  }
+}
+
+}  // namespace
+}  // namespace ort

@@ -5,6 +5,8 @@
 
 #include <octomap/ScanGraph.h>
 
+#include "engine/map_frame.h"
+
 namespace ort {
 
 size_t ScanSet::total_points() const {
@@ -42,7 +44,7 @@ void save_scan_graph(const ScanSet& set, const std::string& path) {
 
 octomap::Pointcloud world_points(const PosedScan& scan) {
   octomap::Pointcloud pc(scan.points);
-  pc.transform(scan.pose);
+  transform_to_map_frame(pc, scan.pose);  // = pc.transform(scan.pose), on several threads
   return pc;
 }
 
