@@ -27,7 +27,7 @@ void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::p
                       ShotScan& out) {
   out = ShotScan{};
   const auto t0 = Clock::now();
-  const RayBatch batch = prepare_scan(origin, points, max_range, opts_.resolution, out.prepare);
+  const RayBatch batch = prepare_scan(origin, points, max_range, opts_.resolution, out.prepare, opts_.octree.threads);
   out.shoot.times.prepare_ms = ms_since(t0);
   if (!out.prepare.origin_ok) return;
   backend_->shoot(batch, opts_.traversal, out.voxels, out.shoot);

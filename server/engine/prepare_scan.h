@@ -24,9 +24,10 @@ struct PrepareReport {
 };
 
 // Builds the rays of one scan. Points are in the map frame, as OctoMap's insertPointCloud
-// takes them. max_range < 0 means no limit.
+// takes them. max_range < 0 means no limit. Large scans are prepared on `threads` threads
+// (0: hardware threads); the result is the same as on one thread, ray for ray.
 RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::point3d> points,
-                      double max_range, double resolution, PrepareReport& report);
+                      double max_range, double resolution, PrepareReport& report, unsigned threads = 0);
 
 // OctoMap's coordToKeyChecked for a tree of the given resolution (depth 16).
 bool coord_to_key_checked(const octomap::point3d& p, double resolution, octomap::OcTreeKey& key);

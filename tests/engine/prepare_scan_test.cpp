@@ -101,3 +101,43 @@ TEST(MapFrame, ParallelTransformEqualsPointcloudTransformBitForBit) {
 
 }  // namespace
 }  // namespace ort
+
+namespace ort {
+namespace {
+
+TEST(PrepareScan, ThreadsGiveTheSameBatchRayForRay) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(-40.0f, 40.0f);
+  std::vector<octomap::point3d> pts;
+  for (int i = 0; i < 200000; ++i) {
+    octomap::point3d p(u(rng), u(rng), u(rng));
+    if (i % 997 == 0) p.x() = std::numeric_limits<float>::quiet_NaN();
+    if (i % 1499 == 0) p.y() = 1e7f;  // outside the key range
+    pts.push_back(p);
+  }
+  for (double max_range : {-1.0, 25.0}) {
+    PrepareReport r1, r7;
+    const RayBatch b1 = prepare_scan({1, 2, 3}, pts, max_range, 0.1, r1, 1);
+    const RayBatch b7 = prepare_scan({1, 2, 3}, pts, max_range, 0.1, r7, 7);
+    EXPECT_EQ(r1.rays, r7.rays);
+    EXPECT_EQ(r1.nonfinite, r7.nonfinite);
+    EXPECT_EQ(r1.out_of_range, r7.out_of_range);
+    EXPECT_EQ(r1.cut_at_max_range, r7.cut_at_max_range);
+    EXPECT_GT(r1.nonfinite, 0u);
+    if (max_range < 0) EXPECT_GT(r1.out_of_range, 0u);  // with a max range they are cut, not dropped
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_EQ(b1.keys.lo[i], b7.keys.lo[i]);
+      EXPECT_EQ(b1.keys.hi[i], b7.keys.hi[i]);
+    }
+    ASSERT_EQ(b1.ends.size(), b7.ends.size());
+    for (size_t i = 0; i < b1.ends.size(); ++i) {
+      ASSERT_EQ(b1.ends[i].x, b7.ends[i].x);
+      ASSERT_EQ(b1.ends[i].y, b7.ends[i].y);
+      ASSERT_EQ(b1.ends[i].z, b7.ends[i].z);
+      ASSERT_EQ(b1.ends[i].flags, b7.ends[i].flags);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace ort
