@@ -4,6 +4,7 @@
 #include <cstring>
 #include <utility>
 
+#include "gpu/rt/rt_functions.h"
 #include "gpu/vk/vk_check.h"
 #include "gpu/vk/vk_timestamps.h"
 
@@ -13,13 +14,7 @@ namespace {
 VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) { return a ? (v + a - 1) / a * a : v; }
 
 VkDeviceSize scratch_alignment(const vk::Context& ctx) {
-  VkPhysicalDeviceAccelerationStructurePropertiesKHR as{};
-  as.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR;
-  VkPhysicalDeviceProperties2 p2{};
-  p2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
-  p2.pNext = &as;
-  vkGetPhysicalDeviceProperties2(ctx.physical_device(), &p2);
-  return as.minAccelerationStructureScratchOffsetAlignment;
+  return acceleration_structure_properties(ctx.physical_device()).minAccelerationStructureScratchOffsetAlignment;
 }
 
 // A scratch buffer for one build, with its device address aligned as the device requires.

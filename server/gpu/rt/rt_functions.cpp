@@ -22,4 +22,14 @@ RtFunctions load_rt_functions(VkDevice device) {
   return f;
 }
 
+VkPhysicalDeviceAccelerationStructurePropertiesKHR acceleration_structure_properties(VkPhysicalDevice device) {
+  VkPhysicalDeviceAccelerationStructurePropertiesKHR as{};
+  as.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR;
+  VkPhysicalDeviceProperties2 p2{};
+  p2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+  p2.pNext = &as;
+  vkGetPhysicalDeviceProperties2(device, &p2);
+  return as;
+}
+
 }  // namespace ort::rt

@@ -20,4 +20,7 @@ struct RtFunctions {
 // Throws std::runtime_error naming the first entry point the driver does not give.
 RtFunctions load_rt_functions(VkDevice device);
 
+// The device's VK_KHR_acceleration_structure limits (instance count, scratch alignment).
+VkPhysicalDeviceAccelerationStructurePropertiesKHR acceleration_structure_properties(VkPhysicalDevice device);
+
 }  // namespace ort::rt

@@ -63,15 +63,10 @@ std::unique_ptr<vk::Context> make_context(const BackendOptions& opts) {
 }
 
 SpaceLimits device_limits(const vk::Context& ctx, const BackendOptions& opts, SpaceLimits l) {
-  VkPhysicalDeviceAccelerationStructurePropertiesKHR as{};
-  as.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR;
-  VkPhysicalDeviceProperties2 p2{};
-  p2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
-  p2.pNext = &as;
-  vkGetPhysicalDeviceProperties2(ctx.physical_device(), &p2);
+  const auto as = acceleration_structure_properties(ctx.physical_device());
   l.max_instances = std::min<uint64_t>(l.max_instances, as.maxInstanceCount);
   // The grid is one storage buffer of 2-bit states: 4 voxels a byte.
-  l.max_voxels = std::min<uint64_t>(l.max_voxels, uint64_t(p2.properties.limits.maxStorageBufferRange) * 4);
+  l.max_voxels = std::min<uint64_t>(l.max_voxels, uint64_t(ctx.properties().limits.maxStorageBufferRange) * 4);
   if (opts.grid_budget_bytes) l.max_voxels = std::min<uint64_t>(l.max_voxels, opts.grid_budget_bytes * 4);
   l.max_voxels = std::min<uint64_t>(l.max_voxels, uint64_t(1) << 32);  // 32-bit voxel index in the shaders
   return l;
