@@ -8,5 +8,6 @@ namespace ort::cli {
 void register_build_command(CLI::App& app);
 void register_replay_command(CLI::App& app);
 void register_bench_command(CLI::App& app);
+void register_render_command(CLI::App& app);
 
 }  // namespace ort::cli
