@@ -1,6 +1,7 @@
-// The shared ray space as the shoot shaders see it: the persistent grid of 2-bit voxel
-// states (16 voxels a word; bit 0 occupied, bit 1 free, 11 = occupied wins), the list of
-// words touched in this window, and the counters. Layouts: server/gpu/shader_interface.h.
+// The GPU ray space (server/gpu/gpu_ray_space.h) as the shooting shaders see it: the
+// persistent grid of 2-bit voxel states (16 voxels a word; bit 0 occupied, bit 1 free,
+// 11 = occupied wins), the list of words touched in this window, and the counters.
+// Layouts: server/gpu/shader_interface.h.
 #ifndef RAY_SPACE_GLSL
 #define RAY_SPACE_GLSL
 

@@ -1,5 +1,6 @@
-# The compute back end's shaders (server/gpu/vulkan_backend.cpp). The ray-tracing back end
-# lists its own shaders in rt_shaders.cmake.
+# The compute shaders: the vulkan back end's shooting passes (server/gpu/vulkan_backend.cpp)
+# and the GPU ray space's compaction (server/gpu/gpu_ray_space.cpp). The ray-tracing back
+# end lists its own shaders in rt_shaders.cmake.
 octomap_rt_embed_shader(shoot_octomap.comp shoot_octomap_spv)
 octomap_rt_embed_shader(shoot_exact.comp shoot_exact_spv)
 octomap_rt_embed_shader(compact_touched.comp compact_touched_spv)

@@ -201,8 +201,8 @@ void compare_on_real_data(const rt::RtOptions& knobs, bool check_reference_on_fi
       }
       std::printf("%s res %.2f max_range %.0f scan %d: %zu rays, %zu voxels, %llu window(s), k=%d space %dx%dx%d%s\n",
                   c.file, c.resolution, c.max_range, scan, batch.ends.size(), got.size(),
-                  (unsigned long long)stats.windows, info.layout.block, info.layout.voxels(0), info.layout.voxels(1),
-                  info.layout.voxels(2), equal_vk ? ", equal to vulkan" : (vk ? ", DIFFERENT from vulkan" : ""));
+                  (unsigned long long)stats.windows, info.block_grid.block, info.block_grid.voxels(0), info.block_grid.voxels(1),
+                  info.block_grid.voxels(2), equal_vk ? ", equal to vulkan" : (vk ? ", DIFFERENT from vulkan" : ""));
       ++scan;
     }
   }

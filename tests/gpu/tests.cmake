@@ -10,7 +10,7 @@ octomap_rt_add_test(gpu_traversal_test SOURCES ${GPU_TEST_DIR}/traversal_test.cp
 
 # rt back end (issue 5): the GPU-free parts on the CPU (layout, windows, window frame, a CPU
 # model of the rt shoot against the exact reference).
-octomap_rt_add_test(gpu_rt_space_test SOURCES ${GPU_TEST_DIR}/rt_space_test.cpp TIMEOUT 300)
+octomap_rt_add_test(gpu_rt_block_grid_test SOURCES ${GPU_TEST_DIR}/rt_block_grid_test.cpp TIMEOUT 300)
 # rt against vulkan and the exact reference on the GPU; on a device without ray tracing it
 # checks the clean refusal and skips the comparisons.
 octomap_rt_add_test(gpu_rt_parity_test SOURCES ${GPU_TEST_DIR}/rt_parity_test.cpp

@@ -198,8 +198,8 @@ int main(int argc, char** argv) {
             continue;
           }
           std::printf("| %s | %.1f | rt | %d | %dx%dx%d | %llu | %.2f | %.1f / %.1f | %.3f + %.2f | %.3f (%.3f) | %s | %.1f |\n",
-                      name.c_str(), res, k, info.layout.voxels(0), info.layout.voxels(1), info.layout.voxels(2),
-                      (unsigned long long)info.layout.instance_count(), t.windows, info.build_ms, info.gpu_build_ms,
+                      name.c_str(), res, k, info.block_grid.voxels(0), info.block_grid.voxels(1), info.block_grid.voxels(2),
+                      (unsigned long long)info.block_grid.instance_count(), t.windows, info.build_ms, info.gpu_build_ms,
                       double(info.blas_bytes) / (1024.0 * 1024.0), double(info.tlas_bytes) / (1024.0 * 1024.0),
                       t.per_scan_ms, t.trace_ms,
                       have_vk ? (std::to_string(t.per_scan_ms / vk.per_scan_ms).substr(0, 5) + "x").c_str() : "-",

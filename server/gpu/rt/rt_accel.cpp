@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cstring>
+#include <optional>
+#include <vector>
 #include <utility>
 
 #include "gpu/rt/rt_functions.h"
@@ -76,58 +78,79 @@ VkDeviceAddress AccelerationStructure::address() const {
   return fn_->get_acceleration_structure_address(device_, &info);
 }
 
-SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const SpaceLayout& layout,
-                           vk::CommandRunner& runner, float aabb_margin) {
-  const auto t0 = std::chrono::steady_clock::now();
-  SharedBvh bvh;
-  const VkDevice dev = ctx.device();
-  const VkDeviceSize scratch_align = scratch_alignment(ctx);
-  const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-  const VkBufferUsageFlags input_usage =
-      VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+namespace {
 
-  // --- BLAS: the k^3 voxel boxes of one block (enlarged by kAabbMargin).
-  const std::vector<Aabb> boxes = block_aabbs(layout.block, aabb_margin);
-  vk::Buffer aabb_buffer(ctx, boxes.size() * sizeof(Aabb), input_usage, host);
-  std::memcpy(aabb_buffer.mapped(), boxes.data(), boxes.size() * sizeof(Aabb));
+// One level of the BVH on its way: its geometry, build info and scratch buffer.
+struct LevelBuild {
+  VkAccelerationStructureGeometryKHR geometry{};
+  VkAccelerationStructureBuildGeometryInfoKHR info{};
+  uint32_t primitives = 0;
+  VkDeviceSize scratch_bytes = 0;
+  std::optional<Scratch> scratch;
 
-  VkAccelerationStructureGeometryKHR blas_geometry{};
-  blas_geometry.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR;
-  blas_geometry.geometryType = VK_GEOMETRY_TYPE_AABBS_KHR;
-  blas_geometry.geometry.aabbs.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR;
-  blas_geometry.geometry.aabbs.data.deviceAddress = aabb_buffer.device_address();
-  blas_geometry.geometry.aabbs.stride = sizeof(Aabb);
-  // Opaque: no any-hit shader; the intersection shader still runs for every candidate box.
-  blas_geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
-  VkAccelerationStructureBuildGeometryInfoKHR blas_info{};
-  blas_info.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR;
-  blas_info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-  blas_info.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
-  blas_info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-  blas_info.geometryCount = 1;
-  blas_info.pGeometries = &blas_geometry;
-  const uint32_t box_count = uint32_t(boxes.size());
-  VkAccelerationStructureBuildSizesInfoKHR blas_sizes{};
-  blas_sizes.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR;
-  fn.get_build_sizes(dev, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &blas_info, &box_count, &blas_sizes);
-  bvh.blas = AccelerationStructure(ctx, fn, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
-                                   blas_sizes.accelerationStructureSize);
-  Scratch blas_scratch(ctx, blas_sizes.buildScratchSize, scratch_align);
-  blas_info.dstAccelerationStructure = bvh.blas.handle();
-  blas_info.scratchData.deviceAddress = blas_scratch.address;
+  void record(VkCommandBuffer cmd, const RtFunctions& fn) {
+    info.pGeometries = &geometry;  // set here: the struct may have moved since it was made
+    const VkAccelerationStructureBuildRangeInfoKHR range{primitives, 0, 0, 0};
+    const VkAccelerationStructureBuildRangeInfoKHR* ranges = &range;
+    fn.cmd_build_acceleration_structures(cmd, 1, &info, &ranges);
+  }
+};
 
-  // --- TLAS: one instance of the BLAS per block, translated to the block's corner (voxel
-  // units). Instance i is block (i % bx, i / bx % by, i / (bx * by)); the intersection
-  // shader inverts that from gl_InstanceID (rt_space.h instance_block).
-  const uint64_t instances = layout.instance_count();
-  bvh.instance_bytes = instances * sizeof(VkAccelerationStructureInstanceKHR);
-  vk::Buffer instance_buffer(ctx, bvh.instance_bytes, input_usage, host, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  const VkDeviceAddress blas_address = bvh.blas.address();
-  auto* records = instance_buffer.as<VkAccelerationStructureInstanceKHR>();
-  for (uint64_t i = 0; i < instances; ++i) {
+// Sizes the level's build, creates the structure it builds into (`out`) and its scratch.
+LevelBuild prepare_level(const vk::Context& ctx, const RtFunctions& fn, VkAccelerationStructureTypeKHR type,
+                         const VkAccelerationStructureGeometryKHR& geometry, uint32_t primitives,
+                         VkDeviceSize scratch_align, AccelerationStructure& out) {
+  LevelBuild b;
+  b.geometry = geometry;
+  b.primitives = primitives;
+  b.info.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR;
+  b.info.type = type;
+  b.info.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+  b.info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  b.info.geometryCount = 1;
+  b.info.pGeometries = &b.geometry;
+  VkAccelerationStructureBuildSizesInfoKHR sizes{};
+  sizes.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR;
+  fn.get_build_sizes(ctx.device(), VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &b.info, &primitives, &sizes);
+  out = AccelerationStructure(ctx, fn, type, sizes.accelerationStructureSize);
+  b.scratch.emplace(ctx, sizes.buildScratchSize, scratch_align);
+  b.scratch_bytes = sizes.buildScratchSize;
+  b.info.dstAccelerationStructure = out.handle();
+  b.info.scratchData.deviceAddress = b.scratch->address;
+  return b;
+}
+
+// The BLAS's geometry: the k^3 voxel boxes of one block, opaque (no any-hit shader; the
+// intersection shader still runs for every candidate box).
+VkAccelerationStructureGeometryKHR box_geometry(VkDeviceAddress boxes) {
+  VkAccelerationStructureGeometryKHR g{};
+  g.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR;
+  g.geometryType = VK_GEOMETRY_TYPE_AABBS_KHR;
+  g.geometry.aabbs.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR;
+  g.geometry.aabbs.data.deviceAddress = boxes;
+  g.geometry.aabbs.stride = sizeof(Aabb);
+  g.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+  return g;
+}
+
+VkAccelerationStructureGeometryKHR instance_geometry(VkDeviceAddress instances) {
+  VkAccelerationStructureGeometryKHR g{};
+  g.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR;
+  g.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
+  g.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
+  g.geometry.instances.arrayOfPointers = VK_FALSE;
+  g.geometry.instances.data.deviceAddress = instances;
+  return g;
+}
+
+// The TLAS records: one instance of the BLAS per block, translated to the block's corner
+// (voxel units). Instance i is block (i % bx, i / bx % by, i / (bx * by)); the intersection
+// shader inverts that from gl_InstanceID (block_grid.h instance_block).
+void write_instances(const BlockGrid& grid, VkDeviceAddress blas, VkAccelerationStructureInstanceKHR* records) {
+  for (uint64_t i = 0; i < grid.instance_count(); ++i) {
     VkAccelerationStructureInstanceKHR r{};
     float t[3];
-    instance_translation(layout, i, t);
+    instance_translation(grid, i, t);
     r.transform.matrix[0][0] = r.transform.matrix[1][1] = r.transform.matrix[2][2] = 1.0f;
     r.transform.matrix[0][3] = t[0];
     r.transform.matrix[1][3] = t[1];
@@ -136,51 +159,58 @@ SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const 
     r.mask = 0xFF;
     r.instanceShaderBindingTableRecordOffset = 0;
     r.flags = VK_GEOMETRY_INSTANCE_FORCE_OPAQUE_BIT_KHR;
-    r.accelerationStructureReference = blas_address;
+    r.accelerationStructureReference = blas;
     records[i] = r;
   }
-  instance_buffer.flush();
+}
 
-  VkAccelerationStructureGeometryKHR tlas_geometry{};
-  tlas_geometry.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR;
-  tlas_geometry.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
-  tlas_geometry.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
-  tlas_geometry.geometry.instances.arrayOfPointers = VK_FALSE;
-  tlas_geometry.geometry.instances.data.deviceAddress = instance_buffer.device_address();
-  VkAccelerationStructureBuildGeometryInfoKHR tlas_info{};
-  tlas_info.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR;
-  tlas_info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
-  tlas_info.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
-  tlas_info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-  tlas_info.geometryCount = 1;
-  tlas_info.pGeometries = &tlas_geometry;
-  const uint32_t instance_count = uint32_t(instances);
-  VkAccelerationStructureBuildSizesInfoKHR tlas_sizes{};
-  tlas_sizes.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR;
-  fn.get_build_sizes(dev, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &tlas_info, &instance_count, &tlas_sizes);
-  bvh.tlas = AccelerationStructure(ctx, fn, VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR,
-                                   tlas_sizes.accelerationStructureSize);
-  Scratch tlas_scratch(ctx, tlas_sizes.buildScratchSize, scratch_align);
-  tlas_info.dstAccelerationStructure = bvh.tlas.handle();
-  tlas_info.scratchData.deviceAddress = tlas_scratch.address;
-  bvh.scratch_bytes = blas_sizes.buildScratchSize + tlas_sizes.buildScratchSize;
-
+// Runs both builds in one submission; returns their device time.
+double run_builds(const vk::Context& ctx, const RtFunctions& fn, vk::CommandRunner& runner, LevelBuild& blas,
+                  LevelBuild& tlas) {
   vk::TimestampQueries stamps(ctx, 2);
   VkCommandBuffer cmd = runner.begin();
   stamps.reset(cmd);
   stamps.write(cmd, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT);
-  const VkAccelerationStructureBuildRangeInfoKHR blas_range{box_count, 0, 0, 0};
-  const VkAccelerationStructureBuildRangeInfoKHR* blas_ranges = &blas_range;
-  fn.cmd_build_acceleration_structures(cmd, 1, &blas_info, &blas_ranges);
+  blas.record(cmd, fn);
   build_barrier(cmd);  // the TLAS build reads the BLAS
-  const VkAccelerationStructureBuildRangeInfoKHR tlas_range{instance_count, 0, 0, 0};
-  const VkAccelerationStructureBuildRangeInfoKHR* tlas_ranges = &tlas_range;
-  fn.cmd_build_acceleration_structures(cmd, 1, &tlas_info, &tlas_ranges);
+  tlas.record(cmd, fn);
   build_barrier(cmd);
   stamps.write(cmd, 1, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
   runner.submit_and_wait();
   stamps.fetch(2);
-  bvh.gpu_build_ms = stamps.elapsed_ms(0, 1);
+  return stamps.elapsed_ms(0, 1);
+}
+
+}  // namespace
+
+SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const BlockGrid& grid,
+                           vk::CommandRunner& runner, float aabb_margin) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SharedBvh bvh;
+  const VkDeviceSize scratch_align = scratch_alignment(ctx);
+  const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  const VkBufferUsageFlags input_usage =
+      VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+
+  // BLAS: the k^3 voxel boxes of one block (enlarged by aabb_margin).
+  const std::vector<Aabb> boxes = block_aabbs(grid.block, aabb_margin);
+  vk::Buffer box_buffer(ctx, boxes.size() * sizeof(Aabb), input_usage, host);
+  std::memcpy(box_buffer.mapped(), boxes.data(), boxes.size() * sizeof(Aabb));
+  LevelBuild blas = prepare_level(ctx, fn, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                                  box_geometry(box_buffer.device_address()), uint32_t(boxes.size()), scratch_align,
+                                  bvh.blas);
+
+  // TLAS: one instance of the BLAS per block.
+  bvh.instance_bytes = grid.instance_count() * sizeof(VkAccelerationStructureInstanceKHR);
+  vk::Buffer instance_buffer(ctx, bvh.instance_bytes, input_usage, host, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  write_instances(grid, bvh.blas.address(), instance_buffer.as<VkAccelerationStructureInstanceKHR>());
+  instance_buffer.flush();
+  LevelBuild tlas = prepare_level(ctx, fn, VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR,
+                                  instance_geometry(instance_buffer.device_address()),
+                                  uint32_t(grid.instance_count()), scratch_align, bvh.tlas);
+  bvh.scratch_bytes = blas.scratch_bytes + tlas.scratch_bytes;
+
+  bvh.gpu_build_ms = run_builds(ctx, fn, runner, blas, tlas);
   bvh.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return bvh;
 }

@@ -1,6 +1,6 @@
 // The persistent shared BVH of the rt back end (paper IV-B/IV-C): one BLAS of the k^3
-// voxel AABBs of a block, one TLAS instancing it over the whole shared ray space. Built
-// once at start-up; per scan only the rays move (rt_space.h), so nothing is rebuilt.
+// voxel AABBs of a block, one TLAS instancing it over the whole block grid. Built
+// once at start-up; per scan only the rays move (block_grid.h), so nothing is rebuilt.
 #pragma once
 
 #include <cstdint>
@@ -8,7 +8,7 @@
 #include <vulkan/vulkan.h>
 
 #include "gpu/rt/rt_functions.h"
-#include "gpu/rt/rt_space.h"
+#include "gpu/rt/block_grid.h"
 #include "gpu/vk/vk_buffer.h"
 #include "gpu/vk/vk_commands.h"
 #include "gpu/vk/vk_context.h"
@@ -42,16 +42,16 @@ class AccelerationStructure {
 
 struct SharedBvh {
   AccelerationStructure blas;  // k^3 AABBs
-  AccelerationStructure tlas;  // one instance per block of the space
+  AccelerationStructure tlas;  // one instance per block of the grid
   double build_ms = 0;         // host wall clock: instance records, buffers, both builds
   double gpu_build_ms = 0;     // device timestamps around the two build commands
   uint64_t scratch_bytes = 0;  // freed after the build
   uint64_t instance_bytes = 0; // freed after the build
 };
 
-// Builds the BLAS and the TLAS for this layout and waits for them. The AABB, instance and
+// Builds the BLAS and the TLAS for this block grid and waits for them. The AABB, instance and
 // scratch buffers are released before it returns: only blas + tlas stay on the GPU.
-SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const SpaceLayout& layout,
+SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const BlockGrid& grid,
                            vk::CommandRunner& runner, float aabb_margin = kAabbMargin);
 
 }  // namespace ort::rt

@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "gpu/vk/vk_context.h"
+
 namespace ort::rt {
 
 RtFunctions load_rt_functions(VkDevice device) {
@@ -23,13 +25,8 @@ RtFunctions load_rt_functions(VkDevice device) {
 }
 
 VkPhysicalDeviceAccelerationStructurePropertiesKHR acceleration_structure_properties(VkPhysicalDevice device) {
-  VkPhysicalDeviceAccelerationStructurePropertiesKHR as{};
-  as.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR;
-  VkPhysicalDeviceProperties2 p2{};
-  p2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
-  p2.pNext = &as;
-  vkGetPhysicalDeviceProperties2(device, &p2);
-  return as;
+  return vk::extension_properties<VkPhysicalDeviceAccelerationStructurePropertiesKHR>(
+      device, VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR);
 }
 
 }  // namespace ort::rt

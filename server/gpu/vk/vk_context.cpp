@@ -100,7 +100,63 @@ const char* device_type_name(VkPhysicalDeviceType t) {
   }
 }
 
+namespace {
+
+std::string describe_devices(const std::vector<DeviceInfo>& devices) {
+  std::string s;
+  for (const DeviceInfo& d : devices) {
+    s += "\n  [" + std::to_string(d.index) + "] " + d.name + " (" + device_type_name(d.type) + "): " +
+         (d.unusable.empty() ? "usable" : d.unusable);
+  }
+  return s;
+}
+
+// The index of the device to take: the best usable type when `wanted` is empty, else the
+// device of that index or the first usable one whose name contains it (any case). Throws
+// saying why, per device, when there is none.
+int choose_device(const std::vector<DeviceInfo>& devices, const std::string& wanted) {
+  int chosen = -1;
+  if (wanted.empty()) {
+    for (const DeviceInfo& d : devices) {
+      if (!d.unusable.empty()) continue;
+      if (chosen < 0 || type_rank(d.type) < type_rank(devices[chosen].type)) chosen = int(d.index);
+    }
+    if (chosen < 0) throw std::runtime_error("no usable Vulkan device:" + describe_devices(devices));
+    return chosen;
+  }
+  if (all_digits(wanted)) {
+    const unsigned long idx = std::stoul(wanted);
+    if (idx >= devices.size()) throw std::runtime_error("no Vulkan device with index " + wanted + ":" + describe_devices(devices));
+    if (!devices[idx].unusable.empty())
+      throw std::runtime_error("Vulkan device " + wanted + " (" + devices[idx].name + ") " + devices[idx].unusable);
+    return int(idx);
+  }
+  const std::string name = lower(wanted);
+  bool matched = false;
+  for (const DeviceInfo& d : devices) {
+    if (lower(d.name).find(name) == std::string::npos) continue;
+    matched = true;
+    if (d.unusable.empty()) return int(d.index);
+  }
+  throw std::runtime_error((matched ? "no usable Vulkan device matches '" : "no Vulkan device matches '") + wanted +
+                           "':" + describe_devices(devices));
+}
+
+}  // namespace
+
 Context::Context(const ContextOptions& opts) {
+  create_instance();
+  try {
+    choose_physical_device(opts);
+    create_device(opts);
+  } catch (...) {
+    if (device_) vkDestroyDevice(device_, nullptr);
+    vkDestroyInstance(instance_, nullptr);
+    throw;
+  }
+}
+
+void Context::create_instance() {
   uint32_t loader_version = 0;
   if (vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS || loader_version < VK_API_VERSION_1_2) {
     throw std::runtime_error("no Vulkan device: the Vulkan loader does not support Vulkan 1.2");
@@ -119,107 +175,72 @@ Context::Context(const ContextOptions& opts) {
     throw std::runtime_error(std::string("no Vulkan device: vkCreateInstance failed (") + result_name(ir) +
                              "); is a Vulkan driver installed?");
   }
-  try {
-    uint32_t n = 0;
-    vkEnumeratePhysicalDevices(instance_, &n, nullptr);
-    std::vector<VkPhysicalDevice> pds(n);
-    if (n) vkEnumeratePhysicalDevices(instance_, &n, pds.data());
-    if (n == 0) throw std::runtime_error("no Vulkan device found");
+}
 
-    for (uint32_t i = 0; i < n; ++i) {
-      VkPhysicalDeviceProperties p;
-      vkGetPhysicalDeviceProperties(pds[i], &p);
-      devices_.push_back({i, p.deviceName, p.deviceType, p.apiVersion, check_device(pds[i], opts)});
-    }
-    auto describe_all = [&] {
-      std::string s;
-      for (const DeviceInfo& d : devices_) {
-        s += "\n  [" + std::to_string(d.index) + "] " + d.name + " (" + device_type_name(d.type) + "): " +
-             (d.unusable.empty() ? "usable" : d.unusable);
-      }
-      return s;
-    };
-
-    int chosen = -1;
-    if (opts.device.empty()) {
-      for (const DeviceInfo& d : devices_) {
-        if (!d.unusable.empty()) continue;
-        if (chosen < 0 || type_rank(d.type) < type_rank(devices_[chosen].type)) chosen = int(d.index);
-      }
-      if (chosen < 0) throw std::runtime_error("no usable Vulkan device:" + describe_all());
-    } else if (all_digits(opts.device)) {
-      const unsigned long idx = std::stoul(opts.device);
-      if (idx >= devices_.size()) throw std::runtime_error("no Vulkan device with index " + opts.device + ":" + describe_all());
-      if (!devices_[idx].unusable.empty())
-        throw std::runtime_error("Vulkan device " + opts.device + " (" + devices_[idx].name + ") " + devices_[idx].unusable);
-      chosen = int(idx);
-    } else {
-      const std::string want = lower(opts.device);
-      bool matched = false;
-      for (const DeviceInfo& d : devices_) {
-        if (lower(d.name).find(want) == std::string::npos) continue;
-        matched = true;
-        if (d.unusable.empty()) {
-          chosen = int(d.index);
-          break;
-        }
-      }
-      if (chosen < 0) {
-        throw std::runtime_error((matched ? "no usable Vulkan device matches '" : "no Vulkan device matches '") +
-                                 opts.device + "':" + describe_all());
-      }
-    }
-    physical_ = pds[chosen];
-    vkGetPhysicalDeviceProperties(physical_, &properties_);
-    vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
-    queue_family_ = uint32_t(pick_queue_family(physical_, &timestamp_valid_bits_));
-
-    // Unified memory: a CPU or integrated device whose largest device-local heap is also
-    // host-visible and coherent; buffers are then written and read in place.
-    if (properties_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ||
-        properties_.deviceType == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU) {
-      const VkMemoryPropertyFlags want = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                                         VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-      for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
-        if ((memory_.memoryTypes[i].propertyFlags & want) == want &&
-            memory_.memoryHeaps[memory_.memoryTypes[i].heapIndex].size == device_local_bytes()) {
-          unified_memory_ = true;
-        }
-      }
-    }
-
-    const float priority = 1.0f;
-    VkDeviceQueueCreateInfo qci{};
-    qci.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
-    qci.queueFamilyIndex = queue_family_;
-    qci.queueCount = 1;
-    qci.pQueuePriorities = &priority;
-    VkPhysicalDeviceVulkan12Features f12 = opts.features12;
-    f12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
-    f12.pNext = opts.feature_chain;
-    VkPhysicalDeviceFeatures2 f2{};
-    f2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-    f2.pNext = &f12;
-    f2.features.shaderFloat64 = opts.need_float64 ? VK_TRUE : VK_FALSE;
-    f2.features.shaderInt64 = opts.need_int64 ? VK_TRUE : VK_FALSE;
-    VkDeviceCreateInfo dci{};
-    dci.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
-    dci.pNext = &f2;
-    dci.queueCreateInfoCount = 1;
-    dci.pQueueCreateInfos = &qci;
-    dci.enabledExtensionCount = uint32_t(opts.device_extensions.size());
-    dci.ppEnabledExtensionNames = opts.device_extensions.data();
-    const VkResult dr = vkCreateDevice(physical_, &dci, nullptr, &device_);
-    if (dr != VK_SUCCESS) {
-      device_ = VK_NULL_HANDLE;
-      throw std::runtime_error(std::string("vkCreateDevice on ") + properties_.deviceName + " failed: " + result_name(dr));
-    }
-    vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
-  } catch (...) {
-    if (device_) vkDestroyDevice(device_, nullptr);
-    vkDestroyInstance(instance_, nullptr);
-    throw;
+void Context::choose_physical_device(const ContextOptions& opts) {
+  uint32_t n = 0;
+  vkEnumeratePhysicalDevices(instance_, &n, nullptr);
+  std::vector<VkPhysicalDevice> pds(n);
+  if (n) vkEnumeratePhysicalDevices(instance_, &n, pds.data());
+  if (n == 0) throw std::runtime_error("no Vulkan device found");
+  for (uint32_t i = 0; i < n; ++i) {
+    VkPhysicalDeviceProperties p;
+    vkGetPhysicalDeviceProperties(pds[i], &p);
+    devices_.push_back({i, p.deviceName, p.deviceType, p.apiVersion, check_device(pds[i], opts)});
   }
+  physical_ = pds[choose_device(devices_, opts.device)];
+  vkGetPhysicalDeviceProperties(physical_, &properties_);
+  vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
+  queue_family_ = uint32_t(pick_queue_family(physical_, &timestamp_valid_bits_));
+  unified_memory_ = has_unified_memory();
+}
+
+// Unified memory: a CPU or integrated device whose largest device-local heap is also
+// host-visible and coherent; buffers are then written and read in place.
+bool Context::has_unified_memory() const {
+  if (properties_.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU &&
+      properties_.deviceType != VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU) {
+    return false;
+  }
+  const VkMemoryPropertyFlags want =
+      VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
+    if ((memory_.memoryTypes[i].propertyFlags & want) == want &&
+        memory_.memoryHeaps[memory_.memoryTypes[i].heapIndex].size == device_local_bytes()) {
+      return true;
+    }
+  }
+  return false;
+}
+
+void Context::create_device(const ContextOptions& opts) {
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo qci{};
+  qci.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+  qci.queueFamilyIndex = queue_family_;
+  qci.queueCount = 1;
+  qci.pQueuePriorities = &priority;
+  VkPhysicalDeviceVulkan12Features f12 = opts.features12;
+  f12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+  f12.pNext = opts.feature_chain;
+  VkPhysicalDeviceFeatures2 f2{};
+  f2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+  f2.pNext = &f12;
+  f2.features.shaderFloat64 = opts.need_float64 ? VK_TRUE : VK_FALSE;
+  f2.features.shaderInt64 = opts.need_int64 ? VK_TRUE : VK_FALSE;
+  VkDeviceCreateInfo dci{};
+  dci.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+  dci.pNext = &f2;
+  dci.queueCreateInfoCount = 1;
+  dci.pQueueCreateInfos = &qci;
+  dci.enabledExtensionCount = uint32_t(opts.device_extensions.size());
+  dci.ppEnabledExtensionNames = opts.device_extensions.data();
+  const VkResult dr = vkCreateDevice(physical_, &dci, nullptr, &device_);
+  if (dr != VK_SUCCESS) {
+    device_ = VK_NULL_HANDLE;
+    throw std::runtime_error(std::string("vkCreateDevice on ") + properties_.deviceName + " failed: " + result_name(dr));
+  }
+  vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
 }
 
 Context::~Context() {

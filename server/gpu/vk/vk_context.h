@@ -40,7 +40,25 @@ struct DeviceInfo {
 
 const char* device_type_name(VkPhysicalDeviceType t);
 
-// Owns VkInstance + VkDevice. Not copyable or movable: hold it by unique_ptr/shared_ptr.
+// An extension's properties of a physical device: `T` is the properties struct and `type`
+// its sType (e.g. the acceleration-structure or ray-tracing-pipeline limits).
+template <class T>
+T extension_properties(VkPhysicalDevice device, VkStructureType type) {
+  T props{};
+  props.sType = type;
+  VkPhysicalDeviceProperties2 p2{};
+  p2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+  p2.pNext = &props;
+  vkGetPhysicalDeviceProperties2(device, &p2);
+  return props;
+}
+
+// Owns VkInstance + VkDevice. Not copyable or movable. Several GPU objects can work on one
+// context (a back end's GPU ray space and its shooting pipelines today, further GPU passes
+// beside them): it is held by std::shared_ptr, and each object that makes Vulkan objects
+// from it keeps a copy of that pointer, or is a member of one that does and is declared
+// after it, so the device outlives everything made on it. Not thread-safe: the objects
+// sharing it submit to its one queue from one thread.
 class Context {
  public:
   explicit Context(const ContextOptions& opts);
@@ -71,6 +89,11 @@ class Context {
                             VkMemoryPropertyFlags preferred = 0) const;
 
  private:
+  void create_instance();
+  void choose_physical_device(const ContextOptions& opts);
+  bool has_unified_memory() const;
+  void create_device(const ContextOptions& opts);
+
   VkInstance instance_ = VK_NULL_HANDLE;
   VkPhysicalDevice physical_ = VK_NULL_HANDLE;
   VkDevice device_ = VK_NULL_HANDLE;

@@ -8,6 +8,7 @@
 #include <vulkan/vulkan.h>
 
 #include "gpu/vk/vk_context.h"
+#include "gpu/vk/vk_pipeline_objects.h"
 
 namespace ort::vk {
 
@@ -34,7 +35,6 @@ class ComputePipeline {
  public:
   ComputePipeline(const Context& ctx, std::span<const uint32_t> spirv, uint32_t storage_buffers, uint32_t push_bytes,
                   const VkSpecializationInfo* specialization = nullptr);
-  ~ComputePipeline();
   ComputePipeline(const ComputePipeline&) = delete;
   ComputePipeline& operator=(const ComputePipeline&) = delete;
 
@@ -45,20 +45,12 @@ class ComputePipeline {
   void dispatch(VkCommandBuffer cmd, const void* push, uint32_t x, uint32_t y = 1, uint32_t z = 1) const;
   void dispatch_indirect(VkCommandBuffer cmd, const void* push, VkBuffer args, VkDeviceSize offset) const;
 
-  VkPipeline handle() const { return pipeline_; }
-  VkPipelineLayout layout() const { return layout_; }
+  VkPipeline handle() const { return objects_.pipeline; }
+  VkPipelineLayout layout() const { return objects_.layout; }
 
  private:
-  void bind(VkCommandBuffer cmd, const void* push) const;
-  void destroy();
-  VkDevice device_;
   uint32_t bindings_;
-  uint32_t push_bytes_;
-  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
-  VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
-  VkDescriptorPool pool_ = VK_NULL_HANDLE;
-  VkDescriptorSet set_ = VK_NULL_HANDLE;
+  PipelineObjects objects_;
 };
 
 }  // namespace ort::vk

@@ -1,16 +1,18 @@
-// The shared ray space of the `rt` back end, as plain numbers (no Vulkan objects), so that
-// everything here is unit-tested on the CPU (tests/gpu/rt_space_test.cpp).
+// The block grid of the `rt` back end: the shape of its BVH (a box of voxels cut into
+// blocks of k x k x k) as plain numbers, no Vulkan objects, so that everything here is
+// unit-tested on the CPU (tests/gpu/rt_block_grid_test.cpp). Its voxels are the voxels of the
+// GPU ray space (gpu/gpu_ray_space.h) that the rt back end shoots into.
 //
-// Geometry (paper sections IV-B/IV-C): the space is a box of voxels, blocks[0..2] blocks
-// of k x k x k voxels each. One BLAS holds the k^3 voxel AABBs of one block; the TLAS holds
-// one instance of it per block, translated by the block's position. Coordinates inside the
-// space are in VOXEL units with the window's lowest key at 0, so the BVH does not depend on
-// the resolution and float keeps ~1e-4 voxel precision over thousands of voxels.
+// Geometry (paper sections IV-B/IV-C): the grid is blocks[0..2] blocks of k x k x k voxels.
+// One BLAS holds the k^3 voxel AABBs of one block; the TLAS holds one instance of it per
+// block, translated by the block's position. Coordinates inside the grid are in VOXEL units
+// with the window's lowest key at 0, so the BVH does not depend on the resolution and float
+// keeps ~1e-4 voxel precision over thousands of voxels.
 //
-// Per scan, the space is laid over the scan's key box as one or more key-aligned windows
-// (lo key = local 0). Rays are moved into a window's frame (ray_to_window), traced, and each
-// candidate voxel is decided by the exact double-precision slab test in map coordinates, so
-// the float frame only has to find candidates, never to decide.
+// Per scan, the grid is laid over the scan's key box as one or more key-aligned windows
+// (lo key = local 0; tile_windows). Rays are moved into a window's frame (to_window_frame),
+// traced, and each candidate voxel is decided by the exact double-precision slab test in map
+// coordinates, so the float frame only has to find candidates, never to decide.
 #pragma once
 
 #include <cstdint>
@@ -37,7 +39,7 @@ struct Aabb {  // layout of VkAabbPositionsKHR
 };
 static_assert(sizeof(Aabb) == 24);
 
-struct SpaceLayout {
+struct BlockGrid {
   int block = 4;                  // k: voxels along each edge of the BLAS block (2..8)
   int blocks[3] = {1, 1, 1};      // TLAS instances along x, y, z
   int voxels(int axis) const { return blocks[axis] * block; }
@@ -46,16 +48,16 @@ struct SpaceLayout {
   uint64_t grid_words() const { return (voxel_count() + 15) / 16; }  // 2-bit states, 16 a word
 };
 
-struct SpaceLimits {
+struct BlockGridLimits {
   uint64_t max_voxels = uint64_t(1) << 28;     // 2-bit grid of 64 MiB
   uint64_t max_instances = uint64_t(1) << 22;  // TLAS instance records: 256 MiB at 64 B each
   int max_side = 4096;                         // voxels per axis
 };
 
-// Chooses the space: a box `wanted` voxels per axis (rounded up to whole blocks), shrunk
+// Chooses the grid: a box `wanted` voxels per axis (rounded up to whole blocks), shrunk
 // along its longest axis until it fits the limits. Throws std::invalid_argument for k
-// outside 2..8 or a space that cannot hold one block.
-SpaceLayout choose_layout(int block, const int wanted[3], const SpaceLimits& limits);
+// outside 2..8 or limits that cannot hold one block.
+BlockGrid choose_block_grid(int block, const int wanted[3], const BlockGridLimits& limits);
 // The wanted voxels per axis for a sensor of this max range (< 0: none, take `fallback`):
 // a cube of side 2 * range / resolution plus a margin, as the compute back end sizes its grid.
 void wanted_from_range(double resolution, double max_range, int fallback, int wanted[3]);
@@ -64,18 +66,19 @@ void wanted_from_range(double resolution, double max_range, int fallback, int wa
 std::vector<Aabb> block_aabbs(int block, float margin = kAabbMargin);
 
 // TLAS instance i covers block (bx, by, bz) with x fastest; its translation is block * k.
-void instance_block(const SpaceLayout& s, uint64_t instance, int out[3]);
-void instance_translation(const SpaceLayout& s, uint64_t instance, float out[3]);
+void instance_block(const BlockGrid& s, uint64_t instance, int out[3]);
+void instance_translation(const BlockGrid& s, uint64_t instance, float out[3]);
 
 // The key of primitive `primitive` of instance `instance` in a window whose lowest key is lo.
 // (The intersection shader does the same arithmetic with gl_InstanceID / gl_PrimitiveID.)
-void voxel_key(const SpaceLayout& s, const int lo[3], uint64_t instance, uint32_t primitive, int out[3]);
+void voxel_key(const BlockGrid& s, const int lo[3], uint64_t instance, uint32_t primitive, int out[3]);
 
 // Key-aligned windows covering `keys` widened by `margin` voxels (an exact segment that ends
-// on a voxel face touches the voxel beyond it) and clamped to the key range. Windows tile
-// that box in a regular grid; each is at most the space's size per axis, so each key lies in
-// exactly one window.
-std::vector<KeyBox> plan_windows(const KeyBox& keys, const SpaceLayout& s, int margin = 1);
+// on a voxel face touches the voxel beyond it) and clamped to the key range. Unlike the
+// compute back end's plan_windows (core/ray_space.h), which cuts by voxel count, the BVH has
+// a fixed shape: the windows tile that box in a regular grid, each at most the block grid's
+// size per axis, so each key lies in exactly one window.
+std::vector<KeyBox> tile_windows(const KeyBox& keys, const BlockGrid& s, int margin = 1);
 
 // The smallest direction component a traced ray gets (voxel units over t in [0, 1]). WHY:
 // with an exactly zero component, a slab test written as box * (1/d) - o * (1/d) computes

@@ -1,4 +1,4 @@
-#include "gpu/rt/rt_space.h"
+#include "gpu/rt/block_grid.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,9 @@
 
 namespace ort::rt {
 
-SpaceLayout choose_layout(int block, const int wanted[3], const SpaceLimits& limits) {
+BlockGrid choose_block_grid(int block, const int wanted[3], const BlockGridLimits& limits) {
   if (block < 2 || block > 8) throw std::invalid_argument("rt: BLAS block size k must be 2..8, got " + std::to_string(block));
-  SpaceLayout s;
+  BlockGrid s;
   s.block = block;
   const int max_blocks = std::max(1, std::min(limits.max_side, 65536) / block);
   for (int i = 0; i < 3; ++i) s.blocks[i] = std::clamp((std::max(wanted[i], 1) + block - 1) / block, 1, max_blocks);
@@ -19,7 +19,7 @@ SpaceLayout choose_layout(int block, const int wanted[3], const SpaceLimits& lim
     for (int i = 1; i < 3; ++i)
       if (s.blocks[i] > s.blocks[axis]) axis = i;
     if (s.blocks[axis] == 1) {
-      throw std::invalid_argument("rt: the ray-space limits cannot hold one block of " + std::to_string(block) + "^3 voxels");
+      throw std::invalid_argument("rt: the block-grid limits cannot hold one block of " + std::to_string(block) + "^3 voxels");
     }
     s.blocks[axis] = (s.blocks[axis] + 1) / 2;
   }
@@ -53,19 +53,19 @@ std::vector<Aabb> block_aabbs(int block, float margin) {
   return out;
 }
 
-void instance_block(const SpaceLayout& s, uint64_t instance, int out[3]) {
+void instance_block(const BlockGrid& s, uint64_t instance, int out[3]) {
   out[0] = int(instance % uint64_t(s.blocks[0]));
   out[1] = int((instance / uint64_t(s.blocks[0])) % uint64_t(s.blocks[1]));
   out[2] = int(instance / (uint64_t(s.blocks[0]) * uint64_t(s.blocks[1])));
 }
 
-void instance_translation(const SpaceLayout& s, uint64_t instance, float out[3]) {
+void instance_translation(const BlockGrid& s, uint64_t instance, float out[3]) {
   int b[3];
   instance_block(s, instance, b);
   for (int i = 0; i < 3; ++i) out[i] = float(b[i] * s.block);  // exact: integers < 2^24
 }
 
-void voxel_key(const SpaceLayout& s, const int lo[3], uint64_t instance, uint32_t primitive, int out[3]) {
+void voxel_key(const BlockGrid& s, const int lo[3], uint64_t instance, uint32_t primitive, int out[3]) {
   int b[3];
   instance_block(s, instance, b);
   const uint32_t k = uint32_t(s.block);
@@ -73,7 +73,7 @@ void voxel_key(const SpaceLayout& s, const int lo[3], uint64_t instance, uint32_
   for (int i = 0; i < 3; ++i) out[i] = lo[i] + b[i] * s.block + p[i];
 }
 
-std::vector<KeyBox> plan_windows(const KeyBox& keys, const SpaceLayout& s, int margin) {
+std::vector<KeyBox> tile_windows(const KeyBox& keys, const BlockGrid& s, int margin) {
   std::vector<KeyBox> out;
   if (keys.empty()) return out;
   KeyBox wide;

@@ -1,4 +1,4 @@
-// The GPU-free half of the `rt` back end, on the CPU: the shared ray space's layout (BLAS
+// The GPU-free half of the `rt` back end, on the CPU: the block grid (BLAS
 // boxes, TLAS instances and their translations, instance/primitive -> key), the key-aligned
 // windows, the window frame, and a CPU model of the whole rt shoot (float candidates from
 // the enlarged AABBs, then the exact double slab test) that must equal the exact CPU
@@ -15,38 +15,38 @@
 
 #include "engine/cpu_backend.h"
 #include "engine/exact_traversal.h"
-#include "gpu/rt/rt_space.h"
+#include "gpu/rt/block_grid.h"
 
 namespace ort::rt {
 namespace {
 
 using Key = std::array<int, 3>;
 
-TEST(RtSpace, LayoutRoundsUpToBlocksAndShrinksToLimits) {
+TEST(RtBlockGrid, RoundsUpToBlocksAndShrinksToLimits) {
   const int wanted[3] = {10, 17, 3};
-  const SpaceLayout s = choose_layout(4, wanted, SpaceLimits{});
+  const BlockGrid s = choose_block_grid(4, wanted, BlockGridLimits{});
   EXPECT_EQ(s.voxels(0), 12);
   EXPECT_EQ(s.voxels(1), 20);
   EXPECT_EQ(s.voxels(2), 4);
   EXPECT_EQ(s.instance_count(), 3u * 5u * 1u);
   EXPECT_EQ(s.grid_words(), (12u * 20u * 4u + 15u) / 16u);
 
-  SpaceLimits tight;
+  BlockGridLimits tight;
   tight.max_instances = 100;
   const int big[3] = {1000, 1000, 40};
-  const SpaceLayout t = choose_layout(2, big, tight);
+  const BlockGrid t = choose_block_grid(2, big, tight);
   EXPECT_LE(t.instance_count(), 100u);
   EXPECT_GE(t.blocks[0], 1);
   EXPECT_LE(t.blocks[2], 20);
 
-  EXPECT_THROW(choose_layout(1, wanted, SpaceLimits{}), std::invalid_argument);
-  EXPECT_THROW(choose_layout(9, wanted, SpaceLimits{}), std::invalid_argument);
-  SpaceLimits none;
+  EXPECT_THROW(choose_block_grid(1, wanted, BlockGridLimits{}), std::invalid_argument);
+  EXPECT_THROW(choose_block_grid(9, wanted, BlockGridLimits{}), std::invalid_argument);
+  BlockGridLimits none;
   none.max_voxels = 7;
-  EXPECT_THROW(choose_layout(2, wanted, none), std::invalid_argument);
+  EXPECT_THROW(choose_block_grid(2, wanted, none), std::invalid_argument);
 }
 
-TEST(RtSpace, WantedFromRangeCoversTheRangeBothWays) {
+TEST(RtBlockGrid, WantedFromRangeCoversTheRangeBothWays) {
   int w[3];
   wanted_from_range(0.1, 10.0, 512, w);
   EXPECT_EQ(w[0], 204);
@@ -55,7 +55,7 @@ TEST(RtSpace, WantedFromRangeCoversTheRangeBothWays) {
   EXPECT_EQ(w[1], 512);
 }
 
-TEST(RtSpace, BlockAabbsAreTheVoxelsEnlargedByTheMargin) {
+TEST(RtBlockGrid, BlockAabbsAreTheVoxelsEnlargedByTheMargin) {
   for (int k = 2; k <= 8; ++k) {
     const auto boxes = block_aabbs(k);
     ASSERT_EQ(boxes.size(), size_t(k * k * k));
@@ -69,9 +69,9 @@ TEST(RtSpace, BlockAabbsAreTheVoxelsEnlargedByTheMargin) {
   }
 }
 
-TEST(RtSpace, InstancesAndPrimitivesNameEveryVoxelOfTheWindowOnce) {
+TEST(RtBlockGrid, InstancesAndPrimitivesNameEveryVoxelOfTheWindowOnce) {
   const int wanted[3] = {9, 6, 7};
-  const SpaceLayout s = choose_layout(3, wanted, SpaceLimits{});
+  const BlockGrid s = choose_block_grid(3, wanted, BlockGridLimits{});
   const int lo[3] = {32760, 100, 65530};
   std::set<Key> seen;
   const uint32_t prims = uint32_t(s.block * s.block * s.block);
@@ -94,14 +94,14 @@ TEST(RtSpace, InstancesAndPrimitivesNameEveryVoxelOfTheWindowOnce) {
   EXPECT_EQ(seen.size(), s.voxel_count());
 }
 
-TEST(RtSpace, WindowsTileTheWidenedKeyBoxOnceEach) {
+TEST(RtBlockGrid, WindowsTileTheWidenedKeyBoxOnceEach) {
   const int wanted[3] = {8, 8, 4};
-  const SpaceLayout s = choose_layout(4, wanted, SpaceLimits{});
+  const BlockGrid s = choose_block_grid(4, wanted, BlockGridLimits{});
   KeyBox keys;
   keys.lo[0] = 3; keys.hi[0] = 30;          // near the low key edge: clamped to 0
   keys.lo[1] = 32760; keys.hi[1] = 32770;
   keys.lo[2] = 65530; keys.hi[2] = 65535;   // at the high key edge: clamped to 65535
-  const auto windows = plan_windows(keys, s, 1);
+  const auto windows = tile_windows(keys, s, 1);
   std::map<Key, int> hits;
   for (const KeyBox& w : windows) {
     for (int i = 0; i < 3; ++i) {
@@ -117,10 +117,10 @@ TEST(RtSpace, WindowsTileTheWidenedKeyBoxOnceEach) {
   EXPECT_EQ(hits.size(), expect);
   for (const auto& [k, n] : hits) ASSERT_EQ(n, 1);
   EXPECT_EQ(hits.begin()->first[0], 2);
-  EXPECT_TRUE(plan_windows(KeyBox{}, s).empty());
+  EXPECT_TRUE(tile_windows(KeyBox{}, s).empty());
 }
 
-TEST(RtSpace, WindowFrameIsVoxelUnitsFromTheLowKey) {
+TEST(RtBlockGrid, WindowFrameIsVoxelUnitsFromTheLowKey) {
   const int lo[3] = {32768, 32700, 40000};
   const double p[3] = {0.25, -0.05, 723.2};
   float f[3];
@@ -148,7 +148,7 @@ bool float_ray_hits_box(const float o[3], const float d[3], float tmax, const fl
   return true;
 }
 
-TEST(RtSpace, TraceDirectionHasNoZeroComponents) {
+TEST(RtBlockGrid, TraceDirectionHasNoZeroComponents) {
   const float o[3] = {3.0f, 5.0f, 7.0f}, f[3] = {3.0f, 9.5f, 7.0f - 1e-9f};
   float d[3];
   trace_direction(o, f, d);
@@ -171,13 +171,13 @@ TEST(RtSpace, TraceDirectionHasNoZeroComponents) {
 
 // The rt back end's algorithm, in C++: windows, float frame, enlarged AABBs as candidates,
 // the exact test in map coordinates, the 2-bit states, occupied wins.
-VoxelList model_rt_shoot(const RayBatch& batch, const SpaceLayout& s, uint64_t* candidates = nullptr) {
+VoxelList model_rt_shoot(const RayBatch& batch, const BlockGrid& s, uint64_t* candidates = nullptr) {
   std::map<Key, uint32_t> states;
   const double res = batch.resolution, inv_res = 1.0 / res;
   const auto boxes = block_aabbs(s.block);
   const uint32_t k = uint32_t(s.block);
   const double a[3] = {batch.origin.x(), batch.origin.y(), batch.origin.z()};
-  for (const KeyBox& w : plan_windows(batch.keys, s)) {
+  for (const KeyBox& w : tile_windows(batch.keys, s)) {
     for (const RayEnd& e : batch.ends) {
       const double b[3] = {e.x, e.y, e.z};
       float o[3], f[3], d[3];
@@ -256,14 +256,14 @@ RayBatch make_batch(const octomap::point3d& origin, const std::vector<octomap::p
   return b;
 }
 
-TEST(RtSpace, ModelOfTheRtShootEqualsTheExactCpuReference) {
+TEST(RtBlockGrid, ModelOfTheRtShootEqualsTheExactCpuReference) {
   const double res = 0.1;
   std::mt19937 rng(2024);
   std::uniform_real_distribution<float> u(-1.2f, 1.2f);
   std::uniform_int_distribution<int> g(-12, 12);
   std::uniform_int_distribution<int> pick(0, 5);
   const int wanted[3] = {8, 12, 8};
-  const SpaceLayout s = choose_layout(4, wanted, SpaceLimits{});  // small: many windows
+  const BlockGrid s = choose_block_grid(4, wanted, BlockGridLimits{});  // small: many windows
   auto cpu = make_cpu_backend(res);
   uint64_t rays = 0;
   for (int scan = 0; scan < 60; ++scan) {
@@ -291,7 +291,7 @@ TEST(RtSpace, ModelOfTheRtShootEqualsTheExactCpuReference) {
   EXPECT_GE(rays, 12000u);
 }
 
-TEST(RtSpace, ModelCoversVoxelsJustBelowTheKeyBox) {
+TEST(RtBlockGrid, ModelCoversVoxelsJustBelowTheKeyBox) {
   // Every ray lies in the planes x = -16 and y = 5 (voxel faces at 0.5 m), so the voxels on
   // their low sides have keys below the scan's key box: the window margin must hold them.
   const double res = 0.5;
@@ -305,13 +305,13 @@ TEST(RtSpace, ModelCoversVoxelsJustBelowTheKeyBox) {
   cpu->shoot(batch, Traversal::kExact, want, st);
   for (int k : {2, 4, 8}) {
     const int wanted[3] = {64, 64, 64};
-    EXPECT_EQ(sorted(model_rt_shoot(batch, choose_layout(k, wanted, SpaceLimits{}))), sorted(want)) << "k " << k;
+    EXPECT_EQ(sorted(model_rt_shoot(batch, choose_block_grid(k, wanted, BlockGridLimits{}))), sorted(want)) << "k " << k;
   }
-  const KeyBox w = plan_windows(batch.keys, choose_layout(4, wanted_cube(), SpaceLimits{}))[0];
+  const KeyBox w = tile_windows(batch.keys, choose_block_grid(4, wanted_cube(), BlockGridLimits{}))[0];
   EXPECT_EQ(w.lo[0], batch.keys.lo[0] - 1);
 }
 
-TEST(RtSpace, MarginCostsFewExtraCandidates) {
+TEST(RtBlockGrid, MarginCostsFewExtraCandidates) {
   // The margin must let in touching boxes but not many more: count candidates per true voxel.
   const double res = 0.2;
   std::mt19937 rng(7);
@@ -320,7 +320,7 @@ TEST(RtSpace, MarginCostsFewExtraCandidates) {
   for (int r = 0; r < 500; ++r) ends.emplace_back(u(rng), u(rng), u(rng));
   const RayBatch batch = make_batch({0.01f, 0.02f, 0.03f}, ends, res);
   const int wanted[3] = {64, 64, 64};
-  const SpaceLayout s = choose_layout(8, wanted, SpaceLimits{});
+  const BlockGrid s = choose_block_grid(8, wanted, BlockGridLimits{});
   uint64_t candidates = 0, touched = 0;
   model_rt_shoot(batch, s, &candidates);
   for (const RayEnd& e : batch.ends) {
