@@ -1,6 +1,6 @@
 // The server's map: the octree, the order its scans were applied in, and the lock that
-// makes every reader (saves, status, later snapshots and queries) see a state between two
-// whole scans. Stage 2 holds the lock for one scan's octree update at a time.
+// makes every reader (saves, status, snapshots, queries) see a state between two whole
+// scans. Stage 2 holds the lock for one scan's octree update at a time.
 #pragma once
 
 #include <cstdint>
@@ -17,7 +17,11 @@ struct MapState {
   std::mutex mutex;
   std::unique_ptr<octomap::OcTree> tree;
   AppliedOrder order;
-  uint64_t version = 0;          // +1 per applied scan (saves skip an unchanged map)
+  // The map state id: how many scans the map contains by its applied order, over the map's
+  // whole life (a loaded map starts at its order file's count; +1 per applied scan, under
+  // the lock). Two reads with the same version saw the same map. Snapshot ids and the map
+  // state a query was answered on are this number.
+  uint64_t version = 0;
   int64_t last_scan_utime = 0;   // utime of the newest applied scan
 };
 

@@ -5,10 +5,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 #include "daemon/kernel_udp_stats.h"
+#include "daemon/map_snapshot.h"
 #include "daemon/map_store.h"
+#include "daemon/run_summary.h"
 #include "daemon/server_lcm_url.h"
 
 namespace ort::daemon {
@@ -59,17 +62,13 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ost
   if (!cfg_.applied_log.empty()) map_.order.open_live_log(cfg_.applied_log);
 
   if (shared) {
-    lc_ = shared;
     url_ = "(shared LCM instance)";
+    loop_ = std::make_unique<LcmLoop>(*shared, log_);
   } else {
     const LcmUrlChoice c = choose_lcm_url(cfg_.lcm_url, cfg_.recv_buf_size);
     url_ = c.url;
     if (!c.warning.empty()) log_ << c.warning << "\n";
-    own_lcm_ = std::make_unique<lcm::LCM>(url_);
-    if (!own_lcm_->good())
-      throw std::runtime_error("LCM could not start on '" + url_ +
-                               "' (for udpm on one host: ip route add 224.0.0.0/4 dev lo, see LCM's multicast setup)");
-    lc_ = own_lcm_.get();
+    loop_ = std::make_unique<LcmLoop>(url_, log_);
   }
 }
 
@@ -97,8 +96,8 @@ void MappingServer::load_or_create_map() {
       previous = std::move(f.entries);
     }
     map_.order.restore(std::move(previous));
-    map_.version = 0;
-    saved_version_ = 0;
+    map_.version = map_.order.size();
+    saved_version_ = map_.version;
     log_ << "octomap-rt-server: loaded map " << cfg_.map_path << " (" << map_.tree->size() << " nodes, "
          << map_.order.size() << " scans applied before)\n";
   } else {
@@ -116,8 +115,9 @@ void MappingServer::start() {
   limits.resolution = cfg_.engine.resolution;
   pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, cfg_.pipeline);
   pipeline_->start();
-  intake_ = std::make_unique<ScanIntake>(*lc_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
-  intake_->start();
+  intake_ = std::make_unique<ScanIntake>(*loop_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
+  intake_->open();  // before the loop starts: 1.3.1's subscribe races with handle
+  loop_->start();
   status_thread_ = std::thread([this] { run_status_loop(); });
   if (!cfg_.map_path.empty() && cfg_.save_interval_s > 0) save_thread_ = std::thread([this] { run_save_loop(); });
   set_state(Status::STATE_RUNNING, "serving " + cfg_.scan_channels);
@@ -127,7 +127,7 @@ void MappingServer::stop() {
   if (!started_ || stopped_) return;
   stopped_ = true;
   set_state(Status::STATE_STOPPING, "stopping: intake closed, draining queued scans");
-  intake_->stop();
+  intake_->close();
   queue_.close();
   pipeline_->join();
   {
@@ -147,6 +147,7 @@ void MappingServer::stop() {
   }
   wake_.notify_all();
   if (status_thread_.joinable()) status_thread_.join();
+  loop_->stop();
 }
 
 void MappingServer::set_state(int8_t state, std::string message) {
@@ -162,33 +163,21 @@ void MappingServer::set_state(int8_t state, std::string message) {
 void MappingServer::save(bool force) {
   if (cfg_.map_path.empty()) return;
   std::lock_guard save_lock(save_mutex_);
-  std::unique_ptr<octomap::OcTree> snapshot;
-  size_t scans = 0;
-  uint64_t version = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  double lock_ms = 0;
-  {
-    // Copy under the lock (a state between two whole scans); serialize and write outside
-    // it. The copy holds the lock about half as long as serializing would (measured on a
-    // 400k-node map: 52-85 ms vs 89-98 ms).
-    std::lock_guard lock(map_.mutex);
-    if (!force && map_.version == saved_version_) return;
-    snapshot = std::make_unique<octomap::OcTree>(*map_.tree);
-    scans = map_.order.size();
-    version = map_.version;
-    lock_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  }
-  const std::string bytes = serialize_map(*snapshot);
-  snapshot.reset();
-  const std::vector<AppliedEntry> order = map_.order.entries(scans);
+  // Copy under the map lock (a state between two whole scans); serialize and write outside it.
+  std::optional<MapCopy> copy = force ? std::optional<MapCopy>(copy_map(map_)) : copy_map_if_changed(map_, saved_version_);
+  if (!copy) return;
+  const std::string bytes = serialize_map(*copy->tree);
+  copy->tree.reset();
+  const std::vector<AppliedEntry> order = map_.order.entries(copy->scans);
   // Map first: if we die between the two renames the order file is the older one, which
   // the next start detects by its map_bytes line.
   write_file_atomically(cfg_.map_path, bytes);
   write_file_atomically(cfg_.map_path + ".order", format_applied_order(order, bytes.size()));
-  saved_version_ = version;
+  saved_version_ = copy->version;
   saves_++;
   last_save_utime_ = now_utime();
-  max_save_lock_ms_ = std::max(max_save_lock_ms_, lock_ms);
+  max_save_lock_ms_ = std::max(max_save_lock_ms_, copy->lock_ms);
   last_save_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
@@ -298,7 +287,7 @@ void MappingServer::publish_status() {
   last_kernel_errors_ = kernel;
   {
     std::lock_guard lock(state_mutex_);
-    if (intake_ && intake_->failed()) {
+    if (loop_->failed()) {
       state_ = Status::STATE_ERROR;
       message_ = "LCM intake failed; no scans are received";
     } else if (state_ == Status::STATE_RUNNING && !why.str().empty()) {
@@ -317,60 +306,17 @@ void MappingServer::publish_status() {
     in.seq = status_seq_++;
   }
   const octomap_rt::server_status_t msg = make_status(in);
-  lc_->publish(cfg_.status_channel, &msg);
+  loop_->publish(cfg_.status_channel, msg);
 }
 
 void MappingServer::print_summary(std::ostream& out) {
-  const StatusInputs s = gather_status();
-  const MetricsSnapshot& m = s.metrics;
-  char line[512];
-  out << "octomap-rt-server summary\n";
-  std::snprintf(line, sizeof line, "  ran %.1f s as %s; back end %s on %s; pipeline %s; resolution %g m\n", s.uptime_s,
-                s.server_id.c_str(), s.backend.c_str(), s.device.c_str(), s.pipelined ? "on" : "off", s.resolution);
-  out << line;
-  out << "  producers (received = applied + rejected + dropped):\n";
-  for (const ProducerStats& p : s.producers) {
-    std::snprintf(line, sizeof line,
-                  "    %-16s received %lld = applied %lld + rejected %lld + dropped %lld%s; missed (seq gaps) %lld; "
-                  "points %lld\n",
-                  p.robot_id.c_str(), (long long)p.received, (long long)p.applied, (long long)p.rejected,
-                  (long long)p.dropped, p.in_flight ? (" + in flight " + std::to_string(p.in_flight)).c_str() : "",
-                  (long long)p.missed, (long long)p.points_applied);
-    out << line;
-    std::string reasons;
-    for (size_t k = 0; k < kRejectReasonCount; ++k)
-      if (p.rejects[k]) reasons += std::string(reasons.empty() ? "" : ", ") + to_string(static_cast<Reject>(k)) + " " +
-                                   std::to_string(p.rejects[k]);
-    if (!reasons.empty()) out << "      rejected: " << reasons << "\n";
-  }
-  std::snprintf(line, sizeof line,
-                "  stage times:  shoot (stage 1) p50 %.2f ms p99 %.2f ms, total %.1f ms; octree (stage 2) p50 %.2f ms "
-                "p99 %.2f ms, total %.1f ms; end to end p50 %.2f ms p99 %.2f ms\n",
-                m.shoot_p50, m.shoot_p99, m.shoot_total_ms, m.octree_p50, m.octree_p99, m.octree_total_ms, m.e2e_p50,
-                m.e2e_p99);
-  out << line;
-  std::snprintf(line, sizeof line,
-                "  overlap:      stage 1 busy %.3f s, stage 2 busy %.3f s, both at once %.3f s; %lld of %lld scans "
-                "had their octree update overlap another scan's shoot\n",
-                m.overlap.busy_s[0], m.overlap.busy_s[1], m.overlap.both_s, (long long)m.overlapped_scans,
-                (long long)m.scans_applied);
-  out << line;
-  std::snprintf(line, sizeof line, "  map:          %lld nodes (%lld leaves), %.1f MiB in memory, %zu scans applied in total\n",
-                (long long)s.num_nodes, (long long)s.num_leaf_nodes, s.memory_bytes / 1048576.0, map_.order.size());
-  out << line;
-  out << "  kernel UDP drops: " << s.socket_rcvbuf_drops << " on the server's sockets, " << s.kernel_rcvbuf_errors
-      << " in this network namespace (all programs; -1: unknown)\n";
-  if (!cfg_.map_path.empty()) {
-    std::snprintf(line, sizeof line,
-                  "  map file:     %s (saved %lld times; last save %.1f ms, map lock held at most %.1f ms)\n"
-                  "  order file:   %s.order\n",
-                  cfg_.map_path.c_str(), (long long)saves_.load(), last_save_ms_, max_save_lock_ms_,
-                  cfg_.map_path.c_str());
-    out << line;
-  } else {
-    out << "  map file:     none (no --map given: the map was not saved)\n";
-  }
-  if (!cfg_.applied_log.empty()) out << "  applied log:  " << cfg_.applied_log << "\n";
+  RunSummaryInputs in;
+  in.status = gather_status();
+  in.scans_in_map = map_.order.size();
+  in.applied_log = cfg_.applied_log;
+  in.last_save_ms = last_save_ms_;
+  in.max_save_lock_ms = max_save_lock_ms_;
+  print_run_summary(out, in);
 }
 
 }  // namespace ort::daemon

@@ -1,6 +1,7 @@
-// octomap-rt-server's logic, as a library so tests can run it in-process over memq://:
-// map (loaded from --map), engine, the LCM intake thread, the two-stage pipeline, status
-// heartbeats, periodic atomic saves, and the orderly stop (intake off, drain, save).
+// octomap-rt-server's logic, as a library so tests can run it in-process over memq://.
+// It wires the parts: map (loaded from --map), engine, the LCM loop with the scan intake
+// on it, the two-stage pipeline, status heartbeats, periodic atomic saves, and the orderly
+// stop (intake off, drain, save, loop off).
 #pragma once
 
 #include <atomic>
@@ -14,6 +15,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "daemon/lcm_loop.h"
 #include "daemon/map_state.h"
 #include "daemon/pipeline_metrics.h"
 #include "daemon/producer_registry.h"
@@ -33,7 +35,7 @@ class MappingServer {
   // resolution, back end unavailable, LCM not usable.
   MappingServer(const ServerConfig& cfg, std::ostream& log);
   // On a shared LCM (tests: one memq:// instance shared with in-process producers). The
-  // server's thread is the only one that may call handle on it.
+  // server's LCM loop is the only one that may call handle on it.
   MappingServer(const ServerConfig& cfg, lcm::LCM& shared, std::ostream& log);
   ~MappingServer();
 
@@ -54,6 +56,8 @@ class MappingServer {
     return f(static_cast<const octomap::OcTree&>(*map_.tree));
   }
   const std::string& lcm_url() const { return url_; }
+  // The server's one LCM thread: services register their raw handlers on it before start().
+  LcmLoop& lcm_loop() { return *loop_; }
   // Human-readable end-of-run summary (per producer, stage times, overlap, map, files).
   void print_summary(std::ostream& out);
 
@@ -69,8 +73,7 @@ class MappingServer {
   ServerConfig cfg_;
   std::ostream& log_;
   std::string url_;
-  std::unique_ptr<lcm::LCM> own_lcm_;
-  lcm::LCM* lc_ = nullptr;
+  std::unique_ptr<LcmLoop> loop_;
   std::unique_ptr<MapEngine> engine_;
   MapState map_;
   ProducerRegistry producers_;

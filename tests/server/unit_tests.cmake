@@ -7,3 +7,4 @@ octomap_rt_add_test(server_memq_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_me
 octomap_rt_add_test(server_persistence_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_store_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/server_persistence_test.cpp ${SERVER_TEST_FIXTURES}
                     LIBS octomap_rt_daemon TIMEOUT 300)
+octomap_rt_add_test(lcm_loop_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/lcm_loop_test.cpp LIBS octomap_rt_daemon TIMEOUT 120)

@@ -1,0 +1,77 @@
+#include "daemon/run_summary.h"
+
+#include <cstdio>
+
+namespace ort::daemon {
+namespace {
+
+void print_producers(std::ostream& out, const StatusInputs& s) {
+  char line[512];
+  out << "  producers (received = applied + rejected + dropped):\n";
+  for (const ProducerStats& p : s.producers) {
+    std::snprintf(line, sizeof line,
+                  "    %-16s received %lld = applied %lld + rejected %lld + dropped %lld%s; missed (seq gaps) %lld; "
+                  "points %lld\n",
+                  p.robot_id.c_str(), (long long)p.received, (long long)p.applied, (long long)p.rejected,
+                  (long long)p.dropped, p.in_flight ? (" + in flight " + std::to_string(p.in_flight)).c_str() : "",
+                  (long long)p.missed, (long long)p.points_applied);
+    out << line;
+    std::string reasons;
+    for (size_t k = 0; k < kRejectReasonCount; ++k)
+      if (p.rejects[k]) reasons += std::string(reasons.empty() ? "" : ", ") + to_string(static_cast<Reject>(k)) + " " +
+                                   std::to_string(p.rejects[k]);
+    if (!reasons.empty()) out << "      rejected: " << reasons << "\n";
+  }
+}
+
+void print_stages(std::ostream& out, const MetricsSnapshot& m) {
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "  stage times:  shoot (stage 1) p50 %.2f ms p99 %.2f ms, total %.1f ms; octree (stage 2) p50 %.2f ms "
+                "p99 %.2f ms, total %.1f ms; end to end p50 %.2f ms p99 %.2f ms\n",
+                m.shoot_p50, m.shoot_p99, m.shoot_total_ms, m.octree_p50, m.octree_p99, m.octree_total_ms, m.e2e_p50,
+                m.e2e_p99);
+  out << line;
+  std::snprintf(line, sizeof line,
+                "  overlap:      stage 1 busy %.3f s, stage 2 busy %.3f s, both at once %.3f s; %lld of %lld scans "
+                "had their octree update overlap another scan's shoot\n",
+                m.overlap.busy_s[0], m.overlap.busy_s[1], m.overlap.both_s, (long long)m.overlapped_scans,
+                (long long)m.scans_applied);
+  out << line;
+}
+
+void print_files(std::ostream& out, const RunSummaryInputs& in) {
+  const StatusInputs& s = in.status;
+  char line[1024];
+  if (!s.map_path.empty()) {
+    std::snprintf(line, sizeof line,
+                  "  map file:     %s (saved %lld times; last save %.1f ms, map lock held at most %.1f ms)\n"
+                  "  order file:   %s.order\n",
+                  s.map_path.c_str(), (long long)s.map_saves, in.last_save_ms, in.max_save_lock_ms, s.map_path.c_str());
+    out << line;
+  } else {
+    out << "  map file:     none (no --map given: the map was not saved)\n";
+  }
+  if (!in.applied_log.empty()) out << "  applied log:  " << in.applied_log << "\n";
+}
+
+}  // namespace
+
+void print_run_summary(std::ostream& out, const RunSummaryInputs& in) {
+  const StatusInputs& s = in.status;
+  char line[512];
+  out << "octomap-rt-server summary\n";
+  std::snprintf(line, sizeof line, "  ran %.1f s as %s; back end %s on %s; pipeline %s; resolution %g m\n", s.uptime_s,
+                s.server_id.c_str(), s.backend.c_str(), s.device.c_str(), s.pipelined ? "on" : "off", s.resolution);
+  out << line;
+  print_producers(out, s);
+  print_stages(out, s.metrics);
+  std::snprintf(line, sizeof line, "  map:          %lld nodes (%lld leaves), %.1f MiB in memory, %zu scans applied in total\n",
+                (long long)s.num_nodes, (long long)s.num_leaf_nodes, s.memory_bytes / 1048576.0, in.scans_in_map);
+  out << line;
+  out << "  kernel UDP drops: " << s.socket_rcvbuf_drops << " on the server's sockets, " << s.kernel_rcvbuf_errors
+      << " in this network namespace (all programs; -1: unknown)\n";
+  print_files(out, in);
+}
+
+}  // namespace ort::daemon

@@ -1,0 +1,22 @@
+// The server's human-readable end-of-run summary (per producer, stage times, overlap, map,
+// files), printed from the same inputs as the status message plus what only a person reads.
+#pragma once
+
+#include <cstddef>
+#include <ostream>
+#include <string>
+
+#include "daemon/status_message.h"
+
+namespace ort::daemon {
+
+struct RunSummaryInputs {
+  StatusInputs status;
+  size_t scans_in_map = 0;         // applied-order entries, earlier runs included
+  std::string applied_log;         // "": none
+  double last_save_ms = 0, max_save_lock_ms = 0;
+};
+
+void print_run_summary(std::ostream& out, const RunSummaryInputs& in);
+
+}  // namespace ort::daemon
