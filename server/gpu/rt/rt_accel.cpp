@@ -98,10 +98,14 @@ struct LevelBuild {
 
 // Sizes the level's build, creates the structure it builds into (`out`) and its scratch.
 LevelBuild prepare_level(const vk::Context& ctx, const RtFunctions& fn, VkAccelerationStructureTypeKHR type,
-                         const VkAccelerationStructureGeometryKHR& geometry, uint32_t primitives,
-                         VkDeviceSize scratch_align, AccelerationStructure& out) {
+                         VkGeometryTypeKHR geometry_type, const VkAccelerationStructureGeometryDataKHR& data,
+                         uint32_t primitives, VkDeviceSize scratch_align, AccelerationStructure& out) {
   LevelBuild b;
-  b.geometry = geometry;
+  b.geometry.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR;
+  b.geometry.geometryType = geometry_type;
+  b.geometry.geometry = data;
+  // Opaque: no any-hit shader; the intersection shader still runs for every candidate box.
+  if (geometry_type == VK_GEOMETRY_TYPE_AABBS_KHR) b.geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
   b.primitives = primitives;
   b.info.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR;
   b.info.type = type;
@@ -120,27 +124,18 @@ LevelBuild prepare_level(const vk::Context& ctx, const RtFunctions& fn, VkAccele
   return b;
 }
 
-// The BLAS's geometry: the k^3 voxel boxes of one block, opaque (no any-hit shader; the
-// intersection shader still runs for every candidate box).
-VkAccelerationStructureGeometryKHR box_geometry(VkDeviceAddress boxes) {
-  VkAccelerationStructureGeometryKHR g{};
-  g.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR;
-  g.geometryType = VK_GEOMETRY_TYPE_AABBS_KHR;
-  g.geometry.aabbs.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR;
-  g.geometry.aabbs.data.deviceAddress = boxes;
-  g.geometry.aabbs.stride = sizeof(Aabb);
-  g.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
-  return g;
+// The BLAS's data: the k^3 voxel boxes of one block.
+VkAccelerationStructureGeometryDataKHR box_data(VkDeviceAddress boxes) {
+  VkAccelerationStructureGeometryDataKHR d{};
+  d.aabbs = {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR, nullptr, {boxes}, sizeof(Aabb)};
+  return d;
 }
 
-VkAccelerationStructureGeometryKHR instance_geometry(VkDeviceAddress instances) {
-  VkAccelerationStructureGeometryKHR g{};
-  g.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR;
-  g.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
-  g.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
-  g.geometry.instances.arrayOfPointers = VK_FALSE;
-  g.geometry.instances.data.deviceAddress = instances;
-  return g;
+// The TLAS's data: a plain array of instance records.
+VkAccelerationStructureGeometryDataKHR instance_data(VkDeviceAddress instances) {
+  VkAccelerationStructureGeometryDataKHR d{};
+  d.instances = {VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR, nullptr, VK_FALSE, {instances}};
+  return d;
 }
 
 // The TLAS records: one instance of the BLAS per block, translated to the block's corner
@@ -196,8 +191,8 @@ SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const 
   const std::vector<Aabb> boxes = block_aabbs(grid.block, aabb_margin);
   vk::Buffer box_buffer(ctx, boxes.size() * sizeof(Aabb), input_usage, host);
   std::memcpy(box_buffer.mapped(), boxes.data(), boxes.size() * sizeof(Aabb));
-  LevelBuild blas = prepare_level(ctx, fn, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
-                                  box_geometry(box_buffer.device_address()), uint32_t(boxes.size()), scratch_align,
+  LevelBuild blas = prepare_level(ctx, fn, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, VK_GEOMETRY_TYPE_AABBS_KHR,
+                                  box_data(box_buffer.device_address()), uint32_t(boxes.size()), scratch_align,
                                   bvh.blas);
 
   // TLAS: one instance of the BLAS per block.
@@ -205,9 +200,9 @@ SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const 
   vk::Buffer instance_buffer(ctx, bvh.instance_bytes, input_usage, host, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   write_instances(grid, bvh.blas.address(), instance_buffer.as<VkAccelerationStructureInstanceKHR>());
   instance_buffer.flush();
-  LevelBuild tlas = prepare_level(ctx, fn, VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR,
-                                  instance_geometry(instance_buffer.device_address()),
-                                  uint32_t(grid.instance_count()), scratch_align, bvh.tlas);
+  LevelBuild tlas = prepare_level(ctx, fn, VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, VK_GEOMETRY_TYPE_INSTANCES_KHR,
+                                  instance_data(instance_buffer.device_address()), uint32_t(grid.instance_count()),
+                                  scratch_align, bvh.tlas);
   bvh.scratch_bytes = blas.scratch_bytes + tlas.scratch_bytes;
 
   bvh.gpu_build_ms = run_builds(ctx, fn, runner, blas, tlas);

@@ -46,10 +46,8 @@ template <class T>
 T extension_properties(VkPhysicalDevice device, VkStructureType type) {
   T props{};
   props.sType = type;
-  VkPhysicalDeviceProperties2 p2{};
-  p2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
-  p2.pNext = &props;
-  vkGetPhysicalDeviceProperties2(device, &p2);
+  VkPhysicalDeviceProperties2 chain{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &props, {}};
+  vkGetPhysicalDeviceProperties2(device, &chain);
   return props;
 }
 

@@ -1,6 +1,7 @@
 #include "gpu/vk/vk_pipeline_objects.h"
 
 #include <map>
+#include <utility>
 #include <vector>
 
 #include "gpu/vk/vk_check.h"
@@ -51,15 +52,11 @@ void PipelineObjects::make_set(std::span<const VkDescriptorSetLayoutBinding> bin
 }
 
 void PipelineObjects::destroy() {
-  if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
-  if (pipeline) vkDestroyPipeline(device, pipeline, nullptr);
-  if (layout) vkDestroyPipelineLayout(device, layout, nullptr);
-  if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, nullptr);
-  pool = VK_NULL_HANDLE;
-  set = VK_NULL_HANDLE;
-  pipeline = VK_NULL_HANDLE;
-  layout = VK_NULL_HANDLE;
-  set_layout = VK_NULL_HANDLE;
+  set = VK_NULL_HANDLE;  // freed with its pool
+  if (pool) vkDestroyDescriptorPool(device, std::exchange(pool, VK_NULL_HANDLE), nullptr);
+  if (pipeline) vkDestroyPipeline(device, std::exchange(pipeline, VK_NULL_HANDLE), nullptr);
+  if (layout) vkDestroyPipelineLayout(device, std::exchange(layout, VK_NULL_HANDLE), nullptr);
+  if (set_layout) vkDestroyDescriptorSetLayout(device, std::exchange(set_layout, VK_NULL_HANDLE), nullptr);
 }
 
 void PipelineObjects::write_storage_buffers(std::span<const VkBuffer> buffers, uint32_t first_binding) const {
