@@ -13,6 +13,13 @@
 // restores exactly the 8 equal leaves that were pruned. tests/octree checks all of this
 // against OctoMap, also against the list in other orders.
 //
+// The stage (all of it on the worker pool but the walk down to the buckets' nodes):
+//   1. bucket_voxels: the list cut into the subtrees of the nodes at one depth (voxel_buckets.h)
+//   2. SplitTop: the nodes above them made, one thread, a few hundred nodes at most
+//   3. per bucket, largest first: sort it (it is in this thread's cache now), update_subtree,
+//      and settle the nodes above when it was their last child (split_top.h)
+//   4. the worker threads' net node count added to the tree's counter (node_count.h)
+//
 // Trees with change detection on (enableChangeDetection) go through the plain updateNode
 // loop, which also records the changed keys.
 #pragma once
@@ -25,32 +32,27 @@
 #include <octomap/OcTree.h>
 
 #include "engine/voxel_update.h"
-#include "octree/morton_order.h"
-#include "octree/voxel_sort.h"
+#include "octree/voxel_buckets.h"
 #include "octree/worker_pool.h"
 
 namespace ort {
 
 struct BatchedUpdateOptions {
   unsigned threads = 0;  // 0: all hardware threads
-  SortMethod sort = SortMethod::kRadix;
-  // Subtrees per thread to aim for: more balance the load better, each costs a little.
-  unsigned subtrees_per_thread = 8;
+  BucketOptions buckets;
   // Below this many voxels a batch is updated on the calling thread alone.
   size_t min_parallel_voxels = 16384;
-  // Subtrees are cut no deeper than this (1..16): at 0.1 m a depth-12 node is a 1.6 m cube,
-  // already far below any useful grain. Tests cut deeper to exercise the split.
-  unsigned max_split_depth = 12;
 };
 
 // Where the time of the last apply() went, for tools/octree_bench.
 struct BatchedUpdateStats {
-  double sort_ms = 0;      // Morton codes and sort
-  double top_ms = 0;       // split into subtrees, nodes above them made (one thread)
-  double subtrees_ms = 0;  // subtrees updated (all threads)
-  double settle_ms = 0;    // nodes above the split settled, node counter fixed up
-  size_t subtrees = 0;
-  long long node_count_change = 0;  // net nodes made by the worker threads
+  double bucket_ms = 0;    // bucket_voxels (all threads)
+  double top_ms = 0;       // nodes above the buckets made (one thread)
+  double subtrees_ms = 0;  // buckets sorted and updated, nodes above settled (all threads)
+  double sort_cpu_ms = 0;  // of which sorting the buckets, summed over the threads
+  size_t subtrees = 0;     // buckets updated
+  unsigned bucket_depth = 0;
+  long long node_count_change = 0;  // net nodes made by the threads
 };
 
 // Keeps the threads and buffers between scans. One apply() at a time.
@@ -66,10 +68,12 @@ class BatchedOctreeUpdater {
  private:
   BatchedUpdateOptions opts_;
   WorkerPool pool_;
-  // One empty OcTree per worker thread but the calling one: they count the nodes their
-  // thread makes and deletes (node_count.h). Kept because an OcTree is costly to construct.
+  // One empty OcTree per worker: its node methods count the nodes that worker makes and
+  // deletes (node_count.h). Kept because an OcTree is costly to construct.
   std::vector<std::unique_ptr<octomap::OcTree>> counting_trees_;
-  std::vector<SortedVoxel> sorted_, sort_scratch_;
+  std::vector<std::vector<SortedVoxel>> sort_tmp_;  // per worker
+  VoxelBuckets buckets_;
+  BucketScratch bucket_scratch_;
 };
 
 // One-off convenience: makes an updater (and its threads) for this call only.

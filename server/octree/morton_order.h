@@ -1,4 +1,4 @@
-// Morton (Z-order) codes of OcTree keys (voxel_sort.h sorts a scan's list by them).
+// Morton (Z-order) codes of OcTree keys (voxel_buckets.h orders a scan's list by them).
 //
 // The code interleaves the key bits so that its 3-bit groups, read from the top, are exactly
 // the child indices OctoMap takes on the way from the root to the voxel (computeChildIdx: x is

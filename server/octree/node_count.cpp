@@ -1,31 +1,27 @@
 #include "octree/node_count.h"
 
 namespace ort {
+namespace {
 
-void add_to_node_count(octomap::OcTree& tree, octomap::OcTree& helper, int64_t delta) {
-  // Children made for `holder` never join a tree; `holder` must end without a child array
-  // (OcTreeDataNode's destructor expects that), which only pruneNode frees publicly.
-  octomap::OcTreeNode holder;
-  octomap::OcTree& up = delta >= 0 ? tree : helper;    // its createNodeChild counts +1
-  octomap::OcTree& down = delta >= 0 ? helper : tree;  // its deleteNodeChild counts -1
-  uint64_t remaining = delta >= 0 ? static_cast<uint64_t>(delta) : static_cast<uint64_t>(-(delta + 1)) + 1;
+// Never instantiated: only its right to name the protected members of OctoMap's base.
+struct NodeCounterAccess : octomap::OcTree {
+  static size_t& counter(octomap::OcTree& tree) { return tree.*(&NodeCounterAccess::tree_size); }
+  static bool& extent_changed(octomap::OcTree& tree) { return tree.*(&NodeCounterAccess::size_changed); }
+};
 
-  // Eight at a time: expandNode makes 8 equal leaf children, pruneNode deletes them again
-  // together with the child array.
-  for (; remaining >= 8; remaining -= 8) {
-    up.expandNode(&holder);
-    down.pruneNode(&holder);
-  }
-  for (; remaining > 0; --remaining) {
-    up.createNodeChild(&holder, 0);
-    down.deleteNodeChild(&holder, 0);
-  }
-  // Sets the tree's size_changed flag even when delta is 0.
-  tree.createNodeChild(&holder, 0);
-  tree.deleteNodeChild(&holder, 0);
-  // createNodeChild left a child array behind: free it the public way.
-  helper.expandNode(&holder);
-  helper.pruneNode(&holder);
+}  // namespace
+
+void add_to_node_count(octomap::OcTree& tree, int64_t delta) {
+  // Modulo 2^64, as the counter itself goes when a counting tree deletes more than it made.
+  NodeCounterAccess::counter(tree) += static_cast<size_t>(delta);
+  NodeCounterAccess::extent_changed(tree) = true;
+}
+
+int64_t take_node_count(octomap::OcTree& counting) {
+  size_t& c = NodeCounterAccess::counter(counting);
+  const int64_t change = static_cast<int64_t>(c);
+  c = 0;
+  return change;
 }
 
 }  // namespace ort

@@ -1,10 +1,19 @@
 // OctoMap's node counter (OcTree::size(), used by memoryUsage() and written into .ot files)
-// is a plain size_t inside the tree that createNodeChild, expandNode, deleteNodeChild and
-// pruneNode change. Threads that change one tree's nodes at once must not all go through
-// that tree: each calls those methods on its own empty "counting" OcTree instead (they work
-// on any node), whose size() then moves by the thread's net change. Afterwards one
-// thread moves the sum into the real tree with the functions below, through the public API
-// only, so the map stays a plain octomap::OcTree.
+// is a plain size_t inside the tree (OcTreeBaseImpl::tree_size, protected) that
+// createNodeChild, expandNode, deleteNodeChild and pruneNode change. Threads that change one
+// tree's nodes at once must not all go through that tree: each calls those methods on its
+// own empty "counting" OcTree instead (they work on any node), whose counter then holds the
+// thread's net change; afterwards the sum is added to the real tree's counter in O(1).
+//
+// Why an accessor and not a subclass of OcTree for the map: the counter lives in the base
+// class, so a subclass would add nothing but its type, and that type would have to reach
+// every place that makes or reads the map (MapEngine, `octomap-rt build`, the bench, the
+// daemon's map_store, which loads FILE.ot through AbstractOcTree::read and so always gets a
+// plain OcTree back, since the file's id "OcTree" names OcTree's registered prototype). The
+// accessor below is a class derived from OcTree that is never instantiated: a derived class
+// may form a pointer to a protected member of its base ([class.protected]), and that pointer
+// applies to any OcTree. So the map stays a plain octomap::OcTree, its .ot files keep the id
+// "OcTree", and nothing but this file knows about the counter.
 #pragma once
 
 #include <cstdint>
@@ -13,17 +22,14 @@
 
 namespace ort {
 
-// The net change of a counting tree's size() between two readings (modulo 2^64: a counting
-// tree's count may well go "below zero").
-inline int64_t counted_change(size_t size_after, size_t size_before) {
-  return static_cast<int64_t>(size_after - size_before);
-}
-
 // Adds `delta` to tree.size() without changing tree's nodes, and marks the tree's extent as
 // changed (OctoMap recomputes its metric bounds lazily after any node was created or
-// deleted). Costs one allocation and one free per unit of |delta|: it creates (or deletes)
-// children of a node that belongs to no tree, with `tree`'s methods, and undoes that with
-// `helper`'s, an empty OcTree whose own count is of no interest.
-void add_to_node_count(octomap::OcTree& tree, octomap::OcTree& helper, int64_t delta);
+// deleted; nodes made through a counting tree did not tell `tree`).
+void add_to_node_count(octomap::OcTree& tree, int64_t delta);
+
+// The net number of nodes made (made minus deleted) through `counting` since the last call,
+// and the counter back at zero. `counting` must hold no root (its counter then counts only
+// what other trees' nodes were changed by through it).
+int64_t take_node_count(octomap::OcTree& counting);
 
 }  // namespace ort

@@ -1,47 +1,53 @@
-// The few nodes above the subtrees that the threads update. One thread walks down to every
-// subtree's node before the threads start (creating or expanding nodes on the way, as
-// updateNode would), so that no two threads ever touch the same node; after the threads are
-// done it settles the nodes above them (prune, or max of the children), children first.
+// The few nodes above the buckets that the threads update. One thread walks down to every
+// bucket's node before the threads start (creating or expanding nodes on the way, as
+// updateNode would), so that no two threads ever touch the same node. There is no serial
+// pass afterwards: each node above the buckets counts the children it waits for, and the
+// thread that finishes its last child settles it (prune, or max of the children) and
+// reports to its parent, up to the root.
 #pragma once
 
-#include <span>
+#include <atomic>
+#include <memory>
 #include <vector>
 
 #include <octomap/OcTree.h>
 
-#include "octree/morton_order.h"
-#include "octree/subtree_split.h"
 #include "octree/subtree_update.h"
+#include "octree/voxel_buckets.h"
 
 namespace ort {
 
 struct PlannedSubtree {
   SubtreeRoot root;
-  size_t begin = 0, end = 0;  // its voxels in the sorted batch
-  int parent = -1;            // index into SplitTop::nodes
-  bool changed = false;       // set by the thread that updated it
+  size_t bucket = 0;  // index into VoxelBuckets
+  int parent = -1;    // index into SplitTop::nodes
 };
 
-struct SplitTop {
+class SplitTop {
+ public:
   struct Node {
     octomap::OcTreeNode* node;
     int parent;  // -1 for the root
     bool just_created;
-    bool changed;
   };
-  std::vector<Node> nodes;               // root first
-  std::vector<int> settle_order;         // indices into nodes, each node after its children
-  std::vector<PlannedSubtree> subtrees;  // those that have voxels to apply, in Morton order
+
+  // The buckets lie below the root (depth >= 1); the tree's root must exist. A bucket whose
+  // path runs into a pruned node that is at the clamping bound for all its voxels is left out:
+  // updateNode would return early for each of them.
+  SplitTop(octomap::OcTree& tree, VoxelBuckets& buckets);
+
+  const std::vector<PlannedSubtree>& subtrees() const { return subtrees_; }
+
+  // Called once per child (planned subtree, or node of the top) when it is done; `changed`:
+  // a voxel below it was applied. The last child's thread settles the parent with
+  // `node_ops`'s node methods (see subtree_update.h), and so on upwards. Thread-safe.
+  void child_done(int parent, bool changed, octomap::OcTree& node_ops);
+
+ private:
+  std::vector<Node> nodes_;  // root first, each node after its parent
+  std::vector<PlannedSubtree> subtrees_;  // in Morton order
+  std::unique_ptr<std::atomic<int>[]> pending_;  // children not yet done, per node
+  std::unique_ptr<std::atomic<bool>[]> changed_;
 };
-
-// `ranges` come from split_into_subtrees and lie below the root (depth >= 1); the tree's
-// root must exist. A range whose path runs into a pruned node that is at the clamping bound
-// for all its voxels is left out: updateNode would return early for each of them.
-SplitTop build_split_top(octomap::OcTree& tree, std::span<const SortedVoxel> voxels,
-                         std::span<const SubtreeRange> ranges);
-
-// Call after every subtree ran (their `changed` set): settles each node above a changed
-// subtree, with the tree's own methods, on one thread.
-void settle_split_top(octomap::OcTree& tree, SplitTop& top);
 
 }  // namespace ort

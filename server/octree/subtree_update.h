@@ -31,7 +31,7 @@ struct SubtreeRoot {
 //
 // Values and the sensor model come from `tree` (updateNodeLogOdds, read only). Nodes are
 // created, expanded and pruned through `node_ops`, which is `tree` itself or, when several
-// threads update one tree, a per-thread OcTree that only counts the nodes (OctoMap's node
+// threads update one tree, the thread's own OcTree that only counts the nodes (OctoMap's node
 // counter is a plain size_t; see node_count.h).
 bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, const SubtreeRoot& root,
                     std::span<const SortedVoxel> voxels);

@@ -1,13 +1,10 @@
-// Morton codes follow OctoMap's own child order, and both sorts give the same order.
-#include <algorithm>
+// Morton codes follow OctoMap's own child order.
 #include <random>
 
 #include <gtest/gtest.h>
 #include <octomap/OcTreeKey.h>
 
 #include "octree/morton_order.h"
-#include "octree/voxel_sort.h"
-#include "octree/subtree_split.h"
 
 namespace ort {
 namespace {
@@ -60,66 +57,6 @@ TEST(MortonOrder, SharedPathDepth) {
     if (a == b) continue;
     const SortedVoxel va = make_sorted_voxel(make_update(a, true)), vb = make_sorted_voxel(make_update(b, false));
     ASSERT_EQ(shared_path_depth(va, vb), shared_depth_by_walk(a, b));
-  }
-}
-
-VoxelList random_unique_list(std::mt19937& rng, size_t n, int lo, int hi) {
-  std::uniform_int_distribution<int> key(lo, hi);
-  VoxelList list;
-  octomap::KeySet seen;
-  while (list.size() < n) {
-    const octomap::OcTreeKey k(key(rng), key(rng), key(rng));
-    if (seen.insert(k).second) list.push_back(make_update(k, rng() % 3 == 0));
-  }
-  return list;
-}
-
-TEST(MortonOrder, RadixSortEqualsStdSort) {
-  std::mt19937 rng(3);
-  WorkerPool pool(3);
-  for (auto [n, lo, hi] : {std::tuple{0, 0, 1}, {1, 0, 65535}, {1000, 32700, 32800}, {200000, 0, 65535},
-                           {100000, 32000, 33000}, {60000, 32760, 32800}, {50000, 0, 40}}) {
-    const VoxelList list = random_unique_list(rng, n, lo, hi);
-    std::vector<SortedVoxel> radix, pooled, standard, scratch;
-    sort_voxels(list, radix, scratch, SortMethod::kRadix);
-    sort_voxels(list, pooled, scratch, SortMethod::kRadix, &pool);
-    sort_voxels(list, standard, scratch, SortMethod::kStd);
-    ASSERT_EQ(radix, standard) << n << " voxels in [" << lo << "," << hi << "]";
-    ASSERT_EQ(pooled, standard) << n << " voxels in [" << lo << "," << hi << "], 3 threads";
-    ASSERT_TRUE(std::is_sorted(radix.begin(), radix.end()));
-    ASSERT_EQ(radix.size(), list.size());
-  }
-}
-
-TEST(SubtreeSplit, RangesAreDisjointSubtreesCoveringAll) {
-  std::mt19937 rng(5);
-  const VoxelList list = random_unique_list(rng, 50000, 32600, 32900);
-  std::vector<SortedVoxel> sorted, scratch;
-  sort_voxels(list, sorted, scratch);
-  for (size_t grain : {size_t{1}, size_t{100}, size_t{5000}, size_t{1000000}}) {
-    for (unsigned max_depth : {1u, 4u, 12u, 16u}) {
-      const std::vector<SubtreeRange> ranges = split_into_subtrees(sorted, grain, max_depth);
-      ASSERT_FALSE(ranges.empty());
-      size_t next = 0;
-      for (const SubtreeRange& r : ranges) {
-        ASSERT_EQ(r.begin, next);
-        ASSERT_LT(r.begin, r.end);
-        ASSERT_LE(r.depth, max_depth);
-        next = r.end;
-        ASSERT_TRUE(r.end - r.begin <= grain || r.depth == max_depth);
-        // All voxels of a range below one node at r.depth, and none of its neighbours.
-        const unsigned shift = 3 * (kTreeDepth - r.depth) + 1;
-        const uint64_t prefix = r.depth == 0 ? 0 : sorted[r.begin] >> shift;
-        for (size_t i = r.begin; i < r.end; ++i) ASSERT_EQ(r.depth == 0 ? 0 : sorted[i] >> shift, prefix);
-        if (r.depth > 0 && r.begin > 0) {
-          ASSERT_NE(sorted[r.begin - 1] >> shift, prefix);
-        }
-        if (r.depth > 0 && r.end < sorted.size()) {
-          ASSERT_NE(sorted[r.end] >> shift, prefix);
-        }
-      }
-      ASSERT_EQ(next, sorted.size());
-    }
   }
 }
 

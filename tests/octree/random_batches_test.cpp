@@ -147,21 +147,22 @@ struct Variant {
 std::vector<Variant> variants() {
   std::vector<Variant> out;
   for (unsigned threads : {1u, 2u, 7u, 16u}) {
-    BatchedUpdateOptions deep;  // split as finely as possible: many subtrees, pruned nodes above them
+    BatchedUpdateOptions deep;  // buckets as deep as possible: many, pruned nodes above them
     deep.threads = threads;
     deep.min_parallel_voxels = 0;
-    deep.subtrees_per_thread = 64;
-    deep.max_split_depth = 16;
-    out.push_back({std::to_string(threads) + " threads, deep split", deep});
+    deep.buckets.voxels_per_cell = 1;
+    deep.buckets.max_cells = 1 << 20;
+    deep.buckets.min_shift = 1;
+    out.push_back({std::to_string(threads) + " threads, deep buckets", deep});
   }
   BatchedUpdateOptions shallow;  // the production defaults but for tiny batches
   shallow.threads = 7;
   shallow.min_parallel_voxels = 0;
-  out.push_back({"7 threads, default split", shallow});
-  BatchedUpdateOptions with_std_sort = shallow;
-  with_std_sort.threads = 2;
-  with_std_sort.sort = SortMethod::kStd;
-  out.push_back({"2 threads, std::sort", with_std_sort});
+  out.push_back({"7 threads, default buckets", shallow});
+  BatchedUpdateOptions coarse = shallow;  // the root's 8 children as the buckets
+  coarse.threads = 2;
+  coarse.buckets.min_shift = 15;
+  out.push_back({"2 threads, buckets at depth 1", coarse});
   return out;
 }
 

@@ -1,4 +1,4 @@
-# The fast CPU octree stage (issue 3): Morton order, node counter fix-up, and the batched,
+# The fast CPU octree stage (issue 3): Morton order, buckets, the node counter, and the batched,
 # multi-threaded update checked node for node against OctoMap's updateNode loop, on random
 # batches and on the real data sets, after every scan.
 # OCTOMAP_RT_OCTREE_TEST_QUICK=1 shortens the long cases (tools/run-tests uses it under TSan).
@@ -6,6 +6,7 @@ octomap_rt_add_test(octree_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/morton_order_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/node_count_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/random_batches_test.cpp
+          ${CMAKE_CURRENT_LIST_DIR}/voxel_buckets_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/real_data_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp
   TIMEOUT 900)

@@ -21,7 +21,7 @@
 #include "engine/map_engine.h"
 #include "octree/batched_update.h"
 #include "octree/morton_order.h"
-#include "octree/voxel_sort.h"
+#include "octree/voxel_buckets.h"
 #include "scene/scan_set.h"
 
 namespace {
@@ -96,25 +96,35 @@ int main(int argc, char** argv) {
     const DataSet d = shoot_lists(data_dir + "/" + g, resolution);
     std::printf("%s: %zu scans, %zu voxel updates per pass\n", d.name.c_str(), d.lists.size(), d.voxels);
 
-    // Sorting alone: radix (1 thread and all) vs std::sort on the same lists.
+    // Ordering alone: the stage's bucketing plus a sort of every bucket on 1 thread, and the
+    // bucketing on all threads, against std::sort of the whole list's Morton codes.
     {
-      std::vector<ort::SortedVoxel> out, scratch;
+      std::vector<ort::SortedVoxel> codes, tmp;
+      ort::VoxelBuckets buckets;
+      ort::BucketScratch scratch;
       ort::WorkerPool pool(hw);
-      double radix = 1e300, radix_pool = 1e300, standard = 1e300;
+      double one = 1e300, standard = 1e300, bucket_all = 1e300;
       for (int r = 0; r < repeat; ++r) {
         auto t = Clock::now();
-        for (const auto& l : d.lists) ort::sort_voxels(l, out, scratch, ort::SortMethod::kRadix);
-        radix = std::min(radix, ms_since(t));
+        for (const auto& l : d.lists) {
+          ort::bucket_voxels(l, ort::BucketOptions{}, nullptr, buckets, scratch);
+          for (size_t b = 0; b < buckets.count(); ++b) ort::sort_bucket(buckets.bucket(b), tmp);
+        }
+        one = std::min(one, ms_since(t));
         t = Clock::now();
-        for (const auto& l : d.lists) ort::sort_voxels(l, out, scratch, ort::SortMethod::kRadix, &pool);
-        radix_pool = std::min(radix_pool, ms_since(t));
+        for (const auto& l : d.lists) ort::bucket_voxels(l, ort::BucketOptions{}, &pool, buckets, scratch);
+        bucket_all = std::min(bucket_all, ms_since(t));
         t = Clock::now();
-        for (const auto& l : d.lists) ort::sort_voxels(l, out, scratch, ort::SortMethod::kStd);
+        for (const auto& l : d.lists) {
+          codes.clear();
+          for (const ort::VoxelUpdate& u : l) codes.push_back(ort::make_sorted_voxel(u));
+          std::sort(codes.begin(), codes.end());
+        }
         standard = std::min(standard, ms_since(t));
       }
-      std::printf("  Morton sort per pass: std::sort %.2f ms, radix 1 thread %.2f ms (%.1fx), radix %u threads "
-                  "%.2f ms (%.1fx)\n",
-                  standard, radix, standard / radix, hw, radix_pool, standard / radix_pool);
+      std::printf("  Morton order per pass: std::sort %.2f ms; buckets + bucket sorts, 1 thread %.2f ms (%.1fx, "
+                  "%.1f ns/voxel); bucketing alone on %u threads %.2f ms\n",
+                  standard, one, standard / one, one * 1e6 / double(d.voxels), hw, bucket_all);
     }
 
     std::vector<std::unique_ptr<ort::BatchedOctreeUpdater>> batched;
@@ -140,10 +150,11 @@ int main(int argc, char** argv) {
         for (int p = 0; p < passes; ++p)
           for (const auto& l : d.lists) {
             batched[i]->apply(tree, l, &one);
-            sum.sort_ms += one.sort_ms;
+            sum.bucket_ms += one.bucket_ms;
             sum.top_ms += one.top_ms;
             sum.subtrees_ms += one.subtrees_ms;
-            sum.settle_ms += one.settle_ms;
+            sum.sort_cpu_ms += one.sort_cpu_ms;
+            sum.bucket_depth = one.bucket_depth;
             sum.subtrees += one.subtrees;
             sum.node_count_change += one.node_count_change;
           }
@@ -160,11 +171,12 @@ int main(int argc, char** argv) {
                 octomap_time.best_ms * 1e6 / passes_voxels, nodes);
     for (size_t i = 0; i < threads.size(); ++i) {
       const Timing& b = batched_time[i];
-      std::printf("  batched, %2u thread(s):   %9.1f ms  (%.0f ns/voxel)  %6.1fx   [sort %.1f, top %.1f, "
-                  "subtrees %.1f, settle+count %.1f ms; %zu subtrees, %lld nodes counted in]\n",
+      std::printf("  batched, %2u thread(s):   %9.1f ms  (%.0f ns/voxel)  %6.1fx   [buckets %.1f, top %.1f, "
+                  "subtrees %.1f (of which bucket sorts %.1f thread-ms) ms; %zu buckets at depth %u, %lld nodes "
+                  "counted in]\n",
                   threads[i], b.best_ms, b.best_ms * 1e6 / passes_voxels, octomap_time.best_ms / b.best_ms,
-                  b.stats.sort_ms, b.stats.top_ms, b.stats.subtrees_ms, b.stats.settle_ms, b.stats.subtrees,
-                  b.stats.node_count_change);
+                  b.stats.bucket_ms, b.stats.top_ms, b.stats.subtrees_ms, b.stats.sort_cpu_ms, b.stats.subtrees,
+                  b.stats.bucket_depth, b.stats.node_count_change);
     }
     std::printf("\n");
   }

@@ -1,0 +1,253 @@
+#include "octree/voxel_buckets.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cstring>
+
+namespace ort {
+namespace {
+
+constexpr size_t kParallelMin = 32768;  // below this the threads cost more than they save
+constexpr size_t kAxisWords = 1024;     // 65536 bits: one per key coordinate
+constexpr size_t kInsertionMax = 32;
+
+// Runs body(worker) on the pool's workers, or once on this thread without a pool.
+template <class F>
+void run_on(WorkerPool* pool, unsigned workers, F&& body) {
+  if (workers <= 1 || !pool) {
+    body(0u);
+    return;
+  }
+  pool->run([&](unsigned w) {
+    if (w < workers) body(w);
+  });
+}
+
+// Bit g * 2^shift of the result is set iff a bit of [g * 2^shift, (g + 1) * 2^shift) is
+// (shift < 6: the groups lie inside the word).
+uint64_t fold_groups(uint64_t v, unsigned shift) {
+  static constexpr std::array<uint64_t, 6> kGroupStarts{~0ull, 0x5555555555555555ull, 0x1111111111111111ull,
+                                                        0x0101010101010101ull, 0x0001000100010001ull,
+                                                        0x0000000100000001ull};
+  for (unsigned j = 0; j < shift; ++j) v |= v >> (1u << j);
+  return v & kGroupStarts[shift];
+}
+
+// Whether a coordinate of node g at depth 16 - shift occurs (bits: one per key coordinate).
+bool group_occupied(const uint64_t* bits, unsigned shift, size_t g) {
+  if (shift >= 6) {
+    const size_t words = size_t{1} << (shift - 6);
+    uint64_t any = 0;
+    for (size_t w = g * words; w < (g + 1) * words; ++w) any |= bits[w];
+    return any != 0;
+  }
+  const size_t bit = g << shift;
+  return ((fold_groups(bits[bit >> 6], shift) >> (bit & 63)) & 1u) != 0;
+}
+
+size_t occupied_groups(const uint64_t* bits, unsigned shift) {
+  size_t n = 0;
+  if (shift >= 6) {
+    for (size_t g = 0; g < (size_t{1} << (16 - shift)); ++g) n += group_occupied(bits, shift, g);
+    return n;
+  }
+  for (size_t w = 0; w < kAxisWords; ++w) n += static_cast<size_t>(std::popcount(fold_groups(bits[w], shift)));
+  return n;
+}
+
+// Per axis: cell_of[v] = rank of node coordinate v among the occupied ones, times the
+// axis's stride; node_of[rank] = v.
+unsigned build_rank_table(const uint64_t* bits, unsigned shift, uint32_t stride, std::vector<uint32_t>& cell_of,
+                          std::vector<uint16_t>& node_of) {
+  const size_t nodes = size_t{1} << (16 - shift);
+  cell_of.assign(nodes, 0);
+  node_of.clear();
+  for (size_t g = 0; g < nodes; ++g) {
+    if (!group_occupied(bits, shift, g)) continue;
+    cell_of[g] = static_cast<uint32_t>(node_of.size()) * stride;
+    node_of.push_back(static_cast<uint16_t>(g));
+  }
+  return static_cast<unsigned>(node_of.size());
+}
+
+// A voxel's cell: the sum of its three coordinates' entries of the rank tables.
+struct CellOf {
+  const uint32_t *x, *y, *z;
+  unsigned shift;
+  uint32_t operator()(const VoxelUpdate& u) const { return x[u.x >> shift] + y[u.y >> shift] + z[u.z >> shift]; }
+};
+
+// Stable insertion sort on the code (bit 0, the state, is not part of the order).
+void insertion_sort(SortedVoxel* v, size_t n) {
+  for (size_t i = 1; i < n; ++i) {
+    const SortedVoxel x = v[i];
+    size_t j = i;
+    for (; j > 0 && (v[j - 1] >> 1) > (x >> 1); --j) v[j] = v[j - 1];
+    v[j] = x;
+  }
+}
+
+}  // namespace
+
+void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& opts, WorkerPool* pool,
+                   VoxelBuckets& out, BucketScratch& scratch) {
+  const size_t n = updates.size();
+  out.voxels.resize(n);
+  out.begin.clear();
+  out.depth = 0;
+  if (n == 0) return;
+  const unsigned workers = (pool && n >= kParallelMin) ? pool->size() : 1;
+  auto chunk_begin = [&](unsigned w) { return n * w / workers; };
+
+  // Pass 1: which key coordinates occur, per axis. Plain byte stores (consecutive voxels
+  // mostly repeat a coordinate, and read-modify-writes of one word would chain them), then
+  // each worker packs its bytes into bits.
+  scratch.seen.resize(size_t{workers} * 3 * 65536);
+  scratch.occupied.resize(size_t{workers} * 3 * kAxisWords);
+  run_on(pool, workers, [&](unsigned w) {
+    uint8_t* seen = &scratch.seen[size_t{w} * 3 * 65536];
+    std::fill_n(seen, 3 * 65536, uint8_t{0});
+    const VoxelUpdate* u = updates.data();
+    for (size_t i = chunk_begin(w), e = chunk_begin(w + 1); i < e; ++i) {
+      seen[u[i].x] = 1;
+      seen[65536 + u[i].y] = 1;
+      seen[2 * 65536 + u[i].z] = 1;
+    }
+    uint64_t* bits = &scratch.occupied[size_t{w} * 3 * kAxisWords];
+    for (size_t word = 0; word < 3 * kAxisWords; ++word) {
+      uint64_t packed = 0;
+      for (unsigned k = 0; k < 8; ++k) {
+        uint64_t bytes;  // eight 0/1 bytes
+        std::memcpy(&bytes, seen + word * 64 + k * 8, 8);
+        // The multiplication moves byte j's bit to bit 56 + j, without carries.
+        packed |= ((bytes * 0x0102040810204080ull) >> 56) << (k * 8);
+      }
+      bits[word] = packed;
+    }
+  });
+  for (unsigned w = 1; w < workers; ++w)
+    for (size_t i = 0; i < 3 * kAxisWords; ++i) scratch.occupied[i] |= scratch.occupied[size_t{w} * 3 * kAxisWords + i];
+  const uint64_t* axis_bits[3] = {&scratch.occupied[0], &scratch.occupied[kAxisWords],
+                                  &scratch.occupied[2 * kAxisWords]};
+
+  // The deepest depth whose cells fit the budget.
+  const size_t budget = std::min(opts.max_cells, std::max<size_t>(64, n / std::max(1u, opts.voxels_per_cell)));
+  unsigned shift = std::clamp(opts.min_shift, 1u, 15u);
+  for (; shift < 15; ++shift) {
+    size_t cells = 1;
+    for (const uint64_t* bits : axis_bits) cells *= occupied_groups(bits, shift);
+    if (cells <= budget) break;
+  }
+  out.depth = kTreeDepth - shift;
+  std::array<std::vector<uint16_t>, 3> node_of;
+  const unsigned nx = build_rank_table(axis_bits[0], shift, 1, scratch.cell_of_axis[0], node_of[0]);
+  const unsigned ny = build_rank_table(axis_bits[1], shift, nx, scratch.cell_of_axis[1], node_of[1]);
+  const unsigned nz = build_rank_table(axis_bits[2], shift, nx * ny, scratch.cell_of_axis[2], node_of[2]);
+  const size_t cells = size_t{nx} * ny * nz;
+  const CellOf cell_of{scratch.cell_of_axis[0].data(), scratch.cell_of_axis[1].data(),
+                      scratch.cell_of_axis[2].data(), shift};
+
+  // Pass 2: voxels per cell, per worker.
+  scratch.counts.assign(size_t{workers} * cells, 0);
+  run_on(pool, workers, [&, cell_of](unsigned w) {
+    uint32_t* count = &scratch.counts[size_t{w} * cells];
+    const VoxelUpdate* u = updates.data();
+    if (chunk_begin(w) == chunk_begin(w + 1)) return;
+    // Runs of voxels in one cell (a ray's) are counted in a register, not through memory.
+    uint32_t cell = cell_of(u[chunk_begin(w)]), run = 0;
+    for (size_t i = chunk_begin(w), e = chunk_begin(w + 1); i < e; ++i) {
+      const uint32_t c = cell_of(u[i]);
+      if (c != cell) {
+        count[cell] += run;
+        cell = c;
+        run = 0;
+      }
+      ++run;
+    }
+    count[cell] += run;
+  });
+
+  // Occupied cells in Morton order of their nodes; each worker's part of a bucket after the
+  // parts of the workers before it, so the buckets keep the list's order.
+  scratch.nonempty.clear();
+  for (size_t c = 0; c < cells; ++c) {
+    uint32_t total = 0;
+    for (unsigned w = 0; w < workers; ++w) total += scratch.counts[size_t{w} * cells + c];
+    if (total == 0) continue;
+    const size_t rx = c % nx, ry = c / nx % ny, rz = c / (size_t{nx} * ny);
+    scratch.nonempty.emplace_back(morton_code(node_of[0][rx], node_of[1][ry], node_of[2][rz]),
+                                  static_cast<uint32_t>(c));
+  }
+  std::sort(scratch.nonempty.begin(), scratch.nonempty.end());
+  out.begin.reserve(scratch.nonempty.size() + 1);
+  size_t offset = 0;
+  for (const auto& [code, c] : scratch.nonempty) {
+    out.begin.push_back(offset);
+    for (unsigned w = 0; w < workers; ++w) {
+      uint32_t& slot = scratch.counts[size_t{w} * cells + c];
+      const uint32_t k = slot;
+      slot = static_cast<uint32_t>(offset);
+      offset += k;
+    }
+  }
+  out.begin.push_back(n);
+
+  // Pass 3: scatter.
+  SortedVoxel* dst = out.voxels.data();
+  run_on(pool, workers, [&, cell_of, dst](unsigned w) {
+    uint32_t* next = &scratch.counts[size_t{w} * cells];
+    const VoxelUpdate* u = updates.data();
+    if (chunk_begin(w) == chunk_begin(w + 1)) return;
+    uint32_t cell = cell_of(u[chunk_begin(w)]), pos = next[cell];
+    for (size_t i = chunk_begin(w), e = chunk_begin(w + 1); i < e; ++i) {
+      const uint32_t c = cell_of(u[i]);
+      if (c != cell) {
+        next[cell] = pos;
+        cell = c;
+        pos = next[c];
+      }
+      dst[pos++] = make_sorted_voxel(u[i]);
+    }
+    next[cell] = pos;
+  });
+}
+
+void sort_bucket(std::span<SortedVoxel> bucket, std::vector<SortedVoxel>& tmp) {
+  const size_t n = bucket.size();
+  SortedVoxel* data = bucket.data();
+  if (n <= kInsertionMax) {
+    insertion_sort(data, n);
+    return;
+  }
+  uint64_t varying = 0;
+  for (size_t i = 0; i < n; ++i) varying |= data[i] ^ data[0];
+  varying >>= 1;  // the code's bits
+  if (varying == 0) return;
+  // LSD radix passes of at most 8 bits over the varying code bits, all counted in one read.
+  const unsigned bits = 64u - static_cast<unsigned>(std::countl_zero(varying));
+  const unsigned passes = (bits + 7) / 8;
+  const unsigned digit = (bits + passes - 1) / passes;
+  const uint64_t mask = (uint64_t{1} << digit) - 1;
+  std::array<std::array<uint32_t, 256>, 8> count;
+  for (unsigned p = 0; p < passes; ++p) std::fill_n(count[p].begin(), mask + 1, 0u);
+  for (size_t i = 0; i < n; ++i)
+    for (unsigned p = 0; p < passes; ++p) ++count[p][(data[i] >> (1 + p * digit)) & mask];
+  tmp.resize(std::max(tmp.size(), n));
+  SortedVoxel* src = data;
+  SortedVoxel* dst = tmp.data();
+  for (unsigned p = 0; p < passes; ++p) {
+    uint32_t offset = 0;
+    for (uint64_t d = 0; d <= mask; ++d) {
+      const uint32_t k = count[p][d];
+      count[p][d] = offset;
+      offset += k;
+    }
+    const unsigned shift = 1 + p * digit;
+    for (size_t i = 0; i < n; ++i) dst[count[p][(src[i] >> shift) & mask]++] = src[i];
+    std::swap(src, dst);
+  }
+  if (src != data) std::copy(src, src + n, data);
+}
+
+}  // namespace ort

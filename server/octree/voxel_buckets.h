@@ -1,0 +1,64 @@
+// One scan's voxel list cut into subtrees for the octree stage's threads, without sorting the
+// whole list: every voxel goes into the bucket of its node at one depth D (its "cell"), the
+// buckets in Morton order of their nodes, and each bucket is sorted on its own later, by the
+// thread that updates it, while it sits in that thread's cache.
+//
+// Why not a global Morton sort: a scan around the map origin varies in every key bit
+// (0x7fff -> 0x8000), so a sort of whole codes either makes extra passes or splits the list
+// into only the 8 octants first; and it is a pass over the whole list that the threads must
+// wait for. Here the cells are numbered densely per axis: only node coordinates some voxel
+// has count (a rank table per axis), so D can be deep even when the scan's voxels are spread
+// over the whole key range, and the three passes (occupied coordinates, counts, scatter) are
+// split over the threads with nothing serial but the choice of D and the prefix sums over
+// the cells.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "engine/voxel_update.h"
+#include "octree/morton_order.h"
+#include "octree/worker_pool.h"
+
+namespace ort {
+
+struct BucketOptions {
+  // Cells (nodes at depth D in the box of occupied node coordinates) allowed per voxel of the
+  // list: D is the deepest with at most max(64, size / voxels_per_cell) cells. More cells:
+  // smaller buckets (better balance, cheaper sorts), more nodes above them to make first.
+  unsigned voxels_per_cell = 32;
+  size_t max_cells = 65536;
+  // Buckets are nodes of at least 2^min_shift voxels a side (D <= 16 - min_shift), and never
+  // the root (D >= 1).
+  unsigned min_shift = 3;
+};
+
+struct VoxelBuckets {
+  std::vector<SortedVoxel> voxels;  // grouped by bucket, buckets in Morton order
+  std::vector<size_t> begin;        // bucket b is voxels[begin[b], begin[b + 1])
+  unsigned depth = 0;               // D: every bucket holds the voxels below one node at D
+
+  size_t count() const { return begin.empty() ? 0 : begin.size() - 1; }
+  std::span<SortedVoxel> bucket(size_t b) { return {voxels.data() + begin[b], begin[b + 1] - begin[b]}; }
+};
+
+// Reused storage of bucket_voxels (per-thread counts, rank tables).
+struct BucketScratch {
+  std::vector<uint8_t> seen;       // [worker][axis][65536]: key coordinates that occur
+  std::vector<uint64_t> occupied;  // [worker][axis][1024 words]: the same as bits; worker 0's: all
+  std::vector<uint32_t> counts;    // [worker][cell]
+  std::vector<uint32_t> cell_of_axis[3];
+  std::vector<std::pair<uint64_t, uint32_t>> nonempty;  // (node code, cell)
+};
+
+// Buckets `updates` (order within a bucket: the list's order). Keys may repeat.
+// With a pool the passes are spread over its workers (not from inside a run of the same pool).
+void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& opts, WorkerPool* pool,
+                   VoxelBuckets& out, BucketScratch& scratch);
+
+// Sorts one bucket into Morton order (stable: a repeated key keeps the list's order of its
+// updates). `tmp` is reused storage.
+void sort_bucket(std::span<SortedVoxel> bucket, std::vector<SortedVoxel>& tmp);
+
+}  // namespace ort
