@@ -1,7 +1,7 @@
 // The `rt` back end (ray-tracing pipeline) against the `vulkan` compute back end and the
 // exact CPU reference, in exact mode: >= 10^5 random rays (axis-aligned, in faces, through
 // edges and corners, zero-length, near the key edge, cut at max range) and the real data
-// sets, with the default shared space and with a small one that forces many windows.
+// sets, with the default block grid and with a small one that forces many windows.
 //
 // Where the device has no ray tracing (lavapipe in CI), the clean refusal is what is tested
 // and the GPU comparisons are skipped.
@@ -199,7 +199,7 @@ void compare_on_real_data(const rt::RtOptions& knobs, bool check_reference_on_fi
         EXPECT_TRUE(equal_vk) << c.file << " @" << c.resolution << " scan " << scan << ": rt " << got.size()
                                   << " voxels, vulkan " << other.size();
       }
-      std::printf("%s res %.2f max_range %.0f scan %d: %zu rays, %zu voxels, %llu window(s), k=%d space %dx%dx%d%s\n",
+      std::printf("%s res %.2f max_range %.0f scan %d: %zu rays, %zu voxels, %llu window(s), k=%d block grid %dx%dx%d%s\n",
                   c.file, c.resolution, c.max_range, scan, batch.ends.size(), got.size(),
                   (unsigned long long)stats.windows, info.block_grid.block, info.block_grid.voxels(0), info.block_grid.voxels(1),
                   info.block_grid.voxels(2), equal_vk ? ", equal to vulkan" : (vk ? ", DIFFERENT from vulkan" : ""));

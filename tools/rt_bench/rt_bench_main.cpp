@@ -134,7 +134,7 @@ int main(int argc, char** argv) {
         s.batch = ort::prepare_scan(s.origin, pts, max_range, res, report);
         if (!report.origin_ok) continue;
         rays += s.batch.ends.size();
-        // The shared ray space covers the largest scan (paper IV-B: sized from the sensor's
+        // The block grid covers the largest scan (paper IV-B: sized from the sensor's
         // local extent), plus the one-voxel window margin on each side.
         for (int i = 0; i < 3; ++i) extent[i] = std::max(extent[i], s.batch.keys.hi[i] - s.batch.keys.lo[i] + 3);
         scans.push_back(std::move(s));
