@@ -1,0 +1,136 @@
+#include "status_json.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "status_text.h"
+
+namespace ort::status {
+namespace {
+
+// Writes "key": value pairs separated by commas; the caller writes the braces.
+class Fields {
+ public:
+  explicit Fields(std::ostringstream& o) : o_(o) {}
+  Fields& raw(const char* key, const std::string& json) {
+    o_ << (first_ ? "" : ",") << '"' << key << "\":" << json;
+    first_ = false;
+    return *this;
+  }
+  Fields& num(const char* key, int64_t v) { return raw(key, std::to_string(v)); }
+  Fields& num(const char* key, double v) {
+    if (!std::isfinite(v)) return raw(key, "null");  // JSON has no NaN or infinity
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return raw(key, buf);
+  }
+  Fields& str(const char* key, const std::string& v) { return raw(key, json_string(v)); }
+  Fields& flag(const char* key, bool v) { return raw(key, v ? "true" : "false"); }
+
+ private:
+  std::ostringstream& o_;
+  bool first_ = true;
+};
+
+std::string robot_json(const octomap_rt::robot_stats_t& r) {
+  std::ostringstream o, reasons;
+  reasons << "{";
+  for (size_t i = 0; i < std::min(r.reject_reason.size(), r.reject_count.size()); ++i)
+    reasons << (i ? "," : "") << json_string(r.reject_reason[i]) << ":" << r.reject_count[i];
+  reasons << "}";
+  o << "{";
+  Fields(o)
+      .str("robot_id", r.robot_id)
+      .str("channel", r.channel)
+      .num("last_scan_utime", r.last_scan_utime)
+      .num("last_seq", r.last_seq)
+      .num("scans_received", r.scans_received)
+      .num("scans_applied", r.scans_applied)
+      .num("scans_rejected", r.scans_rejected)
+      .num("scans_dropped", r.scans_dropped)
+      .num("scans_missed", r.scans_missed)
+      .num("points_applied", r.points_applied)
+      .num("queue_depth", int64_t(r.queue_depth))
+      .num("queue_bytes", r.queue_bytes)
+      .num("last_end_to_end_ms", double(r.last_end_to_end_ms))
+      .raw("reject_reasons", reasons.str());
+  o << "}";
+  return o.str();
+}
+
+}  // namespace
+
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (unsigned char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += char(c);
+    } else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += char(c);
+    }
+  }
+  return out + "\"";
+}
+
+std::string status_json(const octomap_rt::server_status_t& s) {
+  std::ostringstream o, robots;
+  robots << "[";
+  for (size_t i = 0; i < s.robots.size(); ++i) robots << (i ? "," : "") << robot_json(s.robots[i]);
+  robots << "]";
+  o << "{";
+  Fields(o)
+      .num("utime", s.utime)
+      .num("seq", s.seq)
+      .str("server_id", s.server_id)
+      .str("host", s.host)
+      .num("pid", int64_t(s.pid))
+      .num("start_utime", s.start_utime)
+      .num("uptime_s", s.uptime_s)
+      .num("state", int64_t(s.state))
+      .str("state_name", state_name(s.state))
+      .str("message", s.message)
+      .str("backend", s.backend)
+      .str("device", s.device)
+      .flag("pipelined", s.pipelined)
+      .num("resolution", s.resolution)
+      .num("num_nodes", s.num_nodes)
+      .num("num_leaf_nodes", s.num_leaf_nodes)
+      .num("memory_bytes", s.memory_bytes)
+      .str("map_path", s.map_path)
+      .num("map_saves", s.map_saves)
+      .num("last_save_utime", s.last_save_utime)
+      .num("scan_queue_depth", int64_t(s.scan_queue_depth))
+      .num("scan_queue_bytes", s.scan_queue_bytes)
+      .num("queue_budget_bytes", s.queue_budget_bytes)
+      .str("queue_policy", s.queue_policy)
+      .num("shot_queue_depth", int64_t(s.shot_queue_depth))
+      .num("scans_applied", s.scans_applied)
+      .num("points_applied", s.points_applied)
+      .num("scans_per_s", double(s.scans_per_s))
+      .num("points_per_s", double(s.points_per_s))
+      .num("shoot_ms_p50", double(s.shoot_ms_p50))
+      .num("shoot_ms_p99", double(s.shoot_ms_p99))
+      .num("octree_ms_p50", double(s.octree_ms_p50))
+      .num("octree_ms_p99", double(s.octree_ms_p99))
+      .num("end_to_end_ms_p50", double(s.end_to_end_ms_p50))
+      .num("end_to_end_ms_p99", double(s.end_to_end_ms_p99))
+      .num("stage1_busy_s", s.stage1_busy_s)
+      .num("stage2_busy_s", s.stage2_busy_s)
+      .num("overlap_busy_s", s.overlap_busy_s)
+      .num("overlapped_scans", s.overlapped_scans)
+      .num("kernel_rcvbuf_errors", s.kernel_rcvbuf_errors)
+      .num("socket_rcvbuf_drops", s.socket_rcvbuf_drops)
+      .num("latest_snapshot_id", s.latest_snapshot_id)
+      .num("requests_served", s.requests_served)
+      .raw("robots", robots.str());
+  o << "}";
+  return o.str();
+}
+
+}  // namespace ort::status

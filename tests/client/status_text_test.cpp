@@ -1,0 +1,95 @@
+// `octomap-rt status` layout and JSON of a known status message.
+#include <gtest/gtest.h>
+
+#include "status/status_json.h"
+#include "status/status_text.h"
+
+namespace ort::status {
+namespace {
+
+octomap_rt::server_status_t example_status() {
+  octomap_rt::server_status_t s{};
+  s.utime = 1'700'000'010'000'000;
+  s.seq = 42;
+  s.uptime_s = 3725;
+  s.pid = 4242;
+  s.state = octomap_rt::server_status_t::STATE_DEGRADED;
+  s.pipelined = true;
+  s.resolution = 0.1;
+  s.num_nodes = 400844;
+  s.memory_bytes = 10 * 1024 * 1024;
+  s.scans_per_s = 12.5f;
+  s.points_per_s = 1.5e6f;
+  s.shoot_ms_p50 = 4.25f;
+  s.end_to_end_ms_p99 = 30.5f;
+  s.kernel_rcvbuf_errors = -1;
+  s.last_save_utime = s.utime - 12'000'000;
+  s.server_id = "srv-1";
+  s.host = "robot-base";
+  s.backend = "vulkan";
+  s.device = "NVIDIA H100";
+  s.message = "1 scan rejected in the last period";
+  octomap_rt::robot_stats_t r{};
+  r.robot_id = "alpha";
+  r.channel = "OCTOMAP_RT_SCAN_ALPHA";
+  r.scans_received = 1235;
+  r.scans_applied = 1230;
+  r.scans_rejected = 5;
+  r.last_seq = 1234;
+  r.last_scan_utime = s.utime - 500'000;
+  r.reject_reason = {"non-finite point", "truncated \"x\""};
+  r.reject_count = {3, 2};
+  r.num_reject_reasons = 2;
+  s.robots = {r};
+  s.num_robots = 1;
+  return s;
+}
+
+TEST(StatusText, LaysOutStateRatesLatenciesAndRobotsWithReasons) {
+  const auto s = example_status();
+  const std::string text = format_status(s, s.utime + 2'000'000);
+  EXPECT_NE(text.find("srv-1 (pid 4242 on robot-base)   state DEGRADED"), std::string::npos) << text;
+  EXPECT_NE(text.find("up 1:02:05"), std::string::npos) << text;
+  EXPECT_NE(text.find("status #42, 2 s ago"), std::string::npos) << text;
+  EXPECT_NE(text.find("vulkan on NVIDIA H100, pipelined"), std::string::npos) << text;
+  EXPECT_NE(text.find("400,844 nodes"), std::string::npos) << text;
+  EXPECT_NE(text.find("10.0 MiB"), std::string::npos) << text;
+  EXPECT_NE(text.find("last 14 s ago"), std::string::npos) << text;
+  EXPECT_NE(text.find("12.5 scans/s, 1.50 M points/s"), std::string::npos) << text;
+  EXPECT_NE(text.find("shoot 4.2 / 0.0"), std::string::npos) << text;
+  EXPECT_NE(text.find("receive-buffer errors unknown"), std::string::npos) << text;
+  EXPECT_NE(text.find("message   1 scan rejected"), std::string::npos) << text;
+  EXPECT_NE(text.find("alpha            1,235     1,230"), std::string::npos) << text;
+  EXPECT_NE(text.find("rejected: non-finite point 3, truncated \"x\" 2"), std::string::npos) << text;
+}
+
+TEST(StatusText, NumbersForPeople) {
+  EXPECT_EQ(with_commas(0), "0");
+  EXPECT_EQ(with_commas(999), "999");
+  EXPECT_EQ(with_commas(1000), "1,000");
+  EXPECT_EQ(with_commas(-1234567), "-1,234,567");
+  EXPECT_EQ(bytes_text(512), "512 B");
+  EXPECT_EQ(bytes_text(1536), "1.5 KiB");
+  EXPECT_EQ(rate_text(4277.6), "4.3 k");
+  EXPECT_EQ(rate_text(12.5), "12.5");
+  EXPECT_EQ(duration_text(59), "59 s");
+  EXPECT_EQ(duration_text(61), "1:01");
+  EXPECT_EQ(duration_text(3600 * 26 + 1), "26:00:01");
+  EXPECT_EQ(state_name(octomap_rt::server_status_t::STATE_RUNNING), "RUNNING");
+  EXPECT_EQ(state_name(9), "STATE 9");
+}
+
+TEST(StatusJson, EveryFieldAndEscapedStrings) {
+  const std::string json = status_json(example_status());
+  EXPECT_EQ(json.front(), '{');
+  EXPECT_EQ(json.back(), '}');
+  EXPECT_NE(json.find("\"state_name\":\"DEGRADED\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"pid\":4242"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"pipelined\":true"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"reject_reasons\":{\"non-finite point\":3,\"truncated \\\"x\\\"\":2}"), std::string::npos)
+      << json;
+  EXPECT_EQ(json_string("a\nb\\"), "\"a\\u000ab\\\\\"");
+}
+
+}  // namespace
+}  // namespace ort::status
