@@ -118,6 +118,8 @@ void MappingServer::start() {
   intake_ = std::make_unique<ScanIntake>(*loop_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
   intake_->open();  // before the loop starts: 1.3.1's subscribe races with handle
   loop_->start();
+  raw_publisher_ = std::make_unique<OctomapRawPublisher>(cfg_.octomap_raw, map_, *loop_, log_);
+  raw_publisher_->start();
   status_thread_ = std::thread([this] { run_status_loop(); });
   if (!cfg_.map_path.empty() && cfg_.save_interval_s > 0) save_thread_ = std::thread([this] { run_save_loop(); });
   set_state(Status::STATE_RUNNING, "serving " + cfg_.scan_channels);
@@ -147,6 +149,7 @@ void MappingServer::stop() {
   }
   wake_.notify_all();
   if (status_thread_.joinable()) status_thread_.join();
+  raw_publisher_->stop();
   loop_->stop();
 }
 
@@ -305,6 +308,8 @@ void MappingServer::publish_status() {
     in.message = message_;
     in.seq = status_seq_++;
   }
+  // The viewers' map cut or skipped for its size: said in every status.
+  if (const std::string note = raw_publisher_ ? raw_publisher_->note() : ""; !note.empty()) in.message += "; " + note;
   const octomap_rt::server_status_t msg = make_status(in);
   loop_->publish(cfg_.status_channel, msg);
 }

@@ -17,6 +17,7 @@
 
 #include "daemon/lcm_loop.h"
 #include "daemon/map_state.h"
+#include "daemon/octomap_raw_publisher.h"
 #include "daemon/pipeline_metrics.h"
 #include "daemon/producer_registry.h"
 #include "daemon/scan_intake.h"
@@ -81,6 +82,7 @@ class MappingServer {
   PipelineMetrics metrics_;
   std::unique_ptr<ScanIntake> intake_;
   std::unique_ptr<ScanPipeline> pipeline_;
+  std::unique_ptr<OctomapRawPublisher> raw_publisher_;  // the map for LCM viewers (off by default)
 
   std::string host_, server_id_;
   int64_t start_utime_ = 0;

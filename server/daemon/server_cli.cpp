@@ -23,6 +23,14 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
       ->capture_default_str();
   app.add_option("--status-channel", s.status_channel, "channel of server_status_t heartbeats")->capture_default_str();
   app.add_option("--status-period", s.status_period_s, "seconds between status messages")->capture_default_str();
+  app.add_option("--octomap-raw-rate", s.octomap_raw.rate_hz,
+                 "publish the map as octomap.raw_t (LCM's OctoMap viewers) at this rate [Hz]; 0: off")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
+  app.add_option("--octomap-raw-channel", s.octomap_raw.channel, "channel of octomap.raw_t")->capture_default_str();
+  app.add_option("--octomap-raw-max-kib", f.octomap_raw_max_kib,
+                 "size cap of one octomap.raw_t [KiB]; a larger map is sent depth-limited, or not at all (said in "
+                 "the status); default: 90 % of net.core.rmem_default");
   app.add_flag("--no-pipeline", f.no_pipeline, "run the GPU and CPU stages on one thread, one scan after another");
   app.add_option("--server-id", s.server_id, "name in status messages (default octomap-rt-server@HOST)");
   app.add_option("--queue-mib", f.queue_mib,
@@ -39,6 +47,8 @@ ServerConfig to_server_config(const ServerFlags& f) {
   c.pipeline = !f.no_pipeline;
   if (f.queue_mib < 0) throw CLI::ValidationError("--queue-mib", "must be >= 0");
   c.queue_budget_bytes = static_cast<uint64_t>(f.queue_mib * 1048576.0);
+  if (f.octomap_raw_max_kib < 0) throw CLI::ValidationError("--octomap-raw-max-kib", "must be >= 0");
+  c.octomap_raw.max_bytes = static_cast<size_t>(f.octomap_raw_max_kib * 1024.0);
   if (!(c.status_period_s > 0)) throw CLI::ValidationError("--status-period", "must be > 0");
   if (c.max_points == 0) throw CLI::ValidationError("--max-points", "must be > 0");
   if (c.max_producers == 0) throw CLI::ValidationError("--max-producers", "must be > 0");

@@ -14,6 +14,7 @@ struct ServerFlags {
   ServerConfig server;
   bool no_pipeline = false;
   double queue_mib = 0;
+  double octomap_raw_max_kib = 0;  // 0: automatic
 };
 
 void add_server_flags(CLI::App& app, ServerFlags& f);

@@ -1,12 +1,21 @@
 // Everything octomap-rt-server is configured with (flags or config file; see server_cli).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
 #include "engine/map_engine.h"
 
 namespace ort::daemon {
+
+// The map for LCM's OctoMap viewers (octomap.raw_t; daemon/octomap_raw_publisher.h).
+struct OctomapRawConfig {
+  double rate_hz = 0;              // 0: off
+  std::string channel = "OCTOMAP";
+  size_t max_bytes = 0;            // whole message; 0: octomap_raw_default_cap()
+  unsigned min_depth = 10;         // coarsest depth-limited map sent before giving up
+};
 
 struct ServerConfig {
   EngineOptions engine;                        // resolution, sensor model, max range, back end
@@ -24,6 +33,7 @@ struct ServerConfig {
   uint64_t max_points = 4'000'000;             // per scan
   size_t max_producers = 64;
   int lcm_queue_capacity = 64;                 // LCM's own per-subscription queue (messages)
+  OctomapRawConfig octomap_raw;
 };
 
 // Per-producer queue budget sized by memory: 1/64 of physical memory, within [64 MiB, 1 GiB].
