@@ -74,6 +74,16 @@ TEST(StatusIntegration, ShowsARunningServerAsTextJsonAndWatch) {
       dir + "/status.json " + std::to_string(server.pid());
   EXPECT_EQ(std::system(check.c_str()), 0) << json.log();
 
+#ifdef OCTOMAP_RT_JAVA_EXAMPLE_CP
+  // A Java program with lcm.jar and our types jar decodes the same status (Java's LCM takes no
+  // recv_buf_size; a status is one datagram).
+  ChildProcess java({"java", "-Djava.net.preferIPv4Stack=true", "-cp", OCTOMAP_RT_JAVA_EXAMPLE_CP, "StatusListener",
+                     url.substr(0, url.find("&recv_buf_size")), "1"},
+                    dir + "/java.log");
+  ASSERT_EQ(java.wait(60), 0) << java.log();
+  EXPECT_NE(java.log().find("robot ALPHA: received 4, applied 3, rejected 1"), std::string::npos) << java.log();
+#endif
+
   ChildProcess watch({client_program(), "status", "--watch", "--count", "2", "--lcm-url", url}, dir + "/watch.log");
   ASSERT_EQ(watch.wait(30), 0) << watch.log();
   EXPECT_EQ(count_of(watch.log(), "(pid " + std::to_string(server.pid()) + " on "), 2u) << watch.log();
