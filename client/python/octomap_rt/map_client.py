@@ -1,0 +1,96 @@
+"""MapClient: octomap-rt-server from Python (numpy in, numpy out)."""
+
+import struct
+import time
+from typing import Optional, Sequence
+
+from ._types import scan_t, server_status_t
+from .transport import open_transport
+
+STATUS_CHANNEL = "OCTOMAP_RT_STATUS"
+SCAN_CHANNEL_PREFIX = "OCTOMAP_RT_SCAN_"
+
+
+class ServerTimeout(TimeoutError):
+    """No answer from octomap-rt-server within the time given (the message says to what)."""
+
+
+def now_utime() -> int:
+    return int(time.time() * 1e6)
+
+
+class MapClient:
+    """A client of one octomap-rt-server on one LCM URL.
+
+    `url`: LCM URL (default $LCM_DEFAULT_URL, else the host-local udpm URL); add
+    `recv_buf_size=` to receive multi-MB messages. `transport`: any object with publish,
+    subscribe, unsubscribe and handle (default: open_transport(url))."""
+
+    def __init__(self, url: Optional[str] = None, transport=None):
+        self.transport = transport or open_transport(url)
+        self._scan_seq = {}
+
+    def close(self) -> None:
+        self.transport.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def wait_for(self, channel: str, decode, accept=lambda m: True, timeout_s: float = 5.0):
+        """The first message on `channel` that decodes and that `accept` takes."""
+        found = []
+
+        def take(_channel, data):
+            if found:
+                return
+            try:
+                msg = decode(data)
+            except (ValueError, struct.error):  # not this type (fingerprint, length): skipped
+                return
+            if accept(msg):
+                found.append(msg)
+
+        sub = self.transport.subscribe(channel, take)
+        try:
+            deadline = time.monotonic() + timeout_s
+            while not found and time.monotonic() < deadline:
+                self.transport.handle(min(0.1, max(0.0, deadline - time.monotonic())))
+        finally:
+            self.transport.unsubscribe(sub)
+        if not found:
+            raise ServerTimeout(f"nothing on {channel} within {timeout_s} s at {self.transport.url}: "
+                                "is octomap-rt-server running with this LCM URL?")
+        return found[0]
+
+    def status(self, timeout_s: float = 5.0) -> server_status_t:
+        """The server's next status message (it sends one a second)."""
+        return self.wait_for(STATUS_CHANNEL, server_status_t.decode, timeout_s=timeout_s)
+
+    def publish_scan(self, points, robot_id: str, origin: Sequence[float] = (0.0, 0.0, 0.0),
+                     orientation: Sequence[float] = (1.0, 0.0, 0.0, 0.0), points_in_map_frame: bool = False,
+                     max_range: float = -1.0, seq: Optional[int] = None, utime: Optional[int] = None,
+                     map_frame: str = "map") -> int:
+        """Sends one scan as robot `robot_id` (channel OCTOMAP_RT_SCAN_<ROBOT_ID>): `points` an
+        (N, 3) array in the sensor frame (or the map frame), `origin` the sensor position and
+        `orientation` its unit quaternion (w, x, y, z) in the map frame. Returns its seq
+        (0, 1, 2, ... per robot unless given)."""
+        import numpy as np
+
+        xyz = np.ascontiguousarray(np.asarray(points, dtype=np.float32).reshape(-1, 3))
+        msg = scan_t()
+        msg.utime = now_utime() if utime is None else utime
+        msg.seq = self._scan_seq.get(robot_id, 0) if seq is None else seq
+        self._scan_seq[robot_id] = msg.seq + 1
+        msg.sensor_position = [float(v) for v in origin]
+        msg.sensor_orientation = [float(v) for v in orientation]
+        msg.max_range = float(max_range)
+        msg.points_frame = scan_t.POINTS_IN_MAP_FRAME if points_in_map_frame else scan_t.POINTS_IN_SENSOR_FRAME
+        msg.xyz = xyz.reshape(-1).tolist()
+        msg.num_xyz = len(msg.xyz)
+        msg.robot_id = robot_id
+        msg.map_frame = map_frame
+        self.transport.publish(SCAN_CHANNEL_PREFIX + robot_id.upper(), msg.encode())
+        return msg.seq
