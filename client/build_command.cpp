@@ -5,7 +5,7 @@
 #include <iostream>
 
 #include "commands.h"
-#include "engine_flags.h"
+#include "engine/engine_flags.h"
 #include "map_summary.h"
 #include "scene/scan_set.h"
 #include "scene/synthetic_scene.h"

@@ -8,14 +8,7 @@ add_library(octomap_rt_daemon STATIC ${DAEMON_SOURCES})
 target_include_directories(octomap_rt_daemon PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
 target_link_libraries(octomap_rt_daemon PUBLIC octomap_rt_engine octomap_rt_lcmtypes octomap_rt_lcm Threads::Threads)
 
-# The engine flags (-r, sensor model, back end, ...) are the client's, shared so that
-# `octomap-rt build` and the server take the same names and defaults.
-add_executable(octomap-rt-server ${DAEMON_DIR}/server_main.cpp ${DAEMON_DIR}/server_cli.cpp
-               ${CMAKE_SOURCE_DIR}/client/engine_flags.cpp)
-target_include_directories(octomap-rt-server PRIVATE ${CMAKE_SOURCE_DIR}/client)
-target_link_libraries(octomap-rt-server PRIVATE octomap_rt_daemon CLI11::CLI11)
-
-# Pipeline vs --no-pipeline throughput, in-process over memq:// (prints ratios).
-add_executable(octomap-rt-server-bench ${DAEMON_DIR}/bench/pipeline_bench.cpp ${CMAKE_SOURCE_DIR}/client/engine_flags.cpp)
-target_include_directories(octomap-rt-server-bench PRIVATE ${CMAKE_SOURCE_DIR}/client)
-target_link_libraries(octomap-rt-server-bench PRIVATE octomap_rt_daemon octomap_rt_scene CLI11::CLI11)
+# The engine flags (-r, sensor model, back end, ...) come from engine/engine_flags, shared so
+# that `octomap-rt build` and the server take the same names and defaults.
+add_executable(octomap-rt-server ${DAEMON_DIR}/server_main.cpp ${DAEMON_DIR}/server_cli.cpp)
+target_link_libraries(octomap-rt-server PRIVATE octomap_rt_daemon)

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "engine/map_frame.h"
+#include "core/map_frame.h"
 
 namespace ort::daemon {
 

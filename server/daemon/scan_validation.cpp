@@ -4,7 +4,7 @@
 #include <cmath>
 #include <exception>
 
-#include "engine/prepare_scan.h"
+#include "core/prepare_scan.h"
 
 namespace ort::daemon {
 namespace {

@@ -5,7 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "daemon/server_config.h"
-#include "engine_flags.h"
+#include "engine/engine_flags.h"
 
 namespace ort::daemon {
 

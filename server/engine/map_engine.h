@@ -13,9 +13,10 @@
 
 #include <octomap/OcTree.h>
 
-#include "engine/prepare_scan.h"
-#include "engine/ray_backend.h"
-#include "engine/sensor_model.h"
+#include "core/prepare_scan.h"
+#include "core/ray_backend.h"
+#include "engine/backend_factory.h"
+#include "core/sensor_model.h"
 #include "octree/octree_update.h"
 
 namespace ort {

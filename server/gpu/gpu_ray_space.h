@@ -23,9 +23,9 @@
 
 #include <vulkan/vulkan.h>
 
-#include "engine/ray_backend.h"
-#include "engine/ray_batch.h"
-#include "engine/voxel_update.h"
+#include "core/ray_backend.h"
+#include "core/ray_batch.h"
+#include "core/voxel_update.h"
 #include "gpu/ray_space_sizing.h"
 #include "gpu/shader_interface.h"
 #include "gpu/vk/vk_buffer.h"

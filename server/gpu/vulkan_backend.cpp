@@ -9,7 +9,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "engine/ray_space.h"
+#include "core/ray_space.h"
 #include "gpu/gpu_ray_space.h"
 #include "gpu/ray_space_sizing.h"
 #include "gpu/shader_interface.h"

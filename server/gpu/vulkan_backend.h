@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "engine/ray_backend.h"
+#include "core/ray_backend.h"
 
 namespace ort {
 

@@ -31,7 +31,7 @@
 
 #include <octomap/OcTree.h>
 
-#include "engine/voxel_update.h"
+#include "core/voxel_update.h"
 #include "octree/voxel_buckets.h"
 #include "octree/worker_pool.h"
 

@@ -9,7 +9,7 @@
 
 #include <cstdint>
 
-#include "engine/voxel_update.h"
+#include "core/voxel_update.h"
 
 namespace ort {
 

@@ -8,7 +8,7 @@
 
 #include <octomap/OcTree.h>
 
-#include "engine/voxel_update.h"
+#include "core/voxel_update.h"
 
 namespace ort {
 

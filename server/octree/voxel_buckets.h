@@ -17,7 +17,7 @@
 #include <span>
 #include <vector>
 
-#include "engine/voxel_update.h"
+#include "core/voxel_update.h"
 #include "octree/morton_order.h"
 #include "octree/worker_pool.h"
 

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
-#include "engine/exact_traversal.h"
+#include "core/exact_traversal.h"
 
 namespace ort {
 namespace {

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "engine/map_engine.h"
-#include "engine/prepare_scan.h"
+#include "core/prepare_scan.h"
 
 namespace ort {
 namespace {
@@ -77,7 +77,7 @@ TEST(CoordToKey, MatchesOctomap) {
 }  // namespace
 }  // namespace ort
 
-#include "engine/map_frame.h"
+#include "core/map_frame.h"
 
 namespace ort {
 namespace {

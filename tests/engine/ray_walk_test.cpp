@@ -1,4 +1,4 @@
-// The native ray walk (engine/octomap_ray_walk.h) and the cpu-grid back end against
+// The native ray walk (core/octomap_ray_walk.h) and the cpu-grid back end against
 // OctoMap's own computeRayKeys and insertPointCloud, on rays chosen to hit the corner cases.
 #include <random>
 #include <cmath>
@@ -8,10 +8,10 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
-#include "engine/cpu_grid_backend.h"
-#include "engine/cpu_backend.h"
-#include "engine/octomap_ray_walk.h"
-#include "engine/prepare_scan.h"
+#include "core/cpu_grid_backend.h"
+#include "core/cpu_backend.h"
+#include "core/octomap_ray_walk.h"
+#include "core/prepare_scan.h"
 
 namespace ort {
 namespace {

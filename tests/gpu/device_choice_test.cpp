@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/ray_backend.h"
+#include "engine/backend_factory.h"
 #include "gpu/vk/vk_context.h"
 #include "gpu/vulkan_backend.h"
 

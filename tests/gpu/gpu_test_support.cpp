@@ -7,7 +7,8 @@
 
 #include <octomap/OcTree.h>
 
-#include "engine/exact_traversal.h"
+#include "core/exact_traversal.h"
+#include "engine/backend_factory.h"
 
 namespace ort::test {
 namespace {

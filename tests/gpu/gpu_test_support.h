@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "engine/ray_backend.h"
-#include "engine/ray_batch.h"
-#include "engine/voxel_update.h"
+#include "core/ray_backend.h"
+#include "core/ray_batch.h"
+#include "core/voxel_update.h"
 
 namespace ort::test {
 

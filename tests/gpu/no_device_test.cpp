@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/ray_backend.h"
+#include "engine/backend_factory.h"
 
 namespace ort::test {
 namespace {

@@ -9,10 +9,11 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/prepare_scan.h"
+#include "core/prepare_scan.h"
+#include "core/ray_space.h"
+#include "engine/backend_factory.h"
 #include "gpu/gpu_test_support.h"
 #include "gpu/ray_space_sizing.h"
-#include "engine/ray_space.h"
 #include "gpu/vulkan_backend.h"
 #include "scene/synthetic_scene.h"
 

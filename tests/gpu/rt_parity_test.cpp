@@ -15,7 +15,8 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/prepare_scan.h"
+#include "core/prepare_scan.h"
+#include "engine/backend_factory.h"
 #include "gpu/gpu_test_support.h"
 #include "gpu/random_rays.h"
 #include "gpu/rt/rt_ray_backend.h"

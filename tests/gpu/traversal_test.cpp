@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/prepare_scan.h"
+#include "core/prepare_scan.h"
 #include "gpu/gpu_test_support.h"
 #include "gpu/random_rays.h"
 

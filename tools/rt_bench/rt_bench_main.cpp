@@ -18,8 +18,9 @@
 #include <CLI/CLI.hpp>
 #include <octomap/OcTree.h>
 
-#include "engine/prepare_scan.h"
-#include "engine/ray_backend.h"
+#include "core/prepare_scan.h"
+#include "core/ray_backend.h"
+#include "engine/backend_factory.h"
 #include "gpu/rt/rt_ray_backend.h"
 #include "scene/scan_set.h"
 

@@ -18,7 +18,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "engine/ray_batch.h"
+#include "core/ray_batch.h"
 
 namespace ort::rt {
 

@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-#include "engine/ray_backend.h"
+#include "core/ray_backend.h"
 #include "gpu/rt/block_grid.h"
 
 namespace ort::rt {

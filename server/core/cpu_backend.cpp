@@ -1,10 +1,10 @@
-#include "engine/cpu_backend.h"
+#include "core/cpu_backend.h"
 
 #include <chrono>
 
 #include <octomap/OcTree.h>
 
-#include "engine/exact_traversal.h"
+#include "core/exact_traversal.h"
 
 namespace ort {
 namespace {

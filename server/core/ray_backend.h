@@ -1,34 +1,17 @@
-// The seam between the engine and its ray-shooting back ends (cpu, vulkan, rt).
+// The seam between the engine and its ray-shooting back ends (cpu, cpu-grid, vulkan, rt).
 //
 // A back end turns one RayBatch into the scan's consistent voxel states: every voxel a ray
 // crosses is free, every measured end voxel is occupied, occupied wins, each key once.
 #pragma once
 
-#include <memory>
+#include <cstdint>
 #include <string>
 
-#include "engine/ray_batch.h"
-#include "engine/voxel_update.h"
+#include "core/backend_kind.h"
+#include "core/ray_batch.h"
+#include "core/voxel_update.h"
 
 namespace ort {
-
-enum class Traversal {
-  kOctomap,  // OctoMap 1.9.7's computeRayKeys walk, bit for bit (the default)
-  kExact,    // every voxel whose closed box the segment touches (the paper's geometry)
-};
-
-enum class BackendKind {
-  kAuto,
-  kCpu,      // OctoMap's computeRayKeys + KeySets: the reference
-  kCpuGrid,  // native threads into the 2-bit shared ray space (engine/cpu_grid_backend.h)
-  kVulkan,   // compute shaders (gpu/vulkan_backend.h)
-  kRt,       // ray-tracing pipeline (gpu/rt_backend.h)
-};
-
-const char* to_string(Traversal t);
-const char* to_string(BackendKind b);
-bool parse_traversal(const std::string& s, Traversal& out);
-bool parse_backend(const std::string& s, BackendKind& out);
 
 // Wall-clock times of one scan's stages, milliseconds (paper Fig. 6 naming).
 struct StageTimes {
@@ -62,21 +45,5 @@ class RayBackend {
   // Shoots every ray of the batch; replaces `out` with the scan's voxel states.
   virtual void shoot(const RayBatch& batch, Traversal mode, VoxelList& out, ShootStats& stats) = 0;
 };
-
-struct BackendOptions {
-  BackendKind kind = BackendKind::kAuto;
-  std::string device;              // Vulkan device: name substring or index; empty = automatic
-  double resolution = 0.1;
-  double max_range = -1.0;         // sizes the persistent grid; < 0: no limit
-  uint64_t grid_budget_bytes = 0;  // 0: automatic (capped by maxStorageBufferRange)
-  Traversal traversal = Traversal::kOctomap;  // rt refuses octomap mode at creation, so auto moves on
-  unsigned threads = 0;            // cpu-grid: ray threads, 0 = hardware threads
-  bool verbose = false;
-};
-
-// Creates the requested back end. kAuto prefers rt, then vulkan, then cpu; with no Vulkan
-// device at all it says so on `log` and returns cpu. An explicit kind that cannot be made
-// throws std::runtime_error with a message that says why.
-std::unique_ptr<RayBackend> make_backend(const BackendOptions& opts, std::string* log = nullptr);
 
 }  // namespace ort

@@ -7,7 +7,7 @@
 
 #include <memory>
 
-#include "engine/ray_backend.h"
+#include "core/ray_backend.h"
 
 namespace ort {
 

@@ -1,4 +1,4 @@
-#include "engine/prepare_scan.h"
+#include "core/prepare_scan.h"
 
 #include <algorithm>
 #include <cmath>

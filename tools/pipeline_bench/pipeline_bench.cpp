@@ -15,7 +15,7 @@
 #include <CLI/CLI.hpp>
 
 #include "daemon/mapping_server.h"
-#include "engine_flags.h"
+#include "engine/engine_flags.h"
 #include "scene/scan_set.h"
 #include "scene/synthetic_scene.h"
 

@@ -1,14 +1,14 @@
-#include "engine/cpu_grid_backend.h"
+#include "core/cpu_grid_backend.h"
 
 #include <atomic>
 #include <chrono>
 #include <thread>
 #include <vector>
 
-#include "engine/exact_traversal.h"
-#include "engine/octomap_ray_walk.h"
-#include "engine/prepare_scan.h"
-#include "engine/ray_space.h"
+#include "core/exact_traversal.h"
+#include "core/octomap_ray_walk.h"
+#include "core/prepare_scan.h"
+#include "core/ray_space.h"
 
 namespace ort {
 namespace {

@@ -1,4 +1,4 @@
-#include "engine_flags.h"
+#include "engine/engine_flags.h"
 
 namespace ort::cli {
 

@@ -1,4 +1,4 @@
-#include "engine/exact_traversal.h"
+#include "core/exact_traversal.h"
 
 #include <algorithm>
 #include <cmath>

@@ -8,7 +8,7 @@
 
 #include <octomap/octomap_types.h>
 
-#include "engine/ray_batch.h"
+#include "core/ray_batch.h"
 
 namespace ort {
 

@@ -1,4 +1,4 @@
-#include "engine/ray_space.h"
+#include "core/ray_space.h"
 
 #include <algorithm>
 #include <stdexcept>

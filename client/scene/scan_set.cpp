@@ -5,7 +5,7 @@
 
 #include <octomap/ScanGraph.h>
 
-#include "engine/map_frame.h"
+#include "core/map_frame.h"
 
 namespace ort {
 

@@ -1,0 +1,35 @@
+// The list of ray-shooting back ends and the options every back end is made from. They live
+// in the ground layer because the back ends themselves (core/ and gpu/) take these options
+// and name their kind; engine/backend_factory.cpp is the one place that makes them.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "core/traversal.h"
+
+namespace ort {
+
+enum class BackendKind {
+  kAuto,
+  kCpu,      // OctoMap's computeRayKeys + KeySets: the reference
+  kCpuGrid,  // native threads into the 2-bit shared ray space (core/cpu_grid_backend.h)
+  kVulkan,   // compute shaders (gpu/vulkan_backend.h)
+  kRt,       // ray-tracing pipeline (gpu/rt_backend.h)
+};
+
+const char* to_string(BackendKind b);
+bool parse_backend(const std::string& s, BackendKind& out);
+
+struct BackendOptions {
+  BackendKind kind = BackendKind::kAuto;
+  std::string device;              // Vulkan device: name substring or index; empty = automatic
+  double resolution = 0.1;
+  double max_range = -1.0;         // sizes the persistent grid; < 0: no limit
+  uint64_t grid_budget_bytes = 0;  // 0: automatic (capped by maxStorageBufferRange)
+  Traversal traversal = Traversal::kOctomap;  // rt refuses octomap mode at creation, so auto moves on
+  unsigned threads = 0;            // cpu-grid: ray threads, 0 = hardware threads
+  bool verbose = false;
+};
+
+}  // namespace ort

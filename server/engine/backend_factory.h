@@ -1,0 +1,17 @@
+// make_backend: the one place that knows every back end and builds the one asked for.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "core/backend_kind.h"
+#include "core/ray_backend.h"
+
+namespace ort {
+
+// Creates the requested back end. kAuto prefers rt, then vulkan, then cpu; with no Vulkan
+// device at all it says so on `log` and returns cpu. An explicit kind that cannot be made
+// throws std::runtime_error with a message that says why.
+std::unique_ptr<RayBackend> make_backend(const BackendOptions& opts, std::string* log = nullptr);
+
+}  // namespace ort
