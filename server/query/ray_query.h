@@ -1,0 +1,29 @@
+// Ray queries: exactly OcTree::castRay on the map (OctoMap's DDA through the key grid:
+// stops at the first occupied voxel, at unknown space unless ignore_unknown, past
+// max_range, or at the key range's edge), plus the state of the voxel where it stopped.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "query/query_types.h"
+
+namespace ort::query {
+
+struct RayBatchOptions {
+  bool ignore_unknown = false;
+  double max_range = -1;            // <= 0: no limit (castRay's default)
+};
+
+// One ray. An origin outside the map's key range gives hit = false, end = origin, unknown
+// (castRay would return false there too, after printing a warning). Throws QueryError for a
+// non-finite origin or direction, or a zero direction.
+RayAnswer cast_ray(const octomap::OcTree& tree, const octomap::point3d& origin, const octomap::point3d& direction,
+                   const RayBatchOptions& opt);
+// origins, directions: x0 y0 z0 x1 ...; one answer per ray, in order.
+std::vector<RayAnswer> cast_rays(const octomap::OcTree& tree, std::span<const float> origins,
+                                 std::span<const float> directions, const RayBatchOptions& opt);
+
+}  // namespace ort::query
