@@ -77,7 +77,8 @@ class CpuGridBackend final : public RayBackend {
   }
 
   // Sets `bits` of voxel k if it lies in the window; lists the word when it was empty.
-  void mark(const KeyBox& w, const octomap::OcTreeKey& k, uint32_t bits, std::vector<uint32_t>& touched) {
+  [[gnu::always_inline]] void mark(const KeyBox& w, const octomap::OcTreeKey& k, uint32_t bits,
+                                   std::vector<uint32_t>& touched) {
     const int64_t idx = window_index(w, k[0], k[1], k[2]);
     if (idx < 0) return;
     const uint64_t word = uint64_t(idx) / kVoxelsPerWord;

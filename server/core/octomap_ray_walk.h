@@ -47,14 +47,29 @@ inline void walk_octomap_ray(const octomap::point3d& origin, const octomap::poin
       t_delta[i] = std::numeric_limits<double>::max();
     }
   }
+  // The loop keeps its state in registers (OctoMap indexes arrays by the stepping axis, a
+  // chain through memory on every step); the comparisons and operations are the same.
+  double tx = t_max[0], ty = t_max[1], tz = t_max[2];
+  const double dx = t_delta[0], dy = t_delta[1], dz = t_delta[2];
+  const auto sx = octomap::key_type(step[0]), sy = octomap::key_type(step[1]), sz = octomap::key_type(step[2]);
   while (true) {
-    unsigned dim;
-    if (t_max[0] < t_max[1]) dim = (t_max[0] < t_max[2]) ? 0 : 2;
-    else dim = (t_max[1] < t_max[2]) ? 1 : 2;
-    current[dim] += step[dim];
-    t_max[dim] += t_delta[dim];
+    if (tx < ty) {
+      if (tx < tz) {
+        current[0] = octomap::key_type(current[0] + sx);
+        tx += dx;
+      } else {
+        current[2] = octomap::key_type(current[2] + sz);
+        tz += dz;
+      }
+    } else if (ty < tz) {
+      current[1] = octomap::key_type(current[1] + sy);
+      ty += dy;
+    } else {
+      current[2] = octomap::key_type(current[2] + sz);
+      tz += dz;
+    }
     if (current == key_end) return;
-    const double dist_from_origin = std::min(std::min(t_max[0], t_max[1]), t_max[2]);
+    const double dist_from_origin = std::min(std::min(tx, ty), tz);
     if (dist_from_origin > length) return;
     free_voxel(current);
   }
