@@ -9,8 +9,9 @@
 
 namespace ort {
 
-// Creates the requested back end. kAuto prefers rt, then vulkan, then cpu; with no Vulkan
-// device at all it says so on `log` and returns cpu. An explicit kind that cannot be made
+// Creates the requested back end. kAuto prefers rt, then vulkan on a GPU, then cpu-grid (also
+// when the only Vulkan device is a CPU implementation such as lavapipe; backend_factory.cpp
+// says why); with no Vulkan device at all it says so on `log`. An explicit kind that cannot be made
 // throws std::runtime_error with a message that says why.
 std::unique_ptr<RayBackend> make_backend(const BackendOptions& opts, std::string* log = nullptr);
 

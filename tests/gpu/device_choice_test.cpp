@@ -70,7 +70,7 @@ TEST(DeviceChoice, ClearErrors) {
   EXPECT_NE(error_of(o).find("lacks VK_ORT_not_an_extension"), std::string::npos) << error_of(o);
 }
 
-TEST(DeviceChoice, FactoryHonoursDeviceAndFallsBackToCpuOnlyInAuto) {
+TEST(DeviceChoice, FactoryHonoursDeviceAndFallsBackToCpuGridOnlyInAuto) {
   BackendOptions o;
   o.kind = BackendKind::kVulkan;
   o.grid_budget_bytes = 1 << 20;
@@ -79,7 +79,7 @@ TEST(DeviceChoice, FactoryHonoursDeviceAndFallsBackToCpuOnlyInAuto) {
   o.kind = BackendKind::kAuto;
   std::string log;
   auto b = make_backend(o, &log);
-  EXPECT_EQ(b->kind(), BackendKind::kCpu);
+  EXPECT_EQ(b->kind(), BackendKind::kCpuGrid);
   EXPECT_NE(log.find("no-such-gpu-4711"), std::string::npos) << log;
   o.kind = BackendKind::kVulkan;
   o.device.clear();
@@ -88,6 +88,23 @@ TEST(DeviceChoice, FactoryHonoursDeviceAndFallsBackToCpuOnlyInAuto) {
   EXPECT_EQ(v->kind(), BackendKind::kVulkan);
   EXPECT_FALSE(v->device_name().empty());
   EXPECT_NE(log.find(v->device_name()), std::string::npos) << log;
+}
+
+// Automatic choice on a CPU Vulkan device (lavapipe, as in CI): the native walk instead,
+// saying why; on a GPU: a GPU back end.
+TEST(DeviceChoice, AutoTakesTheNativeWalkInsteadOfACpuVulkanDevice) {
+  BackendOptions o;
+  o.kind = BackendKind::kAuto;
+  o.grid_budget_bytes = 1 << 20;
+  std::string log;
+  auto b = make_backend(o, &log);
+  const bool cpu_device = vk::Context(vk::ContextOptions{}).properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  if (cpu_device) {
+    EXPECT_EQ(b->kind(), BackendKind::kCpuGrid);
+    EXPECT_NE(log.find("the Vulkan device is a CPU implementation"), std::string::npos) << log;
+  } else {
+    EXPECT_TRUE(b->kind() == BackendKind::kVulkan || b->kind() == BackendKind::kRt) << log;
+  }
 }
 
 }  // namespace
