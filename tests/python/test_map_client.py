@@ -3,25 +3,15 @@ against the C++ build's own leaf counts. Debian's python3 and python3-numpy only
 
 import os
 import re
-import signal
 import struct
 import subprocess
 import tempfile
-import time
 import unittest
 
 import numpy as np
 
 import octomap_rt
-
-SERVER = os.environ.get("OCTOMAP_RT_SERVER", "")
-CLI = os.environ.get("OCTOMAP_RT_CLI", "")
-
-
-def test_url(port):
-    with open("/proc/sys/net/core/rmem_max") as f:
-        rmem_max = int(f.read())
-    return f"udpm://239.255.76.67:{port}?ttl=0&recv_buf_size={min(4194304, rmem_max)}"
+from server_fixture import CLI, ServerTestCase, voxel_keys
 
 
 def raw_t_data(payload: bytes) -> bytes:
@@ -54,24 +44,7 @@ class BtReaderTest(unittest.TestCase):
             octomap_rt.read_bt(b"# Octomap OcTree file\nid OcTree\nres 0.1\ndata\n")
 
 
-class MapClientTest(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.dir = tempfile.mkdtemp(prefix="ort-py-client-")
-        cls.url = test_url(20000 + (os.getpid() * 7 + 3) % 20000)
-        cls.log = open(os.path.join(cls.dir, "server.log"), "w")
-        cls.server = subprocess.Popen([SERVER, "-r", "0.1", "--lcm-url", cls.url, "--backend", "cpu",
-                                       "--octomap-raw-rate", "5", "--octomap-raw-max-kib", "4096"],
-                                      stdout=cls.log, stderr=subprocess.STDOUT)
-        cls.client = octomap_rt.MapClient(cls.url)
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.client.close()
-        cls.server.send_signal(signal.SIGTERM)
-        cls.server.wait(timeout=60)
-        cls.log.close()
-
+class MapClientTest(ServerTestCase):
     def test_status_and_a_python_scan_reach_the_map(self):
         first = self.client.status(timeout_s=60)
         self.assertEqual(first.backend, "cpu")
@@ -90,10 +63,9 @@ class MapClientTest(unittest.TestCase):
         raw = self.client.wait_for("OCTOMAP", raw_t_data, timeout_s=30,
                                    accept=lambda data: len(octomap_rt.read_bt(data).occupied) > 0)
         m = octomap_rt.read_bt(raw)
-        ends = wall + np.array([0.0, 0.0, 1.0])
-        keys = {tuple(k) for k in np.floor(m.occupied / 0.1).astype(int)}
-        expected = {tuple(k) for k in np.floor(ends / 0.1).astype(int)}
-        self.assertEqual(keys, expected)
+        expected = voxel_keys(wall + np.array([0.0, 0.0, 1.0]))
+        on_plane = {k for k in voxel_keys(m.occupied) if k[0] == 20}  # voxels x in [2.0, 2.1)
+        self.assertEqual(on_plane, expected)
         self.assertGreater(len(m.free), 0)
 
     def test_status_times_out_on_a_silent_channel(self):

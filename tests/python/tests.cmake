@@ -1,17 +1,27 @@
 # Python client (client/python/) with Debian's python3, inside a network namespace per run.
 find_program(PYTHON3 python3 PATHS /usr/bin NO_DEFAULT_PATH)
 find_program(LCM_LOGGER lcm-logger)
+set(ORT_PY_TEST_ENV "PYTHONPATH=${CMAKE_BINARY_DIR}/python:${CMAKE_CURRENT_LIST_DIR}"
+    "OCTOMAP_RT_CLI=$<TARGET_FILE:octomap-rt>" "OCTOMAP_RT_SERVER=$<TARGET_FILE:octomap-rt-server>"
+    "PYTHONDONTWRITEBYTECODE=1")
+
+# octomap_rt_add_python_test(<name> <module> <timeout>): `python3 -m unittest <module>` in its namespace.
+function(octomap_rt_add_python_test name module timeout)
+  add_test(NAME ${name} COMMAND ${CMAKE_CURRENT_FUNCTION_LIST_DIR}/run-in-netns ${PYTHON3} -m unittest -v ${module}
+           WORKING_DIRECTORY ${CMAKE_CURRENT_FUNCTION_LIST_DIR})
+  set_tests_properties(${name} PROPERTIES TIMEOUT ${timeout} LABELS integration ENVIRONMENT "${ORT_PY_TEST_ENV}")
+endfunction()
+
 if(PYTHON3 AND LCM_LOGGER)
-  add_test(NAME python_udpm_transport_test
-           COMMAND ${CMAKE_CURRENT_LIST_DIR}/run-in-netns ${PYTHON3} -m unittest -v test_udpm_transport
-           WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR})
-  set_tests_properties(python_udpm_transport_test PROPERTIES TIMEOUT 180 LABELS integration
-    ENVIRONMENT "PYTHONPATH=${CMAKE_BINARY_DIR}/python:${CMAKE_CURRENT_LIST_DIR};OCTOMAP_RT_CLI=$<TARGET_FILE:octomap-rt>;PYTHONDONTWRITEBYTECODE=1")
-  add_test(NAME python_map_client_test
-           COMMAND ${CMAKE_CURRENT_LIST_DIR}/run-in-netns ${PYTHON3} -m unittest -v test_map_client
-           WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR})
-  set_tests_properties(python_map_client_test PROPERTIES TIMEOUT 300 LABELS integration
-    ENVIRONMENT "PYTHONPATH=${CMAKE_BINARY_DIR}/python:${CMAKE_CURRENT_LIST_DIR};OCTOMAP_RT_CLI=$<TARGET_FILE:octomap-rt>;OCTOMAP_RT_SERVER=$<TARGET_FILE:octomap-rt-server>;PYTHONDONTWRITEBYTECODE=1")
+  octomap_rt_add_python_test(python_udpm_transport_test test_udpm_transport 180)
+  octomap_rt_add_python_test(python_map_client_test test_map_client 300)
+  # The map service and the query service are registered with the server as they exist.
+  if(EXISTS ${CMAKE_SOURCE_DIR}/server/daemon/map_service.cpp)
+    octomap_rt_add_python_test(python_map_service_test test_map_service 300)
+  endif()
+  if(EXISTS ${CMAKE_SOURCE_DIR}/server/daemon/query_service.cpp)
+    octomap_rt_add_python_test(python_queries_test test_queries 300)
+  endif()
 else()
   message(WARNING "octomap-rt: python3 or lcm-logger missing: the Python client tests are not registered")
 endif()

@@ -6,3 +6,5 @@ from .lcm_url import HOST_LOCAL_URL, LcmUrlError, default_url, parse_udpm_url  #
 from .transport import open_transport  # noqa: F401
 from .bt_reader import BtFormatError, BtMap, read_bt, read_bt_file  # noqa: F401
 from .map_client import MapClient, ServerTimeout  # noqa: F401
+from .snapshot_fetch import FetchError, Snapshot  # noqa: F401
+from .queries import FREE, OCCUPIED, UNKNOWN, QueryError  # noqa: F401

@@ -4,10 +4,14 @@ import struct
 import time
 from typing import Optional, Sequence
 
-from ._types import scan_t, server_status_t
+from ._types import map_info_t, scan_t, server_status_t
+from . import queries
+from .bt_reader import BtMap, read_bt
+from .snapshot_fetch import Snapshot, fetch_snapshot, new_client_id
 from .transport import open_transport
 
 STATUS_CHANNEL = "OCTOMAP_RT_STATUS"
+MAP_INFO_CHANNEL = "OCTOMAP_RT_MAP_INFO"
 SCAN_CHANNEL_PREFIX = "OCTOMAP_RT_SCAN_"
 
 
@@ -26,8 +30,10 @@ class MapClient:
     `recv_buf_size=` to receive multi-MB messages. `transport`: any object with publish,
     subscribe, unsubscribe and handle (default: open_transport(url))."""
 
-    def __init__(self, url: Optional[str] = None, transport=None):
+    def __init__(self, url: Optional[str] = None, transport=None, client_id: str = ""):
         self.transport = transport or open_transport(url)
+        self.client_id = client_id or new_client_id()
+        self.queries = queries.QueryChannel(self.transport, self.client_id)
         self._scan_seq = {}
 
     def close(self) -> None:
@@ -68,6 +74,37 @@ class MapClient:
     def status(self, timeout_s: float = 5.0) -> server_status_t:
         """The server's next status message (it sends one a second)."""
         return self.wait_for(STATUS_CHANNEL, server_status_t.decode, timeout_s=timeout_s)
+
+    def map_info(self, timeout_s: float = 5.0) -> map_info_t:
+        """The server's next map_info_t (1 Hz and after each snapshot)."""
+        return self.wait_for(MAP_INFO_CHANNEL, map_info_t.decode, timeout_s=timeout_s)
+
+    def fetch_snapshot(self, format: str = "bt", timeout_s: float = 30.0, snapshot_id: int = -1) -> Snapshot:
+        """The map as a .bt ("bt") or .ot ("ot") file's bytes in Snapshot.data: fresh
+        (snapshot_id -1), the latest kept (0) or a kept one by id. Raises FetchError."""
+        return fetch_snapshot(self.transport, format, timeout_s, snapshot_id, self.client_id)
+
+    def fetch_map(self, timeout_s: float = 30.0) -> BtMap:
+        """A fresh snapshot's occupied and free voxel centres as numpy arrays (read_bt)."""
+        return read_bt(self.fetch_snapshot("bt", timeout_s).data)
+
+    def query_points(self, points, depth: int = 0, min_snapshot_id: int = 0):
+        """(occupancy, probability) arrays for (N, 3) points: queries.UNKNOWN/FREE/OCCUPIED and
+        the node's occupancy probability (-1 where unknown)."""
+        return queries.query_points(self.queries, points, depth, min_snapshot_id)
+
+    def cast_rays(self, origins, directions, max_range: float = -1.0, ignore_unknown: bool = False,
+                  min_snapshot_id: int = 0):
+        """OcTree::castRay per ray on the server: (hit, end_state, end points (N, 3))."""
+        return queries.cast_rays(self.queries, origins, directions, max_range, ignore_unknown, min_snapshot_id)
+
+    def box(self, boxes, min_snapshot_id: int = 0):
+        """Finest-voxel counts in boxes (N, 6): {'occupied', 'free', 'unknown'} arrays."""
+        return queries.box_counts(self.queries, boxes, min_snapshot_id)
+
+    def grid(self, z_min: float, z_max: float, cell_size: float = 0.0, window=None, min_snapshot_id: int = 0):
+        """The 2D occupancy grid of a z band: (cells [row, column] int8, origin (x, y), cell size)."""
+        return queries.grid(self.queries, z_min, z_max, cell_size, window, min_snapshot_id)
 
     def publish_scan(self, points, robot_id: str, origin: Sequence[float] = (0.0, 0.0, 0.0),
                      orientation: Sequence[float] = (1.0, 0.0, 0.0, 0.0), points_in_map_frame: bool = False,

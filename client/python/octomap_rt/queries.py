@@ -1,0 +1,169 @@
+"""Occupancy queries to octomap-rt-server (docs/PROTOCOL.md, query section): points, rays,
+boxes and the 2D grid, numpy in and out. Each request is one datagram-sized message on its
+channel; the answer comes on the client's reply channel, matched by request_id. udpm is
+lossy, so a request unanswered within `retry_after_s` is sent again (a new request_id)."""
+
+import time
+from typing import Optional
+
+from ._types import (box_query_t, box_reply_t, grid_query_t, grid_t, occupancy_query_t,
+                     occupancy_reply_t, ray_query_t, ray_reply_t)
+
+POINTS_CHANNEL = "OCTOMAP_RT_QUERY"
+RAYS_CHANNEL = "OCTOMAP_RT_QUERY_RAYS"
+BOXES_CHANNEL = "OCTOMAP_RT_QUERY_BOXES"
+GRID_CHANNEL = "OCTOMAP_RT_QUERY_GRID"
+REPLY_PREFIX = "OCTOMAP_RT_QUERY_REPLY_"
+MAX_POINTS, MAX_RAYS, MAX_BOXES = 5000, 2000, 1000  # per message (one 60 KB datagram)
+
+UNKNOWN, FREE, OCCUPIED = occupancy_reply_t.OCC_UNKNOWN, occupancy_reply_t.OCC_FREE, occupancy_reply_t.OCC_OCCUPIED
+
+
+class QueryError(RuntimeError):
+    """The server refused or did not answer (status and its reason in the message)."""
+
+
+class QueryChannel:
+    """Sends a query and collects the reply messages with its request_id."""
+
+    def __init__(self, transport, client_id: str, timeout_s: float = 10.0, retry_after_s: float = 1.0):
+        self.transport = transport
+        self.client_id = client_id
+        self.reply_channel = REPLY_PREFIX + client_id
+        self.timeout_s = timeout_s
+        self.retry_after_s = retry_after_s
+        self._next_id = int(time.time() * 1000) * 1000
+
+    def _stamp(self, msg, min_snapshot_id: int) -> None:
+        msg.utime = int(time.time() * 1e6)
+        self._next_id += 1
+        msg.request_id = self._next_id
+        # The map version to wait for; the field is named min_snapshot_id (or min_map_version).
+        for name in ("min_snapshot_id", "min_map_version"):
+            if name in msg.__slots__:
+                setattr(msg, name, min_snapshot_id)
+        msg.wait_seq = -1
+        msg.wait_timeout_ms = 0
+        msg.wait_robot_id = ""
+        msg.client_id = self.client_id
+        msg.reply_channel = self.reply_channel
+
+    def ask(self, channel: str, msg, reply_type, min_snapshot_id: int = 0, complete=lambda replies: True):
+        """Publishes `msg` and returns the replies (a list) once `complete(replies)` holds."""
+        replies, wanted = [], set()
+
+        def take(_channel, data):
+            try:
+                r = reply_type.decode(data)
+            except ValueError:
+                return
+            if r.request_id in wanted and (not replies or r.request_id == replies[0].request_id):
+                replies.append(r)
+
+        sub = self.transport.subscribe(self.reply_channel, take)
+        try:
+            start = time.monotonic()
+            while time.monotonic() - start < self.timeout_s:
+                self._stamp(msg, min_snapshot_id)
+                wanted.add(msg.request_id)
+                self.transport.publish(channel, msg.encode())
+                sent = time.monotonic()
+                while time.monotonic() - sent < self.retry_after_s and not (replies and complete(replies)):
+                    self.transport.handle(0.05)
+                if replies and complete(replies):
+                    break
+                replies.clear()
+        finally:
+            self.transport.unsubscribe(sub)
+        if not replies:
+            raise QueryError(f"no answer on {self.reply_channel} within {self.timeout_s} s: "
+                             "is octomap-rt-server running with this LCM URL?")
+        first = replies[0]
+        if first.status != occupancy_reply_t.REPLY_OK:
+            raise QueryError(f"query refused (status {first.status}): {first.error}")
+        return replies
+
+
+def _float_list(array, np) -> list:
+    return np.ascontiguousarray(array, dtype=np.float32).reshape(-1).tolist()
+
+
+def query_points(q: QueryChannel, points, depth: int = 0, min_snapshot_id: int = 0):
+    """(occupancy int8 array of UNKNOWN/FREE/OCCUPIED, probability float32 array, -1 where
+    unknown) for an (N, 3) array of points in the map frame."""
+    import numpy as np
+
+    pts = np.asarray(points, dtype=np.float32).reshape(-1, 3)
+    occ, prob = [], []
+    for start in range(0, len(pts), MAX_POINTS):
+        m = occupancy_query_t()
+        m.depth = depth
+        m.xyz = _float_list(pts[start:start + MAX_POINTS], np)
+        m.num_xyz = len(m.xyz)
+        r = q.ask(POINTS_CHANNEL, m, occupancy_reply_t, min_snapshot_id)[0]
+        occ.extend(r.occupancy)
+        prob.extend(r.probability)
+    return np.asarray(occ, dtype=np.int8), np.asarray(prob, dtype=np.float32)
+
+
+def cast_rays(q: QueryChannel, origins, directions, max_range: float = -1.0, ignore_unknown: bool = False,
+              min_snapshot_id: int = 0):
+    """OcTree::castRay for each ray: (hit bool array, end_state int8 array, end points (N, 3)).
+    `origins` may be one point for all rays."""
+    import numpy as np
+
+    dirs = np.asarray(directions, dtype=np.float32).reshape(-1, 3)
+    orig = np.broadcast_to(np.asarray(origins, dtype=np.float32).reshape(-1, 3), dirs.shape)
+    hit, state, ends = [], [], []
+    for start in range(0, len(dirs), MAX_RAYS):
+        m = ray_query_t()
+        m.ignore_unknown = 1 if ignore_unknown else 0
+        m.max_range = float(max_range)
+        m.origin_xyz = _float_list(orig[start:start + MAX_RAYS], np)
+        m.direction_xyz = _float_list(dirs[start:start + MAX_RAYS], np)
+        m.num_xyz = len(m.origin_xyz)
+        r = q.ask(RAYS_CHANNEL, m, ray_reply_t, min_snapshot_id)[0]
+        hit.extend(r.hit)
+        state.extend(r.end_state)
+        ends.extend(r.end_xyz)
+    return (np.asarray(hit, dtype=bool), np.asarray(state, dtype=np.int8),
+            np.asarray(ends, dtype=np.float32).reshape(-1, 3))
+
+
+def box_counts(q: QueryChannel, boxes, min_snapshot_id: int = 0):
+    """Finest-voxel counts per box ((N, 6): min x y z, max x y z): a dict of int64 arrays
+    'occupied', 'free', 'unknown'."""
+    import numpy as np
+
+    b = np.asarray(boxes, dtype=np.float64).reshape(-1, 6)
+    out = {"occupied": [], "free": [], "unknown": []}
+    for start in range(0, len(b), MAX_BOXES):
+        m = box_query_t()
+        m.mode = box_query_t.MODE_COUNTS
+        m.boxes = b[start:start + MAX_BOXES].reshape(-1).tolist()
+        m.num_values = len(m.boxes)
+        r = q.ask(BOXES_CHANNEL, m, box_reply_t, min_snapshot_id)[0]
+        for key in out:
+            out[key].extend(getattr(r, key))
+    return {k: np.asarray(v, dtype=np.int64) for k, v in out.items()}
+
+
+def grid(q: QueryChannel, z_min: float, z_max: float, cell_size: float = 0.0,
+         window: Optional[tuple] = None, min_snapshot_id: int = 0):
+    """The 2D grid of a z band: (cells, origin (x, y), cell size), cells an int8 array
+    [row j, column i] of UNKNOWN/FREE/OCCUPIED, cell (i, j) at origin + (i, j) * cell size."""
+    import numpy as np
+
+    m = grid_query_t()
+    m.z_min, m.z_max, m.cell_size = float(z_min), float(z_max), float(cell_size)
+    m.use_window = 1 if window else 0
+    (x0, y0), (x1, y1) = window if window else ((0.0, 0.0), (0.0, 0.0))
+    m.window_min, m.window_max = [float(x0), float(y0)], [float(x1), float(y1)]
+    parts = q.ask(GRID_CHANNEL, m, grid_t, min_snapshot_id,
+                  complete=lambda rs: len({r.chunk_index for r in rs}) >= rs[0].num_chunks)
+    first = parts[0]
+    cells = np.full((first.height, first.width), UNKNOWN, dtype=np.int8)
+    for p in {r.chunk_index: r for r in parts}.values():
+        rows = np.asarray(p.cells, dtype=np.int8).reshape(p.num_rows, first.width)
+        cells[p.row_start:p.row_start + p.num_rows] = rows
+    return cells, (first.origin_x, first.origin_y), first.cell_size

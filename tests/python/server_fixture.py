@@ -1,0 +1,60 @@
+"""What the Python client tests share: a real octomap-rt-server (cpu back end, 0.1 m,
+publishing OCTOMAP) on a test URL of their network namespace, a MapClient on it, and
+helpers to publish a wall of points and to name voxels as OctoMap does."""
+
+import os
+import signal
+import subprocess
+import tempfile
+import unittest
+
+import numpy as np
+
+import octomap_rt
+
+SERVER = os.environ.get("OCTOMAP_RT_SERVER", "")
+CLI = os.environ.get("OCTOMAP_RT_CLI", "")
+EXAMPLE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "client", "python", "examples",
+                       "planner.py")
+
+
+def test_url(port):
+    with open("/proc/sys/net/core/rmem_max") as f:
+        rmem_max = int(f.read())
+    return f"udpm://239.255.76.67:{port}?ttl=0&recv_buf_size={min(4194304, rmem_max)}"
+
+
+def voxel_keys(points, resolution=0.1):
+    """OctoMap's coordToKey of float32 points (what a scan carries), as a set of triples
+    (minus the constant 32768)."""
+    coords = np.asarray(points, dtype=np.float32).astype(np.float64)
+    return {tuple(k) for k in np.floor(coords * (1.0 / resolution)).astype(int)}
+
+
+class ServerTestCase(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.mkdtemp(prefix="ort-py-client-")
+        cls.url = test_url(20000 + (os.getpid() * 7 + 3) % 20000)
+        cls.log = open(os.path.join(cls.dir, "server.log"), "w")
+        cls.server = subprocess.Popen([SERVER, "-r", "0.1", "--lcm-url", cls.url, "--backend", "cpu",
+                                       "--octomap-raw-rate", "5", "--octomap-raw-max-kib", "4096"],
+                                      stdout=cls.log, stderr=subprocess.STDOUT)
+        cls.client = octomap_rt.MapClient(cls.url)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.client.close()
+        cls.server.send_signal(signal.SIGTERM)
+        cls.server.wait(timeout=60)
+        cls.log.close()
+
+    def publish_wall(self, x: float, robot_id: str, origin=(0.0, 0.0, 0.5)):
+        """A 2 m x 1 m wall of points at `x` from a sensor at `origin`, waited for until applied;
+        returns the points in the map frame."""
+        wall = np.array([[x, y, z] for y in np.linspace(-1, 1, 21) for z in np.linspace(0, 1, 11)])
+        self.client.publish_scan(wall, robot_id=robot_id, origin=origin)
+        self.client.wait_for("OCTOMAP_RT_STATUS", octomap_rt.server_status_t.decode, timeout_s=60,
+                             accept=lambda s: any(r.robot_id.lower() == robot_id and r.scans_applied == 1
+                                                  for r in s.robots))
+        return wall + np.asarray(origin)
