@@ -10,5 +10,6 @@ void register_replay_command(CLI::App& app);
 void register_bench_command(CLI::App& app);
 void register_render_command(CLI::App& app);
 void register_status_command(CLI::App& app);
+void register_map_command(CLI::App& app);
 
 }  // namespace ort::cli

@@ -10,8 +10,18 @@
 #include <octomap/OcTree.h>
 
 #include "daemon/applied_order.h"
+#include "engine/voxel_update.h"
 
 namespace ort::daemon {
+
+// Told of every applied scan, under the map lock, right after the tree changed: `voxels`
+// are the keys the scan updated, `version` the map state id it made. Keep it short: the
+// pipeline's stage 2 waits.
+class MapChangeObserver {
+ public:
+  virtual ~MapChangeObserver() = default;
+  virtual void applied(const VoxelList& voxels, const octomap::OcTree& tree, uint64_t version) = 0;
+};
 
 struct MapState {
   std::mutex mutex;
@@ -23,6 +33,7 @@ struct MapState {
   // state a query was answered on are this number.
   uint64_t version = 0;
   int64_t last_scan_utime = 0;   // utime of the newest applied scan
+  MapChangeObserver* observer = nullptr;  // set before the pipeline starts
 };
 
 }  // namespace ort::daemon

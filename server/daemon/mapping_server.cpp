@@ -113,16 +113,51 @@ void MappingServer::start() {
   ScanLimits limits;
   limits.max_points = cfg_.max_points;
   limits.resolution = cfg_.engine.resolution;
+  open_map_serving();  // the delta observer is in place before the first scan is applied
   pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, cfg_.pipeline);
   pipeline_->start();
   intake_ = std::make_unique<ScanIntake>(*loop_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
-  intake_->open();  // before the loop starts: 1.3.1's subscribe races with handle
+  intake_->open();  // services subscribe before the loop starts: 1.3.1's subscribe races with handle
+  map_service_->open();
   loop_->start();
   raw_publisher_ = std::make_unique<OctomapRawPublisher>(cfg_.octomap_raw, map_, *loop_, log_);
   raw_publisher_->start();
+  map_service_->start();
   status_thread_ = std::thread([this] { run_status_loop(); });
   if (!cfg_.map_path.empty() && cfg_.save_interval_s > 0) save_thread_ = std::thread([this] { run_save_loop(); });
   set_state(Status::STATE_RUNNING, "serving " + cfg_.scan_channels);
+}
+
+void MappingServer::open_map_serving() {
+  if (cfg_.delta_rate_hz > 0) {
+    DeltaConfig d;
+    d.channel = cfg_.map_delta_channel;
+    d.max_rate_hz = cfg_.delta_rate_hz;
+    d.exact = cfg_.delta_exact;
+    d.zstd_level = cfg_.snapshot_zstd_level;
+    d.part_interval_ms = cfg_.chunk_interval_ms;
+    d.server_id = server_id_;
+    d.resolution = cfg_.engine.resolution;
+    deltas_ = std::make_unique<DeltaPublisher>(
+        *loop_, d, [this] { return map_service_ ? map_service_->stats().latest_snapshot_id : -1; }, log_);
+    map_.observer = deltas_.get();
+    deltas_->start(map_.version);
+  }
+  MapServiceConfig m;
+  m.request_channel = cfg_.map_request_channel;
+  m.info_channel = cfg_.map_info_channel;
+  m.snapshots = SnapshotPolicy{cfg_.snapshots_kept, cfg_.snapshot_zstd_level, cfg_.snapshot_min_interval_s};
+  m.chunk_interval_ms = cfg_.chunk_interval_ms;
+  m.server_id = server_id_;
+  m.resolution = cfg_.engine.resolution;
+  // This server maps the whole key space of its tree (one region; sharding would narrow it).
+  const double half = 32768.0 * cfg_.engine.resolution;
+  for (int k = 0; k < 3; ++k) {
+    m.region_min[k] = -half;
+    m.region_max[k] = half;
+  }
+  map_service_ = std::make_unique<MapService>(*loop_, map_, m, [this] { return deltas_ ? deltas_->last_seq() : -1; },
+                                              log_);
 }
 
 void MappingServer::stop() {
@@ -132,6 +167,8 @@ void MappingServer::stop() {
   intake_->close();
   queue_.close();
   pipeline_->join();
+  if (deltas_) deltas_->stop();  // sends the last change set
+  map_.observer = nullptr;
   {
     std::lock_guard lock(state_mutex_);
     stopping_ = true;
@@ -150,6 +187,7 @@ void MappingServer::stop() {
   wake_.notify_all();
   if (status_thread_.joinable()) status_thread_.join();
   raw_publisher_->stop();
+  map_service_->stop();
   loop_->stop();
 }
 
@@ -244,6 +282,7 @@ StatusInputs MappingServer::gather_status() {
     }
     const size_t leaves = std::min(cached_leaves_, t.size());
     in.num_nodes = static_cast<int64_t>(t.size());
+    in.map_version = static_cast<int64_t>(map_.version);
     in.num_leaf_nodes = static_cast<int64_t>(leaves);
     in.memory_bytes = static_cast<int64_t>(sizeof(octomap::OcTree) + t.memoryUsageNode() * t.size() +
                                            (t.size() - leaves) * sizeof(octomap::OcTreeNode* [8]));
@@ -255,6 +294,19 @@ StatusInputs MappingServer::gather_status() {
   in.kernel_rcvbuf_errors = read_udp_rcvbuf_errors();
   in.socket_rcvbuf_drops = read_own_udp_drops();
   in.map_saves = saves_;
+  if (map_service_) {
+    const MapServiceStats ms = map_service_->stats();
+    in.latest_snapshot_id = std::max<int64_t>(ms.latest_snapshot_id, 0);
+    in.requests_served = ms.requests_served;
+    in.requests_rejected = ms.requests_rejected;
+    in.snapshots_taken = ms.snapshots_taken;
+    in.chunks_sent = ms.chunks_sent;
+  }
+  if (deltas_) {
+    const DeltaStats ds = deltas_->stats();
+    in.deltas_sent = ds.messages;
+    in.last_delta_seq = ds.last_seq;
+  }
   in.last_save_utime = last_save_utime_;
   in.metrics = metrics_.snapshot();
   in.producers = producers_.snapshot();
@@ -321,6 +373,9 @@ void MappingServer::print_summary(std::ostream& out) {
   in.applied_log = cfg_.applied_log;
   in.last_save_ms = last_save_ms_;
   in.max_save_lock_ms = max_save_lock_ms_;
+  if (map_service_) in.map_service = map_service_->stats();
+  if (deltas_) in.deltas = deltas_->stats();
+  in.deltas_on = deltas_ != nullptr;
   print_run_summary(out, in);
 }
 

@@ -15,7 +15,9 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "daemon/delta_publisher.h"
 #include "daemon/lcm_loop.h"
+#include "daemon/map_service.h"
 #include "daemon/map_state.h"
 #include "daemon/octomap_raw_publisher.h"
 #include "daemon/pipeline_metrics.h"
@@ -65,6 +67,7 @@ class MappingServer {
  private:
   MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ostream& log);
   void load_or_create_map();
+  void open_map_serving();
   void set_state(int8_t state, std::string message);
   StatusInputs gather_status();
   void publish_status();
@@ -83,6 +86,8 @@ class MappingServer {
   std::unique_ptr<ScanIntake> intake_;
   std::unique_ptr<ScanPipeline> pipeline_;
   std::unique_ptr<OctomapRawPublisher> raw_publisher_;  // the map for LCM viewers (off by default)
+  std::unique_ptr<DeltaPublisher> deltas_;
+  std::unique_ptr<MapService> map_service_;
 
   std::string host_, server_id_;
   int64_t start_utime_ = 0;

@@ -55,6 +55,41 @@ void print_files(std::ostream& out, const RunSummaryInputs& in) {
   if (!in.applied_log.empty()) out << "  applied log:  " << in.applied_log << "\n";
 }
 
+void print_serving(std::ostream& out, const RunSummaryInputs& in) {
+  const MapServiceStats& m = in.map_service;
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "  snapshots:    %lld taken, %lld requests served (%lld chunks), %lld refused or ignored",
+                (long long)m.snapshots_taken, (long long)m.requests_served, (long long)m.chunks_sent,
+                (long long)m.requests_rejected);
+  out << line;
+  std::string reasons;
+  for (size_t k = 1; k < kRequestRefusalCount; ++k)
+    if (m.refusals[k])
+      reasons += std::string(reasons.empty() ? "" : ", ") + to_string(static_cast<RequestRefusal>(k)) + " " +
+                 std::to_string(m.refusals[k]);
+  out << (reasons.empty() ? "" : " (" + reasons + ")") << "\n";
+  if (m.snapshots_taken > 0) {
+    std::snprintf(line, sizeof line,
+                  "                last: %lld bytes raw, %lld compressed; copy held the map lock %.1f ms (at most "
+                  "%.1f ms), serialize %.1f ms, compress %.1f ms\n",
+                  (long long)m.last_raw_size, (long long)m.last_size, m.last_copy_lock_ms, m.max_copy_lock_ms,
+                  m.last_serialize_ms, m.last_compress_ms);
+    out << line;
+  }
+  const DeltaStats& d = in.deltas;
+  if (!in.deltas_on) {
+    out << "  deltas:       off\n";
+    return;
+  }
+  std::snprintf(line, sizeof line,
+                "  deltas:       %lld messages in %lld change sets for %lld scans, %lld voxels, %lld bytes (%.0f "
+                "bytes a scan)\n",
+                (long long)d.messages, (long long)d.sets, (long long)d.scans, (long long)d.voxels, (long long)d.bytes,
+                d.scans ? double(d.bytes) / double(d.scans) : 0.0);
+  out << line;
+}
+
 }  // namespace
 
 void print_run_summary(std::ostream& out, const RunSummaryInputs& in) {
@@ -71,6 +106,7 @@ void print_run_summary(std::ostream& out, const RunSummaryInputs& in) {
   out << line;
   out << "  kernel UDP drops: " << s.socket_rcvbuf_drops << " on the server's sockets, " << s.kernel_rcvbuf_errors
       << " in this network namespace (all programs; -1: unknown)\n";
+  print_serving(out, in);
   print_files(out, in);
 }
 

@@ -6,6 +6,8 @@
 #include <ostream>
 #include <string>
 
+#include "daemon/delta_publisher.h"
+#include "daemon/map_service.h"
 #include "daemon/status_message.h"
 
 namespace ort::daemon {
@@ -15,6 +17,9 @@ struct RunSummaryInputs {
   size_t scans_in_map = 0;         // applied-order entries, earlier runs included
   std::string applied_log;         // "": none
   double last_save_ms = 0, max_save_lock_ms = 0;
+  MapServiceStats map_service;
+  DeltaStats deltas;
+  bool deltas_on = false;
 };
 
 void print_run_summary(std::ostream& out, const RunSummaryInputs& in);

@@ -75,6 +75,7 @@ void ScanPipeline::apply(ShotJob& job) {
     map_.order.append(AppliedEntry{job.robot_id, job.seq, job.utime});
     map_.version++;
     map_.last_scan_utime = std::max(map_.last_scan_utime, job.utime);
+    if (map_.observer) map_.observer->applied(job.shot.voxels, *map_.tree, map_.version);
   } catch (const std::exception& e) {
     metrics_.overlap().end(1, token);
     reject(job.producer, Reject::kEngineError, e.what());

@@ -39,6 +39,19 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
   app.add_option("--max-points", s.max_points, "largest scan accepted [points]")->capture_default_str();
   app.add_option("--max-producers", s.max_producers, "most scan channels served; more are rejected")
       ->capture_default_str();
+  app.add_option("--snapshot-zstd-level", s.snapshot_zstd_level, "zstd level of served snapshots (0: uncompressed)")
+      ->capture_default_str();
+  app.add_option("--snapshots-kept", s.snapshots_kept, "snapshots kept for re-sends")->capture_default_str();
+  app.add_option("--snapshot-min-interval", s.snapshot_min_interval_s,
+                 "seconds between two new snapshots, however many clients ask")
+      ->capture_default_str();
+  app.add_option("--chunk-interval-ms", s.chunk_interval_ms,
+                 "pause between two snapshot chunks or delta parts (pacing for clients' receive buffers)")
+      ->capture_default_str();
+  app.add_option("--delta-rate", s.delta_rate_hz, "most map deltas a second (changes coalesced); 0: no deltas")
+      ->capture_default_str();
+  app.add_flag("--delta-exact", s.delta_exact,
+               "deltas carry every changed leaf with its log-odds (an exact mirror), not only class changes");
 }
 
 ServerConfig to_server_config(const ServerFlags& f) {
@@ -52,6 +65,10 @@ ServerConfig to_server_config(const ServerFlags& f) {
   if (!(c.status_period_s > 0)) throw CLI::ValidationError("--status-period", "must be > 0");
   if (c.max_points == 0) throw CLI::ValidationError("--max-points", "must be > 0");
   if (c.max_producers == 0) throw CLI::ValidationError("--max-producers", "must be > 0");
+  if (c.snapshot_zstd_level < 0 || c.snapshot_zstd_level > 19)
+    throw CLI::ValidationError("--snapshot-zstd-level", "must be within 0..19");
+  if (c.snapshots_kept == 0) throw CLI::ValidationError("--snapshots-kept", "must be > 0");
+  if (!(c.chunk_interval_ms >= 0)) throw CLI::ValidationError("--chunk-interval-ms", "must be >= 0");
   try {
     std::regex check(c.scan_channels);
   } catch (const std::regex_error& e) {

@@ -34,6 +34,16 @@ struct ServerConfig {
   size_t max_producers = 64;
   int lcm_queue_capacity = 64;                 // LCM's own per-subscription queue (messages)
   OctomapRawConfig octomap_raw;
+  // Serving the map (docs/PROTOCOL.md).
+  std::string map_request_channel = "OCTOMAP_RT_MAP_REQUEST";
+  std::string map_info_channel = "OCTOMAP_RT_MAP_INFO";
+  std::string map_delta_channel = "OCTOMAP_RT_MAP_DELTA";
+  int snapshot_zstd_level = 3;                 // 0: snapshots uncompressed
+  size_t snapshots_kept = 4;                   // for re-sends of chunks
+  double snapshot_min_interval_s = 0.5;        // a new snapshot at most this often
+  double chunk_interval_ms = 1.5;              // pacing of snapshot chunks and delta parts
+  double delta_rate_hz = 10;                   // most change sets a second; <= 0: no deltas
+  bool delta_exact = false;                    // deltas carry every changed leaf's log-odds
 };
 
 // Per-producer queue budget sized by memory: 1/64 of physical memory, within [64 MiB, 1 GiB].

@@ -38,8 +38,14 @@ octomap_rt::server_status_t make_status(const StatusInputs& in) {
   s.socket_rcvbuf_drops = in.socket_rcvbuf_drops;
   s.map_saves = in.map_saves;
   s.last_save_utime = in.last_save_utime;
-  s.latest_snapshot_id = 0;
-  s.requests_served = 0;
+  s.latest_snapshot_id = in.latest_snapshot_id;
+  s.map_version = in.map_version;
+  s.requests_served = in.requests_served;
+  s.requests_rejected = in.requests_rejected;
+  s.snapshots_taken = in.snapshots_taken;
+  s.chunks_sent = in.chunks_sent;
+  s.deltas_sent = in.deltas_sent;
+  s.last_delta_seq = in.last_delta_seq;
   for (size_t i = 0; i < in.producers.size(); ++i) {
     const ProducerStats& p = in.producers[i];
     octomap_rt::robot_stats_t r;

@@ -25,6 +25,8 @@ struct StatusInputs {
   int64_t queue_bytes = 0, queue_budget_bytes = 0;
   int64_t kernel_rcvbuf_errors = -1, socket_rcvbuf_drops = -1;
   int64_t map_saves = 0, last_save_utime = 0;
+  int64_t map_version = 0, latest_snapshot_id = 0, requests_served = 0, requests_rejected = 0;
+  int64_t snapshots_taken = 0, chunks_sent = 0, deltas_sent = 0, last_delta_seq = -1;
   MetricsSnapshot metrics;
   std::vector<ProducerStats> producers;
   std::vector<int64_t> producer_queue_bytes;  // parallel to producers

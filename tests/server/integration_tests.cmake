@@ -10,7 +10,7 @@ target_compile_definitions(octomap_rt_integration_harness PRIVATE
 
 function(octomap_rt_add_integration_test name timeout)
   octomap_rt_add_test(${name} SOURCES ${ORT_IT_DIR}/${name}.cpp
-                      LIBS octomap_rt_integration_harness octomap_rt_client octomap_rt_daemon
+                      LIBS octomap_rt_integration_harness octomap_rt_client octomap_rt_map_client octomap_rt_daemon
                       TIMEOUT ${timeout} LABELS integration)
   add_dependencies(${name} octomap-rt-server octomap-rt)
 endfunction()
@@ -19,3 +19,4 @@ octomap_rt_add_integration_test(server_producers_integration_test 300)
 octomap_rt_add_integration_test(server_large_scans_integration_test 400)
 octomap_rt_add_integration_test(server_persistence_integration_test 400)
 octomap_rt_add_integration_test(server_log_replay_integration_test 400)
+octomap_rt_add_integration_test(map_serving_integration_test 600)

@@ -1,0 +1,115 @@
+#include "map_client/map_mirror.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "protocol/delta_codec.h"
+
+namespace ort::client {
+namespace {
+using Delta = octomap_rt::map_delta_t;
+}
+
+MapMirror::MapMirror(MapClient& client, MirrorOptions opts) : client_(client), opts_(std::move(opts)) {
+  client_.on_delta([this](const Delta& d) { on_delta(d); });
+}
+
+void MapMirror::on_delta(const Delta& d) {
+  if (syncing_ || !tree_) {
+    buffered_.push_back(d);
+    return;
+  }
+  process(d);
+}
+
+void MapMirror::sync() {
+  syncing_ = true;
+  buffered_.clear();
+  FetchedSnapshot s;
+  try {
+    s = client_.fetch_snapshot(opts_.snapshot_format, opts_.fetch_timeout_s);
+  } catch (...) {
+    syncing_ = false;
+    throw;
+  }
+  tree_ = s.tree();
+  version_ = s.snapshot_id;
+  started_ = false;
+  last_seq_ = -1;
+  need_sync_ = false;
+  syncing_ = false;
+  stats_.snapshots++;
+  std::vector<Delta> pending;
+  pending.swap(buffered_);
+  std::sort(pending.begin(), pending.end(), [](const Delta& a, const Delta& b) { return a.delta_seq < b.delta_seq; });
+  for (const Delta& d : pending) {
+    if (need_sync_) break;
+    process(d);
+  }
+}
+
+void MapMirror::spin(double seconds) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto left = [&] { return seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  while (left() > 0) {
+    if (need_sync_ || !tree_) sync();
+    client_.spin(std::min(0.05, std::max(0.0, left())));
+  }
+}
+
+void MapMirror::gap() {
+  stats_.gaps++;
+  if (opts_.resync) need_sync_ = true;
+}
+
+void MapMirror::process(const Delta& d) {
+  if (need_sync_) return;
+  if (!started_) {
+    if (d.to_version <= version_) {  // already in the snapshot
+      stats_.deltas_skipped++;
+      last_seq_ = d.delta_seq;
+      return;
+    }
+    const bool continues = last_seq_ >= 0 && d.delta_seq == last_seq_ + 1;
+    if (d.from_version > version_ || (d.part_index != 0 && !continues)) {
+      gap();  // changes between the snapshot and this delta were not seen
+      if (!opts_.resync) apply(d);
+      return;
+    }
+    started_ = true;
+  } else if (d.delta_seq != last_seq_ + 1) {
+    gap();
+    if (opts_.resync) return;
+  }
+  apply(d);
+}
+
+void MapMirror::apply(const Delta& d) {
+  std::vector<protocol::VoxelChange> changes;
+  try {
+    changes = protocol::decode_delta_part({reinterpret_cast<const char*>(d.data.data()), d.data.size()}, d.num_voxels,
+                                          d.uncompressed_size, d.mode);
+  } catch (const std::exception&) {
+    stats_.bad_deltas++;
+    last_seq_ = d.delta_seq;
+    gap();  // its changes are lost: as if it never came
+    return;
+  }
+  const float occ = tree_->getClampingThresMaxLog(), free = tree_->getClampingThresMinLog();
+  for (const protocol::VoxelChange& c : changes) {
+    const float value = d.mode == Delta::MODE_LOG_ODDS ? c.value
+                        : (static_cast<int8_t>(c.value) == Delta::CLASS_OCCUPIED ? occ : free);
+    tree_->setNodeValue(protocol::unpack_key(c.key), value);
+  }
+  last_seq_ = d.delta_seq;
+  const bool complete = d.part_index == d.num_parts - 1;
+  if (complete) version_ = std::max(version_, d.to_version);
+  stats_.deltas_applied++;
+  stats_.voxels_applied += static_cast<int64_t>(changes.size());
+  const int64_t bytes = d.getEncodedSize();
+  stats_.delta_bytes += bytes;
+  if (opts_.on_delta)
+    opts_.on_delta(AppliedDelta{d.delta_seq, d.to_version, static_cast<int32_t>(changes.size()), complete, bytes});
+}
+
+}  // namespace ort::client

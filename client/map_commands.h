@@ -1,0 +1,18 @@
+// Shared by `octomap-rt map` subcommands (map_command.cpp, map_watch.cpp).
+#pragma once
+
+#include <string>
+
+namespace ort::cli {
+
+struct MapArgs {
+  std::string lcm_url;
+  double timeout_s = 30;
+  bool json = false, quiet = false;
+  double seconds = 0;  // watch: 0 = until Ctrl-C
+  std::string save;    // watch: .ot written at the end
+};
+
+void run_map_watch(const MapArgs& a);
+
+}  // namespace ort::cli

@@ -1,0 +1,78 @@
+// Live map deltas on OCTOMAP_RT_MAP_DELTA (map_delta_t, docs/PROTOCOL.md).
+//
+// As each scan is applied (under the map lock, MapChangeObserver), the keys of its voxel
+// list are looked up once in the updated tree: in class mode a key is kept when its class
+// may have changed (unknown -> free/occupied, free <-> occupied; the class before is the
+// value after minus the scan's update, OctoMap's clamping taken into account), in exact
+// mode every updated key is kept with its new log-odds. Keys collect in one pending set
+// (the newest value wins) which a thread of its own sends at most max_rate_hz times a
+// second: sorted, delta-coded, compressed, cut into self-contained parts <= 60 KB, paced.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <ostream>
+#include <string>
+#include <thread>
+#include <unordered_map>
+
+#include "daemon/lcm_loop.h"
+#include "daemon/map_state.h"
+
+namespace ort::daemon {
+
+struct DeltaConfig {
+  std::string channel = "OCTOMAP_RT_MAP_DELTA";
+  double max_rate_hz = 10;      // <= 0: no deltas
+  bool exact = false;           // every changed leaf with its log-odds, not only class changes
+  int zstd_level = 3;
+  double part_interval_ms = 1.5;  // pacing between the parts of one change set
+  std::string server_id;
+  double resolution = 0;
+};
+
+struct DeltaStats {
+  int64_t messages = 0, sets = 0, bytes = 0, voxels = 0, scans = 0;
+  int64_t last_seq = -1;
+};
+
+class DeltaPublisher : public MapChangeObserver {
+ public:
+  DeltaPublisher(LcmLoop& loop, DeltaConfig cfg, std::function<int64_t()> latest_snapshot_id, std::ostream& log);
+  ~DeltaPublisher() override;
+  DeltaPublisher(const DeltaPublisher&) = delete;
+  DeltaPublisher& operator=(const DeltaPublisher&) = delete;
+
+  // `version`: the map state id now (the first change set applies on it).
+  void start(uint64_t version);
+  // Sends what is pending, then ends the thread. Idempotent.
+  void stop();
+  void applied(const VoxelList& voxels, const octomap::OcTree& tree, uint64_t version) override;
+  DeltaStats stats() const;
+  int64_t last_seq() const { return last_seq_; }
+
+ private:
+  void run();
+  void flush();
+
+  LcmLoop& loop_;
+  DeltaConfig cfg_;
+  std::function<int64_t()> latest_snapshot_id_;
+  std::ostream& log_;
+
+  mutable std::mutex mutex_;  // pending_, versions, stop_, stats_
+  std::condition_variable cv_;
+  std::unordered_map<uint64_t, float> pending_;
+  uint64_t from_version_ = 0, to_version_ = 0;
+  int64_t pending_scans_ = 0;
+  bool stop_ = false;
+  DeltaStats stats_;
+  std::atomic<int64_t> last_seq_{-1};
+  int64_t next_seq_ = 0;
+  std::thread thread_;
+};
+
+}  // namespace ort::daemon
