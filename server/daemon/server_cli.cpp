@@ -50,6 +50,9 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
       ->capture_default_str();
   app.add_option("--delta-rate", s.delta_rate_hz, "most map deltas a second (changes coalesced); 0: no deltas")
       ->capture_default_str();
+  app.add_option("--map-request-channel", s.map_request_channel, "channel of map requests")->capture_default_str();
+  app.add_option("--map-info-channel", s.map_info_channel, "channel of map_info_t")->capture_default_str();
+  app.add_option("--map-delta-channel", s.map_delta_channel, "channel of map deltas")->capture_default_str();
   app.add_flag("--delta-exact", s.delta_exact,
                "deltas carry every changed leaf with its log-odds (an exact mirror), not only class changes");
 }
