@@ -3,6 +3,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -103,6 +104,12 @@ void register_map_command(CLI::App& app) {
   watch->add_option("--seconds", args->seconds, "stop after this long; 0: at Ctrl-C")->capture_default_str();
   watch->add_option("--save", args->save, "write the mirror to this .ot file at the end");
   watch->callback([args] { run_map_watch(*args); });
+  auto files = std::make_shared<std::vector<std::string>>();
+  CLI::App* diff = map->add_subcommand("diff", "compare two maps (.ot/.bt) voxel by voxel: class, and log-odds; exit 1 if classes differ");
+  diff->add_option("A B", *files, "two map files")->required()->expected(2);
+  diff->callback([files] {
+    if (run_map_diff((*files)[0], (*files)[1]) != 0) throw CLI::RuntimeError(1);
+  });
 }
 
 }  // namespace ort::cli

@@ -14,5 +14,7 @@ struct MapArgs {
 };
 
 void run_map_watch(const MapArgs& a);
+// 0 when both maps classify every finest voxel alike, else 1.
+int run_map_diff(const std::string& a, const std::string& b);
 
 }  // namespace ort::cli

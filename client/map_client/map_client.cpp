@@ -182,7 +182,10 @@ FetchedSnapshot MapClient::fetch_snapshot(int8_t format, double timeout_s, const
       if (progress) progress(as.received_bytes(), as.total_size());
     }
     chunks_.clear();
-    if (!as.complete() && seconds_since(last_arrival) >= opts_.rerequest_after_s) {
+    // Before the first chunk the server may still be copying and compressing a big map: ask
+    // again only after a longer silence, so as not to queue duplicate full sends.
+    const double patience = as.started() ? opts_.rerequest_after_s : opts_.first_answer_after_s;
+    if (!as.complete() && seconds_since(last_arrival) >= patience) {
       if (as.started())
         send_request(next_request_id_++, as.snapshot_id(), format, as.missing());
       else

@@ -35,6 +35,7 @@ struct FetchError : std::runtime_error {
 struct ClientOptions {
   std::string client_id;            // "": client_<pid>_<random>
   double rerequest_after_s = 0.25;  // silence before missing chunks are asked for again
+  double first_answer_after_s = 3;  // silence before a request with no answer at all is repeated
   std::string request_channel = "OCTOMAP_RT_MAP_REQUEST";
   std::string info_channel = "OCTOMAP_RT_MAP_INFO";
   std::string delta_channel = "OCTOMAP_RT_MAP_DELTA";

@@ -9,6 +9,7 @@
 #include "octomap_rt/map_delta_t.hpp"
 #include "protocol/delta_codec.h"
 #include "protocol/map_protocol.h"
+#include "protocol/zstd_codec.h"
 
 namespace ort::daemon {
 namespace {
@@ -87,6 +88,14 @@ void DeltaPublisher::applied(const VoxelList& voxels, const octomap::OcTree& tre
   pending_scans_++;
 }
 
+void DeltaPublisher::replaced(const octomap::OcTree&, uint64_t version) {
+  std::lock_guard lock(mutex_);
+  pending_.clear();
+  pending_scans_ = 0;
+  from_version_ = to_version_ = version;
+  skip_seqs_++;
+}
+
 DeltaStats DeltaPublisher::stats() const {
   std::lock_guard lock(mutex_);
   DeltaStats s = stats_;
@@ -115,7 +124,7 @@ void DeltaPublisher::flush() {
   int64_t scans;
   {
     std::lock_guard lock(mutex_);
-    if (pending_.empty()) return;  // versions keep accumulating into the next set
+    if (pending_.empty() && skip_seqs_ == 0) return;  // versions keep accumulating into the next set
     set.reserve(pending_.size());
     for (const auto& [k, v] : pending_) set.push_back({k, v});
     pending_.clear();
@@ -124,10 +133,14 @@ void DeltaPublisher::flush() {
     from_version_ = to;
     scans = pending_scans_;
     pending_scans_ = 0;
+    next_seq_ += skip_seqs_;
+    skip_seqs_ = 0;
   }
   std::sort(set.begin(), set.end(), [](const VoxelChange& a, const VoxelChange& b) { return a.key < b.key; });
   const int8_t mode = cfg_.exact ? Delta::MODE_LOG_ODDS : Delta::MODE_CLASS;
-  const auto parts = protocol::encode_delta_parts(set, mode, std::max(cfg_.zstd_level, 1), protocol::kDeltaDataBytes);
+  auto parts = protocol::encode_delta_parts(set, mode, std::max(cfg_.zstd_level, 1), protocol::kDeltaDataBytes);
+  if (parts.empty())  // after replaced(): one empty set carries the gap to the mirrors
+    parts.push_back(protocol::DeltaPart{0, 0, protocol::zstd_compress("", 1)});
   Delta d{};
   d.from_version = static_cast<int64_t>(from);
   d.to_version = static_cast<int64_t>(to);

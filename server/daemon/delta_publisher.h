@@ -51,6 +51,9 @@ class DeltaPublisher : public MapChangeObserver {
   // Sends what is pending, then ends the thread. Idempotent.
   void stop();
   void applied(const VoxelList& voxels, const octomap::OcTree& tree, uint64_t version) override;
+  // Drops what is pending and skips one delta_seq on purpose: every mirror sees a gap and
+  // resyncs from a snapshot at `version` or newer.
+  void replaced(const octomap::OcTree& tree, uint64_t version) override;
   DeltaStats stats() const;
   int64_t last_seq() const { return last_seq_; }
 
@@ -68,6 +71,7 @@ class DeltaPublisher : public MapChangeObserver {
   std::unordered_map<uint64_t, float> pending_;
   uint64_t from_version_ = 0, to_version_ = 0;
   int64_t pending_scans_ = 0;
+  int64_t skip_seqs_ = 0;
   bool stop_ = false;
   DeltaStats stats_;
   std::atomic<int64_t> last_seq_{-1};

@@ -10,7 +10,7 @@
 #include <octomap/OcTree.h>
 
 #include "daemon/applied_order.h"
-#include "engine/voxel_update.h"
+#include "core/voxel_update.h"
 
 namespace ort::daemon {
 
@@ -21,6 +21,9 @@ class MapChangeObserver {
  public:
   virtual ~MapChangeObserver() = default;
   virtual void applied(const VoxelList& voxels, const octomap::OcTree& tree, uint64_t version) = 0;
+  // The map changed in a way not described by a voxel list (an edit, a reload): deltas
+  // cannot carry it, so the observer makes clients resync. Also under the map lock.
+  virtual void replaced(const octomap::OcTree& tree, uint64_t version) = 0;
 };
 
 struct MapState {

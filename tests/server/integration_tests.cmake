@@ -20,3 +20,7 @@ octomap_rt_add_integration_test(server_large_scans_integration_test 400)
 octomap_rt_add_integration_test(server_persistence_integration_test 400)
 octomap_rt_add_integration_test(server_log_replay_integration_test 400)
 octomap_rt_add_integration_test(map_serving_integration_test 600)
+# Installs this build into a temporary prefix and builds client/examples/map_fetch against it.
+octomap_rt_add_integration_test(install_integration_test 900)
+target_compile_definitions(install_integration_test PRIVATE OCTOMAP_RT_BUILD_DIR="${CMAKE_BINARY_DIR}"
+                           OCTOMAP_RT_SOURCE_DIR="${CMAKE_SOURCE_DIR}")
