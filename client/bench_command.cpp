@@ -45,6 +45,7 @@ struct BenchArgs {
   std::string device;
   int warmup = 1, repeat = 1;
   bool no_octomap_breakdown = false;
+  std::vector<std::string> prepares = {"device"};
   std::string csv, png_dir, markdown;
   std::vector<std::string> replot;
 };
@@ -148,6 +149,18 @@ Reference run_octomap(const ScanSet& set, const BenchRow& base, const BenchArgs&
   return ref;
 }
 
+// (back end, preparation) pairs to measure: only vulkan prepares on its device, so other
+// back ends get one row whatever --prepare lists.
+std::vector<std::pair<std::string, std::string>> backend_configs(const BenchArgs& a) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& backend : a.backends) {
+    for (const auto& prepare : a.prepares) {
+      if (backend == "vulkan" || prepare == a.prepares.front()) out.emplace_back(backend, prepare);
+    }
+  }
+  return out;
+}
+
 void run_engine(const ScanSet& set, const EngineOptions& opts, const BenchArgs& a, const Reference& ref, BenchRow& r) {
   std::string log;
   MapEngine engine(opts, &log);
@@ -157,8 +170,8 @@ void run_engine(const ScanSet& set, const EngineOptions& opts, const BenchArgs& 
     auto scratch = engine.make_tree();
     for (size_t i = 0; i < warm; ++i) {
       ShotScan shot;
-      const octomap::Pointcloud world = world_points(set.scans[i]);
-      engine.insert(sensor_origin(set.scans[i]), as_span(world), *scratch, shot);
+      const PosedScan& s = set.scans[i];
+      engine.insert_posed(s.pose, sensor_origin(s), as_span(s.points), *scratch, shot);
     }
   }
   std::vector<std::pair<double, BenchRow>> runs;
@@ -167,21 +180,17 @@ void run_engine(const ScanSet& set, const EngineOptions& opts, const BenchArgs& 
     BenchRow m = r;
     tree = engine.make_tree();
     StageTimes st;
-    double transform_ms = 0;
     const auto t0 = Clock::now();
     for (const PosedScan& s : set.scans) {
-      const auto tt = Clock::now();
-      const octomap::Pointcloud world = world_points(s);
-      transform_ms += ms_since(tt);
-      ShotScan shot;
-      engine.insert(sensor_origin(s), as_span(world), *tree, shot);
+      ShotScan shot;  // sensor-frame points: the engine transforms (on the CPU or the GPU)
+      engine.insert_posed(s.pose, sensor_origin(s), as_span(s.points), *tree, shot);
       st.add(shot.shoot.times);
       m.windows += shot.shoot.windows;
       m.voxel_updates += shot.voxels.size();
       m.gpu_grid_bytes = std::max<uint64_t>(m.gpu_grid_bytes, shot.shoot.grid_words * 4);
     }
     m.total_ms = ms_since(t0);
-    m.prepare_ms = transform_ms + st.prepare_ms;
+    m.prepare_ms = st.prepare_ms;  // transform included
     m.upload_ms = st.upload_ms;
     m.shoot_ms = st.shoot_ms;
     m.compact_ms = st.compact_ms;
@@ -291,11 +300,11 @@ int run_bench(const BenchArgs& a) {
       const BenchRow& oct = ref.row;
       rows.push_back(oct);
       std::fprintf(stderr, " %.2f s\n", oct.total_ms / 1000.0);
-      for (const auto& backend : a.backends) {
+      for (const auto& [backend, prepare] : backend_configs(a)) {
         for (const auto& traversal : a.traversals) {
           for (const auto& octree : a.octrees) {
             BenchRow r = base;
-            r.backend = backend;
+            r.backend = backend == "vulkan" && prepare == "cpu" ? "vulkan/cpu-prep" : backend;
             r.traversal = traversal;
             r.octree = octree;
             r.octomap_free = ref.summary.finest_free;
@@ -308,6 +317,7 @@ int run_bench(const BenchArgs& a) {
             if (!parse_traversal(traversal, opts.traversal)) throw std::runtime_error("unknown traversal " + traversal);
             opts.backend.device = a.device;
             opts.backend.threads = a.threads;
+            opts.backend.gpu_prepare = prepare == "device";
             opts.octree.mode = octree == "batched" ? OctreeUpdateMode::kBatched : OctreeUpdateMode::kSequential;
             opts.octree.threads = a.threads;
             std::fprintf(stderr, "  %s @ %.2f m: %s, %s traversal, %s octree ...", name.c_str(), res, backend.c_str(),
@@ -378,6 +388,12 @@ void register_bench_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-octomap-breakdown", a->no_octomap_breakdown,
                 "skip the separate computeUpdate pass that splits OctoMap's time into shoot and octree");
+  cmd->add_option("--prepare", a->prepares,
+                  "scan preparation: device (on the GPU where the back end can: vulkan) and/or cpu; "
+                  "vulkan's cpu rows are named vulkan/cpu-prep")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"device", "cpu"}))
+      ->capture_default_str();
   cmd->add_option("--csv", a->csv, "write the results as CSV");
   cmd->add_option("--markdown", a->markdown, "write the tables as Markdown (default: to stdout)");
   cmd->add_option("--png", a->png_dir, "write a stage chart per data set (gnuplot) into this folder");

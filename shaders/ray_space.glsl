@@ -11,8 +11,9 @@ const int kTreeMaxVal = 32768;
 
 struct RayEnd {
   float x, y, z;
-  uint flags;  // bit 0: the end voxel is a measured hit
+  uint flags;  // bit 0: the end voxel is a measured hit; bit 1: dropped (skip the ray)
 };
+const uint kRayEndDropped = 2u;  // set only by GPU preparation (prepare_rays.comp)
 
 layout(std430, binding = 0) readonly buffer Rays { RayEnd rays[]; };
 layout(std430, binding = 1) buffer Grid { uint grid[]; };

@@ -4,4 +4,5 @@
 octomap_rt_embed_shader(shoot_octomap.comp shoot_octomap_spv)
 octomap_rt_embed_shader(shoot_exact.comp shoot_exact_spv)
 octomap_rt_embed_shader(compact_touched.comp compact_touched_spv)
+octomap_rt_embed_shader(prepare_rays.comp prepare_rays_spv)
 include(${CMAKE_CURRENT_LIST_DIR}/rt_shaders.cmake OPTIONAL)

@@ -25,6 +25,7 @@ void main() {
   const uint i = ray_base + gl_GlobalInvocationID.x;
   if (i >= ray_count) return;
   const RayEnd r = rays[i];
+  if ((r.flags & kRayEndDropped) != 0u) return;  // a point GPU preparation dropped
   const vec3 end = vec3(r.x, r.y, r.z);
   const dvec3 a = dvec3(double(origin_x), double(origin_y), double(origin_z));
   const dvec3 b = dvec3(double(r.x), double(r.y), double(r.z));

@@ -12,6 +12,7 @@ void main() {
   const uint i = ray_base + gl_GlobalInvocationID.x;
   if (i >= ray_count) return;
   const RayEnd r = rays[i];
+  if ((r.flags & kRayEndDropped) != 0u) return;  // a point GPU preparation dropped
   const vec3 origin = vec3(origin_x, origin_y, origin_z);
   const vec3 end = vec3(r.x, r.y, r.z);
   const ivec3 key_origin = ivec3(origin_key_x, origin_key_y, origin_key_z);

@@ -29,6 +29,7 @@ struct BackendOptions {
   uint64_t grid_budget_bytes = 0;  // 0: automatic (capped by maxStorageBufferRange)
   Traversal traversal = Traversal::kOctomap;  // rt refuses octomap mode at creation, so auto moves on
   unsigned threads = 0;            // cpu-grid: ray threads, 0 = hardware threads
+  bool gpu_prepare = true;         // vulkan: transform, max-range cut and keys in a shader (gpu/gpu_prepare.h)
   bool verbose = false;
 };
 

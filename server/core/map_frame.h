@@ -7,6 +7,7 @@
 #pragma once
 
 #include <algorithm>
+#include <span>
 #include <thread>
 #include <vector>
 
@@ -15,7 +16,7 @@
 
 namespace ort {
 
-inline void transform_to_map_frame(octomap::Pointcloud& pc, const octomap::pose6d& pose, unsigned threads = 0) {
+inline void transform_to_map_frame(std::span<octomap::point3d> pc, const octomap::pose6d& pose, unsigned threads = 0) {
   constexpr size_t kMinPointsPerThread = 16384;
   const size_t n = pc.size();
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
@@ -32,6 +33,11 @@ inline void transform_to_map_frame(octomap::Pointcloud& pc, const octomap::pose6
   pool.reserve(threads - 1);
   for (unsigned t = 1; t < threads; ++t) pool.emplace_back(run, t);
   run(0);
+}
+
+inline void transform_to_map_frame(octomap::Pointcloud& pc, const octomap::pose6d& pose, unsigned threads = 0) {
+  if (pc.size() == 0) return;
+  transform_to_map_frame(std::span<octomap::point3d>(&pc[0], pc.size()), pose, threads);
 }
 
 }  // namespace ort

@@ -65,18 +65,23 @@ void prepare_chunk(const octomap::point3d& origin, std::span<const octomap::poin
 
 }  // namespace
 
-RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::point3d> points,
-                      double max_range, double resolution, PrepareReport& report, unsigned threads) {
-  RayBatch batch;
+bool prepare_origin(const octomap::point3d& origin, double resolution, RayBatch& batch, PrepareReport& report) {
   batch.origin = origin;
   batch.resolution = resolution;
-  report.points_in += points.size();
   if (!finite(origin) || !coord_to_key_checked(origin, resolution, batch.origin_key)) {
     report.origin_ok = false;
     report.error = "sensor origin is not finite or lies outside the map's key range";
-    return batch;
+    return false;
   }
   batch.keys.include(batch.origin_key);
+  return true;
+}
+
+RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::point3d> points,
+                      double max_range, double resolution, PrepareReport& report, unsigned threads) {
+  RayBatch batch;
+  report.points_in += points.size();
+  if (!prepare_origin(origin, resolution, batch, report)) return batch;
   // Each point is prepared on its own, so contiguous chunks on several threads, joined in
   // order, give exactly the single-threaded batch (same rays, same order).
   constexpr size_t kMinPointsPerThread = 32768;

@@ -29,6 +29,11 @@ struct PrepareReport {
 RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::point3d> points,
                       double max_range, double resolution, PrepareReport& report, unsigned threads = 0);
 
+// The origin's part of prepare_scan: batch.origin, origin_key and the key box's first key,
+// or report.origin_ok = false (with the reason) when the origin is not finite or outside
+// the key range. Shared with GPU preparation.
+bool prepare_origin(const octomap::point3d& origin, double resolution, RayBatch& batch, PrepareReport& report);
+
 // OctoMap's coordToKeyChecked for a tree of the given resolution (depth 16).
 bool coord_to_key_checked(const octomap::point3d& p, double resolution, octomap::OcTreeKey& key);
 

@@ -5,9 +5,14 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
+#include <stdexcept>
 #include <string>
 
+#include <octomap/octomap_types.h>
+
 #include "core/backend_kind.h"
+#include "core/prepare_scan.h"
 #include "core/ray_batch.h"
 #include "core/voxel_update.h"
 
@@ -37,6 +42,15 @@ struct ShootStats {
   uint64_t grid_allocations = 0; // grid (re)allocations so far; stays 1 after start-up
 };
 
+// One scan as a sensor delivers it: points in the sensor frame, the pose that takes them
+// into the map frame (OctoMap's Pointcloud::transform), the sensor origin in the map frame.
+struct PosedPoints {
+  const octomap::pose6d* pose = nullptr;
+  octomap::point3d origin;
+  std::span<const octomap::point3d> points;
+  double max_range = -1.0;  // < 0: no limit
+};
+
 class RayBackend {
  public:
   virtual ~RayBackend() = default;
@@ -44,6 +58,17 @@ class RayBackend {
   virtual std::string device_name() const = 0;
   // Shoots every ray of the batch; replaces `out` with the scan's voxel states.
   virtual void shoot(const RayBatch& batch, Traversal mode, VoxelList& out, ShootStats& stats) = 0;
+
+  // True when this back end prepares scans on its device (shoot_posed); the engine then
+  // hands it sensor-frame points instead of a RayBatch.
+  virtual bool prepares_on_device() const { return false; }
+  // The transform and prepare_scan's rules on the device, with the same rays bit for bit,
+  // then the shot. Fills `report` as prepare_scan does, and stats.times.prepare_ms.
+  virtual void shoot_posed(const PosedPoints& scan, Traversal mode, VoxelList& out, ShootStats& stats,
+                           PrepareReport& report) {
+    (void)scan, (void)mode, (void)out, (void)stats, (void)report;
+    throw std::logic_error("this back end does not prepare scans on its device");
+  }
 };
 
 }  // namespace ort

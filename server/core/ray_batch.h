@@ -23,7 +23,10 @@ struct RayEnd {
 };
 static_assert(sizeof(RayEnd) == 16);
 
-enum RayEndFlags : uint32_t { kRayEndOccupied = 1u };
+// kRayEndDropped: a point GPU preparation dropped (non-finite, end outside the key range);
+// it keeps its slot so that ray i is point i, and the shooting passes skip it. CPU
+// preparation leaves dropped points out instead.
+enum RayEndFlags : uint32_t { kRayEndOccupied = 1u, kRayEndDropped = 2u };
 
 // Inclusive box of keys.
 struct KeyBox {

@@ -44,9 +44,14 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
   const auto t0 = Clock::now();
   bool ok = true;
   try {
-    const MapFrameScan scan = to_map_frame(item.msg);
+    const PosedMessageScan scan = to_posed_scan(item.msg);
     const std::span<const octomap::point3d> pts(scan.points.size() ? &scan.points[0] : nullptr, scan.points.size());
-    engine_.shoot(scan.origin, pts, effective_max_range(item.msg.max_range, engine_.options().max_range), job.shot);
+    const double max_range = effective_max_range(item.msg.max_range, engine_.options().max_range);
+    if (scan.in_sensor_frame) {
+      engine_.shoot_posed(scan.pose, scan.origin, pts, max_range, job.shot);  // transformed on the GPU where it can
+    } else {
+      engine_.shoot(scan.origin, pts, max_range, job.shot);
+    }
     if (!job.shot.prepare.origin_ok) {
       reject(item.producer, Reject::kOriginOutsideMap, "");
       ok = false;

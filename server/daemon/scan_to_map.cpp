@@ -1,6 +1,7 @@
 #include "daemon/scan_to_map.h"
 
 #include <algorithm>
+#include <utility>
 
 #include "core/map_frame.h"
 
@@ -15,12 +16,18 @@ octomap::pose6d scan_pose(const octomap_rt::scan_t& m) {
 }
 
 MapFrameScan to_map_frame(const octomap_rt::scan_t& m) {
-  MapFrameScan s;
-  const octomap::pose6d pose = scan_pose(m);
-  s.origin = pose.trans();
+  PosedMessageScan s = to_posed_scan(m);
+  if (s.in_sensor_frame) transform_to_map_frame(s.points, s.pose);
+  return {s.origin, std::move(s.points)};
+}
+
+PosedMessageScan to_posed_scan(const octomap_rt::scan_t& m) {
+  PosedMessageScan s;
+  s.pose = scan_pose(m);
+  s.origin = s.pose.trans();
+  s.in_sensor_frame = m.points_frame == octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME;
   s.points.reserve(m.xyz.size() / 3);
   for (size_t i = 0; i + 2 < m.xyz.size(); i += 3) s.points.push_back(m.xyz[i], m.xyz[i + 1], m.xyz[i + 2]);
-  if (m.points_frame == octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME) transform_to_map_frame(s.points, pose);
   return s;
 }
 

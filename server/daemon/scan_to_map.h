@@ -20,6 +20,18 @@ struct MapFrameScan {
 
 MapFrameScan to_map_frame(const octomap_rt::scan_t& msg);
 
+// The points as the message carries them, with the pose that takes them into the map frame
+// (identity for POINTS_IN_MAP_FRAME): for MapEngine::shoot_posed, which transforms on the GPU
+// where the back end prepares scans there, else exactly as to_map_frame does.
+struct PosedMessageScan {
+  octomap::pose6d pose;
+  octomap::point3d origin;
+  octomap::Pointcloud points;
+  bool in_sensor_frame = false;
+};
+
+PosedMessageScan to_posed_scan(const octomap_rt::scan_t& msg);
+
 // Max range for this scan: the message's when > 0, else the server's; the smaller when both.
 double effective_max_range(float scan_max_range, double server_max_range);
 

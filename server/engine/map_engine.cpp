@@ -1,6 +1,9 @@
 #include "engine/map_engine.h"
 
 #include <chrono>
+#include <vector>
+
+#include "core/map_frame.h"
 
 namespace ort {
 namespace {
@@ -31,6 +34,27 @@ void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::p
   out.shoot.times.prepare_ms = ms_since(t0);
   if (!out.prepare.origin_ok) return;
   backend_->shoot(batch, opts_.traversal, out.voxels, out.shoot);
+  count_states(out);
+}
+
+void MapEngine::shoot_posed(const octomap::pose6d& pose, const octomap::point3d& origin,
+                            std::span<const octomap::point3d> sensor_points, double max_range, ShotScan& out) {
+  if (backend_->prepares_on_device()) {
+    out = ShotScan{};
+    backend_->shoot_posed({&pose, origin, sensor_points, max_range}, opts_.traversal, out.voxels, out.shoot,
+                          out.prepare);
+    count_states(out);
+    return;
+  }
+  const auto t0 = Clock::now();
+  std::vector<octomap::point3d> world(sensor_points.begin(), sensor_points.end());
+  transform_to_map_frame(world, pose, opts_.octree.threads);
+  const double transform_ms = ms_since(t0);
+  shoot(origin, world, max_range, out);
+  out.shoot.times.prepare_ms += transform_ms;
+}
+
+void MapEngine::count_states(ShotScan& out) const {
   for (const VoxelUpdate& v : out.voxels) (v.occupied() ? out.occupied_voxels : out.free_voxels)++;
 }
 

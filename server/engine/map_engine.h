@@ -50,6 +50,13 @@ class MapEngine {
   // Stage 1. `max_range` overrides the engine's when >= -1 is not wanted: pass opts' value.
   void shoot(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range,
              ShotScan& out);
+  // Stage 1 for a scan in the sensor frame: `pose` takes the points into the map frame (as
+  // OctoMap's Pointcloud::transform), `origin` is the sensor origin in the map frame. The
+  // back end prepares it on its device where it can (BackendOptions::gpu_prepare), else the
+  // CPU transforms and prepares; the rays are the same either way, bit for bit.
+  // out.shoot.times.prepare_ms includes the transform.
+  void shoot_posed(const octomap::pose6d& pose, const octomap::point3d& origin,
+                   std::span<const octomap::point3d> sensor_points, double max_range, ShotScan& out);
   // Stage 2. Adds its time to out.shoot.times.octree_ms.
   void apply(ShotScan& scan, octomap::OcTree& tree) const;
   // Both stages.
@@ -59,10 +66,19 @@ class MapEngine {
     apply(out, tree);
   }
 
+  // Both stages, for a scan in the sensor frame.
+  void insert_posed(const octomap::pose6d& pose, const octomap::point3d& origin,
+                    std::span<const octomap::point3d> sensor_points, octomap::OcTree& tree, ShotScan& out) {
+    shoot_posed(pose, origin, sensor_points, opts_.max_range, out);
+    apply(out, tree);
+  }
+
   const EngineOptions& options() const { return opts_; }
   const RayBackend& backend() const { return *backend_; }
 
  private:
+  void count_states(ShotScan& out) const;
+
   EngineOptions opts_;
   std::unique_ptr<RayBackend> backend_;
   mutable OctreeStage octree_stage_;  // keeps the batched stage's threads between scans; only apply() uses it

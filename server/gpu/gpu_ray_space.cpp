@@ -33,14 +33,14 @@ void transfer_to_shaders(VkCommandBuffer cmd, VkPipelineStageFlags stage) {
                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
-ShootPush shoot_push(const RayBatch& batch, const KeyBox& w, uint32_t first_chunk_words) {
+ShootPush shoot_push(const RayBatch& batch, uint32_t ray_count, const KeyBox& w, uint32_t first_chunk_words) {
   ShootPush p{};
   p.resolution = batch.resolution;
   p.resolution_factor = 1.0 / batch.resolution;  // as OctoMap keeps it
   p.origin[0] = batch.origin.x();
   p.origin[1] = batch.origin.y();
   p.origin[2] = batch.origin.z();
-  p.ray_count = uint32_t(batch.ends.size());
+  p.ray_count = ray_count;
   p.first_chunk_words = first_chunk_words;
   p.ray_base = 0;
   for (int i = 0; i < 3; ++i) {
@@ -144,24 +144,46 @@ void GpuRaySpace::upload_rays(const RayBatch& batch, ShootStats& stats) {
 void GpuRaySpace::shoot(const RayBatch& batch, std::span<const KeyBox> windows, const RecordShoot& record_shoot,
                         VoxelList& out, ShootStats& stats) {
   out.clear();
-  stats.grid_words = opts_.sizing.grid_words;
-  stats.grid_allocations = grid_allocations_;  // the grid, touched list and output: once, at start-up
-  if (batch.ends.empty()) return;
+  if (batch.ends.empty()) {
+    shoot_windows(batch, 0, {}, record_shoot, out, stats);
+    return;
+  }
   if (batch.ends.size() > UINT32_MAX) throw std::runtime_error("GPU ray space: more than 2^32 rays in one scan");
   upload_rays(batch, stats);
+  shoot_windows(batch, uint32_t(batch.ends.size()), windows, record_shoot, out, stats);
+}
+
+VkBuffer GpuRaySpace::device_rays(uint64_t rays) {
+  if (rays > UINT32_MAX) throw std::runtime_error("GPU ray space: more than 2^32 rays in one scan");
+  ensure_ray_capacity(rays);
+  return rays_.handle();
+}
+
+void GpuRaySpace::shoot_resident(const RayBatch& header, uint32_t ray_count, std::span<const KeyBox> windows,
+                                 const RecordShoot& record_shoot, VoxelList& out, ShootStats& stats) {
+  out.clear();
+  if (ray_count > ray_capacity_) throw std::logic_error("GPU ray space: more resident rays than the rays buffer holds");
+  pending_ray_bytes_ = 0;
+  shoot_windows(header, ray_count, ray_count ? windows : std::span<const KeyBox>{}, record_shoot, out, stats);
+}
+
+void GpuRaySpace::shoot_windows(const RayBatch& batch, uint32_t ray_count, std::span<const KeyBox> windows,
+                                const RecordShoot& record_shoot, VoxelList& out, ShootStats& stats) {
+  stats.grid_words = opts_.sizing.grid_words;
+  stats.grid_allocations = grid_allocations_;  // the grid, touched list and output: once, at start-up
   for (const KeyBox& w : windows) {
     if (w.voxel_count() > grid_voxels()) throw std::logic_error("GPU ray space: a window larger than the grid");
-    shoot_window(batch, w, record_shoot, out, stats);
+    shoot_window(batch, ray_count, w, record_shoot, out, stats);
   }
   stats.windows += windows.size();
 }
 
-void GpuRaySpace::shoot_window(const RayBatch& batch, const KeyBox& window, const RecordShoot& record_shoot,
+void GpuRaySpace::shoot_window(const RayBatch& batch, uint32_t ray_count, const KeyBox& window, const RecordShoot& record_shoot,
                                VoxelList& out, ShootStats& stats) {
   const CompactPush cp = compact_push(window, opts_.sizing.chunk_words);
   const auto t_submit = Clock::now();
   VkCommandBuffer cmd = runner_.begin();
-  record_first_pass(cmd, shoot_push(batch, window, opts_.sizing.chunk_words), record_shoot, cp);
+  record_first_pass(cmd, shoot_push(batch, ray_count, window, opts_.sizing.chunk_words), record_shoot, cp);
   runner_.submit_and_wait();
   const double wall_ms = ms_since(t_submit);
 

@@ -75,11 +75,21 @@ class GpuRaySpace {
   void shoot(const RayBatch& batch, std::span<const KeyBox> windows, const RecordShoot& record_shoot, VoxelList& out,
              ShootStats& stats);
 
+  // Rays written on the device (GPU preparation, gpu/gpu_prepare.h) instead of uploaded:
+  // device_rays() makes room for `rays` and returns the buffer to write them into (valid
+  // until the next call); shoot_resident() then shoots its first `ray_count` rays, with the
+  // origin, origin key and resolution of `header` (whose ends are not read).
+  VkBuffer device_rays(uint64_t rays);
+  void shoot_resident(const RayBatch& header, uint32_t ray_count, std::span<const KeyBox> windows,
+                      const RecordShoot& record_shoot, VoxelList& out, ShootStats& stats);
+
  private:
   void make_buffers();
   void upload_rays(const RayBatch& batch, ShootStats& stats);
   void ensure_ray_capacity(uint64_t rays);
-  void shoot_window(const RayBatch& batch, const KeyBox& window, const RecordShoot& record_shoot, VoxelList& out,
+  void shoot_windows(const RayBatch& batch, uint32_t ray_count, std::span<const KeyBox> windows,
+                     const RecordShoot& record_shoot, VoxelList& out, ShootStats& stats);
+  void shoot_window(const RayBatch& batch, uint32_t ray_count, const KeyBox& window, const RecordShoot& record_shoot, VoxelList& out,
                     ShootStats& stats);
   void record_first_pass(VkCommandBuffer cmd, const ShootPush& push, const RecordShoot& record_shoot,
                          const CompactPush& cp);

@@ -10,6 +10,7 @@ namespace ort::gpu {
 inline constexpr uint32_t kShootGroup = 64;     // local_size_x of shoot_*.comp
 inline constexpr uint32_t kCompactGroup = 256;  // local_size_x of compact_touched.comp
 inline constexpr uint32_t kVoxelsPerWord = 16;  // 2-bit states in a uint32
+inline constexpr uint32_t kPrepareGroup = 64;   // local_size_x of prepare_rays.comp
 
 struct ShootPush {
   double resolution;
@@ -34,6 +35,34 @@ struct CompactPush {
   uint32_t chunk_words;
 };
 static_assert(sizeof(CompactPush) == 32);
+
+// prepare_rays.comp's push constants: the pose, the origin and the max-range rule of a scan.
+struct PreparePush {
+  double resolution_factor;
+  float rot[4];    // u, x, y, z
+  float trans[3];
+  uint32_t point_count;
+  float origin[3];
+  uint32_t point_base;
+  float norm_sq_limit;
+  float max_range_f;
+  uint32_t has_max_range;
+  float zero;
+};
+static_assert(sizeof(PreparePush) == 72);
+static_assert(offsetof(PreparePush, rot) == 8 && offsetof(PreparePush, point_count) == 36 &&
+              offsetof(PreparePush, point_base) == 52 && offsetof(PreparePush, zero) == 68);
+
+// prepare_rays.comp's result buffer: the key box of the kept ends and what was dropped or cut.
+struct PrepareCounts {
+  uint32_t key_lo[3];  // ~0u: no end kept
+  uint32_t key_hi[3];
+  uint32_t nonfinite;
+  uint32_t out_of_range;
+  uint32_t cut_at_max_range;
+  uint32_t pad;
+};
+static_assert(sizeof(PrepareCounts) == 40);
 
 // The Counters buffer; its first three words are the compact pass's VkDispatchIndirectCommand.
 struct Counters {

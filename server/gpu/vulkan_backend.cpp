@@ -3,13 +3,17 @@
 // This file holds only the shooting pass: one invocation per ray (shoot_octomap.comp or
 // shoot_exact.comp), split into dispatches of at most maxComputeWorkGroupCount groups, over
 // key-aligned windows cut to the grid's capacity (core window planning, plan_windows).
+// With BackendOptions::gpu_prepare it also prepares scans on the device (gpu/gpu_prepare.h):
+// the rays never exist on the host.
 #include "gpu/vulkan_backend.h"
 
 #include <algorithm>
+#include <chrono>
 #include <memory>
 #include <stdexcept>
 
 #include "core/ray_space.h"
+#include "gpu/gpu_prepare.h"
 #include "gpu/gpu_ray_space.h"
 #include "gpu/ray_space_sizing.h"
 #include "gpu/shader_interface.h"
@@ -22,6 +26,11 @@ namespace ort {
 namespace {
 
 constexpr int kWindowMargin = 2;  // voxels around the key box: the walk may overstep by one
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
 
 std::shared_ptr<vk::Context> make_context(const BackendOptions& opts) {
   vk::ContextOptions co;
@@ -46,7 +55,9 @@ class VulkanBackend final : public RayBackend {
         space_(ctx_, {.sizing = sizing_for(*ctx_, opts, tuning)}),
         shoot_octomap_(*ctx_, shoot_octomap_spv, 4, sizeof(gpu::ShootPush)),
         shoot_exact_(*ctx_, shoot_exact_spv, 4, sizeof(gpu::ShootPush)),
-        max_groups_(ctx_->properties().limits.maxComputeWorkGroupCount[0]) {
+        max_groups_(ctx_->properties().limits.maxComputeWorkGroupCount[0]),
+        resolution_(opts.resolution) {
+    if (opts.gpu_prepare) prepare_ = std::make_unique<gpu::GpuPrepare>(ctx_);
     space_.on_shoot_buffers([this](const gpu::ShootBuffers& b) {
       for (vk::ComputePipeline* p : {&shoot_octomap_, &shoot_exact_}) {
         p->bind_buffers({b.rays, b.grid, b.touched, b.counters});
@@ -71,6 +82,37 @@ class VulkanBackend final : public RayBackend {
         batch, windows, [&](VkCommandBuffer cmd, gpu::ShootPush push) { record_shoot(cmd, pass, push); }, out, stats);
   }
 
+  bool prepares_on_device() const override { return prepare_ != nullptr; }
+
+  void shoot_posed(const PosedPoints& scan, Traversal mode, VoxelList& out, ShootStats& stats,
+                   PrepareReport& report) override {
+    if (!prepare_) RayBackend::shoot_posed(scan, mode, out, stats, report);
+    out.clear();
+    report.points_in += scan.points.size();
+    RayBatch header;  // origin, origin key, key box; the ends stay on the device
+    if (!prepare_origin(scan.origin, resolution_, header, report)) return;
+    const auto t_stage = Clock::now();
+    prepare_->stage_points(scan.points);
+    stats.times.upload_ms += ms_since(t_stage);
+    const auto t_prepare = Clock::now();
+    const VkBuffer rays = space_.device_rays(scan.points.size());
+    const gpu::DevicePrepared p = prepare_->run({*scan.pose, scan.origin, scan.max_range, resolution_}, rays);
+    stats.times.prepare_ms += ms_since(t_prepare);
+    report.nonfinite += p.nonfinite;
+    report.out_of_range += p.out_of_range;
+    report.cut_at_max_range += p.cut_at_max_range;
+    const uint64_t kept = scan.points.size() - p.nonfinite - p.out_of_range;
+    report.rays += kept;
+    if (kept == 0) return;  // as prepare_scan: no rays, nothing shot
+    header.keys.include(octomap::OcTreeKey(p.end_keys.lo[0], p.end_keys.lo[1], p.end_keys.lo[2]));
+    header.keys.include(octomap::OcTreeKey(p.end_keys.hi[0], p.end_keys.hi[1], p.end_keys.hi[2]));
+    const vk::ComputePipeline& pass = mode == Traversal::kOctomap ? shoot_octomap_ : shoot_exact_;
+    const std::vector<KeyBox> windows = plan_windows(header.keys, space_.grid_voxels(), kWindowMargin);
+    space_.shoot_resident(
+        header, uint32_t(scan.points.size()), windows,
+        [&](VkCommandBuffer cmd, gpu::ShootPush push) { record_shoot(cmd, pass, push); }, out, stats);
+  }
+
  private:
   // One invocation per ray, in dispatches of at most max_groups_ groups.
   void record_shoot(VkCommandBuffer cmd, const vk::ComputePipeline& pass, gpu::ShootPush push) const {
@@ -86,6 +128,8 @@ class VulkanBackend final : public RayBackend {
   gpu::GpuRaySpace space_;
   vk::ComputePipeline shoot_octomap_, shoot_exact_;
   uint32_t max_groups_;
+  double resolution_;
+  std::unique_ptr<gpu::GpuPrepare> prepare_;  // null without BackendOptions::gpu_prepare
   std::string name_;
 };
 

@@ -23,3 +23,7 @@ octomap_rt_add_test(gpu_no_device_test SOURCES ${GPU_TEST_DIR}/no_device_test.cp
 octomap_rt_add_test(gpu_rt_cli_test SOURCES ${GPU_TEST_DIR}/rt_cli_test.cpp TIMEOUT 300)
 target_compile_definitions(gpu_rt_cli_test PRIVATE OCTOMAP_RT_CLI="$<TARGET_FILE:octomap-rt>")
 add_dependencies(gpu_rt_cli_test octomap-rt)
+
+# GPU scan preparation (issue 12) against the CPU's, bit for bit.
+octomap_rt_add_test(gpu_prepare_test SOURCES ${GPU_TEST_DIR}/gpu_prepare_test.cpp
+                    LIBS octomap_rt_gpu_test_support TIMEOUT 600)
