@@ -55,10 +55,10 @@ int run_build(const BuildArgs& a) {
   uint64_t voxels = 0, windows = 0;
   const auto t0 = std::chrono::steady_clock::now();
   for (size_t i = 0; i < set.scans.size(); ++i) {
-    const octomap::Pointcloud world = world_points(set.scans[i]);
-    std::span<const octomap::point3d> pts(world.size() ? &world[0] : nullptr, world.size());
-    ShotScan shot;
-    engine.insert(sensor_origin(set.scans[i]), pts, *tree, shot);
+    const PosedScan& scan = set.scans[i];
+    std::span<const octomap::point3d> pts(scan.points.size() ? &scan.points[0] : nullptr, scan.points.size());
+    ShotScan shot;  // sensor-frame points: transformed on the GPU where the back end prepares there
+    engine.insert_posed(scan.pose, sensor_origin(scan), pts, *tree, shot);
     if (!shot.prepare.origin_ok) {
       std::cerr << "  scan " << i << " rejected: " << shot.prepare.error << "\n";
       continue;
@@ -73,7 +73,7 @@ int run_build(const BuildArgs& a) {
     windows += shot.shoot.windows;
     if (!a.quiet) {
       std::fprintf(stderr, "  [%zu/%zu] %zu points, %zu voxels (%llu occupied), %.1f ms\n", i + 1, set.scans.size(),
-                   world.size(), shot.voxels.size(), (unsigned long long)shot.occupied_voxels,
+                   scan.points.size(), shot.voxels.size(), (unsigned long long)shot.occupied_voxels,
                    shot.shoot.times.total_ms());
     }
   }
