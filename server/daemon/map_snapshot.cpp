@@ -21,13 +21,13 @@ MapCopy copy_locked(const MapState& map, std::chrono::steady_clock::time_point t
 
 MapCopy copy_map(MapState& map) {
   const auto t0 = std::chrono::steady_clock::now();
-  std::lock_guard lock(map.mutex);
+  std::shared_lock lock(map.mutex);  // a reader: queries may read at the same time
   return copy_locked(map, t0);
 }
 
 std::optional<MapCopy> copy_map_if_changed(MapState& map, uint64_t unchanged_since) {
   const auto t0 = std::chrono::steady_clock::now();
-  std::lock_guard lock(map.mutex);
+  std::shared_lock lock(map.mutex);  // a reader: queries may read at the same time
   if (map.version == unchanged_since) return std::nullopt;
   return copy_locked(map, t0);
 }

@@ -5,7 +5,10 @@
 
 #include <cstdint>
 #include <memory>
-#include <mutex>
+#include <condition_variable>
+#include <map>
+#include <shared_mutex>
+#include <string>
 
 #include <octomap/OcTree.h>
 
@@ -27,16 +30,22 @@ class MapChangeObserver {
 };
 
 struct MapState {
-  std::mutex mutex;
+  // Writers (stage 2, edits) lock it exclusively; queries read under a shared lock.
+  std::shared_mutex mutex;
   std::unique_ptr<octomap::OcTree> tree;
   AppliedOrder order;
   // The map state id: how many scans the map contains by its applied order, over the map's
   // whole life (a loaded map starts at its order file's count; +1 per applied scan, under
   // the lock). Two reads with the same version saw the same map. Snapshot ids and the map
-  // state a query was answered on are this number.
+  // state a query was answered on are this number. A map edit (daemon/map_edit_item.h)
+  // also adds 1: the id changes whenever the map does.
   uint64_t version = 0;
   int64_t last_scan_utime = 0;   // utime of the newest applied scan
   MapChangeObserver* observer = nullptr;  // set before the pipeline starts
+  // Newest applied seq per robot (lower-case id), for queries that wait for their own scan.
+  std::map<std::string, int64_t> applied_seq;
+  // Notified (without the lock held) after every applied scan or edit.
+  std::condition_variable_any changed;
 };
 
 }  // namespace ort::daemon

@@ -119,10 +119,13 @@ void MappingServer::start() {
   intake_ = std::make_unique<ScanIntake>(*loop_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
   intake_->open();  // services subscribe before the loop starts: 1.3.1's subscribe races with handle
   map_service_->open();
+  queries_ = std::make_unique<QueryService>(cfg_.queries, map_, queue_, *loop_, server_id_, cfg_.engine.resolution);
+  queries_->open();
   loop_->start();
   raw_publisher_ = std::make_unique<OctomapRawPublisher>(cfg_.octomap_raw, map_, *loop_, log_);
   raw_publisher_->start();
   map_service_->start();
+  queries_->start();
   status_thread_ = std::thread([this] { run_status_loop(); });
   if (!cfg_.map_path.empty() && cfg_.save_interval_s > 0) save_thread_ = std::thread([this] { run_save_loop(); });
   set_state(Status::STATE_RUNNING, "serving " + cfg_.scan_channels);
@@ -188,6 +191,7 @@ void MappingServer::stop() {
   if (status_thread_.joinable()) status_thread_.join();
   raw_publisher_->stop();
   map_service_->stop();
+  if (queries_) queries_->stop();
   loop_->stop();
 }
 
@@ -273,7 +277,7 @@ StatusInputs MappingServer::gather_status() {
     // size() is O(1); the leaf count (and memoryUsage(), which needs it) walks the whole
     // tree under the map lock, stalling stage 2. So on big maps it is refreshed at most
     // every 10 s and memory is computed from the cached leaf count with OctoMap's formula.
-    std::lock_guard lock(map_.mutex);
+    std::shared_lock lock(map_.mutex);
     const octomap::OcTree& t = *map_.tree;
     const auto now = std::chrono::steady_clock::now();
     if (t.size() <= 1'000'000 || now - leaves_time_ > std::chrono::seconds(10)) {

@@ -22,6 +22,7 @@
 #include "daemon/octomap_raw_publisher.h"
 #include "daemon/pipeline_metrics.h"
 #include "daemon/producer_registry.h"
+#include "daemon/query_service.h"
 #include "daemon/scan_intake.h"
 #include "daemon/scan_pipeline.h"
 #include "daemon/scan_queue.h"
@@ -51,11 +52,12 @@ class MappingServer {
 
   octomap_rt::server_status_t status();
   std::vector<ProducerStats> producer_stats() const { return producers_.snapshot(); }
+  std::vector<QueryClientStats> query_stats() const { return queries_ ? queries_->stats() : std::vector<QueryClientStats>{}; }
   std::vector<AppliedEntry> applied_order() const { return map_.order.entries(); }
   // Runs f(const OcTree&) under the map lock: a state between two whole scans.
   template <class F>
   auto with_map(F&& f) {
-    std::lock_guard lock(map_.mutex);
+    std::shared_lock lock(map_.mutex);
     return f(static_cast<const octomap::OcTree&>(*map_.tree));
   }
   const std::string& lcm_url() const { return url_; }
@@ -85,6 +87,7 @@ class MappingServer {
   PipelineMetrics metrics_;
   std::unique_ptr<ScanIntake> intake_;
   std::unique_ptr<ScanPipeline> pipeline_;
+  std::unique_ptr<QueryService> queries_;      // planners' queries and map edits
   std::unique_ptr<OctomapRawPublisher> raw_publisher_;  // the map for LCM viewers (off by default)
   std::unique_ptr<DeltaPublisher> deltas_;
   std::unique_ptr<MapService> map_service_;

@@ -1,11 +1,16 @@
 #include "daemon/scan_pipeline.h"
 
+#include <cctype>
 #include <iostream>
 
 #include "daemon/scan_to_map.h"
 
 namespace ort::daemon {
 namespace {
+std::string lower_case(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
 double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
@@ -40,6 +45,10 @@ void ScanPipeline::reject(size_t producer, Reject why, const char* what) {
 }
 
 bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
+  if (item.edit) {  // edits pass stage 1 untouched
+    job.edit = std::move(item.edit);
+    return true;
+  }
   const double token = metrics_.overlap().begin(0);
   const auto t0 = Clock::now();
   bool ok = true;
@@ -71,7 +80,21 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
   return ok;
 }
 
+void ScanPipeline::apply_edit(MapEditItem& edit) {
+  MapEditResult r;
+  try {
+    std::unique_lock lock(map_.mutex);
+    r = apply_map_edit(map_, edit);
+  } catch (const std::exception& e) {
+    r.ok = false;
+    r.error = e.what();
+  }
+  map_.changed.notify_all();
+  if (edit.done) edit.done(r);
+}
+
 void ScanPipeline::apply(ShotJob& job) {
+  if (job.edit) return apply_edit(*job.edit);
   const double token = metrics_.overlap().begin(1);
   const auto t0 = Clock::now();
   try {
@@ -81,11 +104,13 @@ void ScanPipeline::apply(ShotJob& job) {
     map_.version++;
     map_.last_scan_utime = std::max(map_.last_scan_utime, job.utime);
     if (map_.observer) map_.observer->applied(job.shot.voxels, *map_.tree, map_.version);
+    map_.applied_seq[lower_case(job.robot_id)] = job.seq;
   } catch (const std::exception& e) {
     metrics_.overlap().end(1, token);
     reject(job.producer, Reject::kEngineError, e.what());
     return;
   }
+  map_.changed.notify_all();
   const auto t1 = Clock::now();
   const double overlap_s = metrics_.overlap().end(1, token);
   AppliedTiming t;

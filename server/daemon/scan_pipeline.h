@@ -24,6 +24,7 @@ struct ShotJob {
   Clock::time_point received;
   double shoot_ms = 0;
   ShotScan shot;
+  std::shared_ptr<MapEditItem> edit;  // set: apply this edit instead of a scan
 };
 
 class ScanPipeline {
@@ -41,6 +42,7 @@ class ScanPipeline {
   // Stage 1 on one scan; false when it ended as a rejection.
   bool shoot(QueuedScan& item, ShotJob& job);
   void apply(ShotJob& job);
+  void apply_edit(MapEditItem& edit);
   void reject(size_t producer, Reject why, const char* what);
   void run_stage1();
   void run_stage2();

@@ -31,12 +31,27 @@ bool ScanQueue::try_push(QueuedScan&& s) {
   return true;
 }
 
+bool ScanQueue::push_edit(std::shared_ptr<MapEditItem> edit) {
+  {
+    std::lock_guard lock(mutex_);
+    if (closed_) return false;
+    QueuedScan s;
+    s.edit = std::move(edit);
+    s.received = Clock::now();
+    s.arrival = next_arrival_++;
+    fifo_.push_back(std::move(s));
+  }
+  ready_.notify_one();
+  return true;
+}
+
 std::optional<QueuedScan> ScanQueue::pop() {
   std::unique_lock lock(mutex_);
   ready_.wait(lock, [&] { return closed_ || !fifo_.empty(); });
   if (fifo_.empty()) return std::nullopt;
   QueuedScan s = std::move(fifo_.front());
   fifo_.pop_front();
+  if (s.edit) return s;
   bytes_by_producer_[s.producer] -= s.bytes;
   depth_by_producer_[s.producer]--;
   total_bytes_ -= s.bytes;

@@ -11,10 +11,12 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <vector>
 
+#include "daemon/map_edit_item.h"
 #include "octomap_rt/scan_t.hpp"
 
 namespace ort::daemon {
@@ -27,6 +29,7 @@ struct QueuedScan {
   Clock::time_point received;  // when the LCM thread got it
   size_t bytes = 0;            // what it holds against the budget
   octomap_rt::scan_t msg;
+  std::shared_ptr<MapEditItem> edit;  // set: a map edit, not a scan (msg is empty)
 };
 
 // Memory a queued scan holds (its points dominate).
@@ -38,6 +41,9 @@ class ScanQueue {
 
   // False when the producer's (or the total) budget would be exceeded, or after close().
   bool try_push(QueuedScan&& s);
+  // Queues a map edit in arrival order with the scans, outside every byte budget (edits are
+  // small and rate-limited by the query service). False after close().
+  bool push_edit(std::shared_ptr<MapEditItem> edit);
   // Blocks until a scan is there; nullopt once closed and empty.
   std::optional<QueuedScan> pop();
   // No more pushes; pop() drains what is left, then returns nullopt.

@@ -37,6 +37,11 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                  "per-producer queue budget [MiB]; 0: 1/64 of physical memory within [64, 1024]")
       ->capture_default_str();
   app.add_option("--max-points", s.max_points, "largest scan accepted [points]")->capture_default_str();
+  app.add_option("--control-token", s.queries.control_token,
+                 "allow map edits (octomap-rt map clear-box/reset) from requests carrying this token; without it "
+                 "every edit is refused. LCM has no authentication: the token keeps mistakes out, not attackers");
+  app.add_option("--query-queue", s.queries.per_client_queue, "queued queries per client; more get BUSY replies")
+      ->capture_default_str();
   app.add_option("--max-producers", s.max_producers, "most scan channels served; more are rejected")
       ->capture_default_str();
   app.add_option("--snapshot-zstd-level", s.snapshot_zstd_level, "zstd level of served snapshots (0: uncompressed)")

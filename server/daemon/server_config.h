@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 
+#include "daemon/query_config.h"
 #include "engine/map_engine.h"
 
 namespace ort::daemon {
@@ -44,6 +45,7 @@ struct ServerConfig {
   double chunk_interval_ms = 1.5;              // pacing of snapshot chunks and delta parts
   double delta_rate_hz = 10;                   // most change sets a second; <= 0: no deltas
   bool delta_exact = false;                    // deltas carry every changed leaf's log-odds
+  QueryServiceConfig queries;                  // queries and map edits (daemon/query_service.h)
 };
 
 // Per-producer queue budget sized by memory: 1/64 of physical memory, within [64 MiB, 1 GiB].

@@ -8,3 +8,6 @@ octomap_rt_add_test(server_persistence_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/ma
                     ${CMAKE_CURRENT_LIST_DIR}/server_persistence_test.cpp ${SERVER_TEST_FIXTURES}
                     LIBS octomap_rt_daemon TIMEOUT 300)
 octomap_rt_add_test(lcm_loop_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/lcm_loop_test.cpp LIBS octomap_rt_daemon TIMEOUT 120)
+# The query service (issue 11): answers, read-your-writes, edits, bad queries, over memq://.
+octomap_rt_add_test(server_query_service_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/query_service_test.cpp
+                    ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)

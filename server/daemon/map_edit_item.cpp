@@ -1,0 +1,27 @@
+#include "daemon/map_edit_item.h"
+
+#include "daemon/map_state.h"
+#include "octomap_rt/map_edit_t.hpp"
+#include "query/map_edit.h"
+
+namespace ort::daemon {
+
+MapEditResult apply_map_edit(MapState& map, const MapEditItem& edit) {
+  using Msg = octomap_rt::map_edit_t;
+  MapEditResult r;
+  octomap::OcTree& tree = *map.tree;
+  if (edit.op == Msg::OP_RESET) {
+    query::reset_map(tree);
+  } else {
+    const query::KeyBox box = query::key_box(tree, edit.box_min, edit.box_max);
+    r.voxels = box.voxels();
+    query::clear_box(tree, box, edit.op == Msg::OP_CLEAR_TO_FREE ? query::ClearTo::kFree : query::ClearTo::kUnknown);
+  }
+  map.version++;
+  r.ok = true;
+  r.version = map.version;
+  r.map_utime = map.last_scan_utime;
+  return r;
+}
+
+}  // namespace ort::daemon

@@ -1,0 +1,75 @@
+#include "daemon/query_clients.h"
+
+namespace ort::daemon {
+
+QueryClients::QueryClients(size_t per_client_queue, size_t max_clients)
+    : per_client_queue_(per_client_queue), max_clients_(max_clients) {}
+
+QueryClients::Client& QueryClients::at(const std::string& client) {
+  auto it = clients_.find(client);
+  if (it != clients_.end()) return it->second;
+  // Past max_clients every new id shares one entry, "*", so the map stays bounded.
+  const std::string key = clients_.size() >= max_clients_ ? "*" : client;
+  Client& c = clients_[key];
+  c.stats.client_id = key;
+  return c;
+}
+
+bool QueryClients::push(const std::string& client, PendingQuery&& q) {
+  std::lock_guard lock(mutex_);
+  Client& c = at(client);
+  if (c.queue.size() >= per_client_queue_) {
+    c.stats.busy++;
+    return false;
+  }
+  c.queue.push_back(std::move(q));
+  ++queued_;
+  return true;
+}
+
+std::optional<PendingQuery> QueryClients::pop() {
+  std::lock_guard lock(mutex_);
+  if (queued_ == 0) return std::nullopt;
+  auto it = clients_.upper_bound(next_);
+  for (size_t n = 0; n <= clients_.size(); ++n, ++it) {
+    if (it == clients_.end()) it = clients_.begin();
+    if (!it->second.queue.empty()) {
+      PendingQuery q = std::move(it->second.queue.front());
+      it->second.queue.pop_front();
+      --queued_;
+      next_ = it->first;
+      return q;
+    }
+  }
+  return std::nullopt;
+}
+
+size_t QueryClients::queued() const {
+  std::lock_guard lock(mutex_);
+  return queued_;
+}
+
+void QueryClients::count(const std::string& client, Count what, const std::string& error) {
+  std::lock_guard lock(mutex_);
+  QueryClientStats& s = at(client).stats;
+  switch (what) {
+    case Count::kReceived: s.received++; break;
+    case Count::kAnswered: s.answered++; break;
+    case Count::kBad: s.bad++; break;
+    case Count::kBusy: s.busy++; break;
+    case Count::kNotReady: s.not_ready++; break;
+    case Count::kDropped: s.dropped++; break;
+    case Count::kEditApplied: s.edits_applied++; break;
+    case Count::kEditRefused: s.edits_refused++; break;
+  }
+  if (!error.empty()) s.last_error = error;
+}
+
+std::vector<QueryClientStats> QueryClients::snapshot() const {
+  std::lock_guard lock(mutex_);
+  std::vector<QueryClientStats> out;
+  for (const auto& [name, c] : clients_) out.push_back(c.stats);
+  return out;
+}
+
+}  // namespace ort::daemon

@@ -1,0 +1,312 @@
+// The query service in one process over memq://: answers equal server/query/ on the
+// server's map, read-your-writes, map edits through the pipeline with the control token, and
+// bad queries (each refused with a reason or dropped, and counted) while mapping goes on.
+#include <atomic>
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "daemon/query_wire.h"
+#include "octomap_rt/box_query_t.hpp"
+#include "octomap_rt/box_reply_t.hpp"
+#include "octomap_rt/grid_query_t.hpp"
+#include "octomap_rt/grid_t.hpp"
+#include "octomap_rt/map_edit_ack_t.hpp"
+#include "octomap_rt/map_edit_t.hpp"
+#include "octomap_rt/occupancy_query_t.hpp"
+#include "octomap_rt/occupancy_reply_t.hpp"
+#include "octomap_rt/ray_query_t.hpp"
+#include "octomap_rt/ray_reply_t.hpp"
+#include "octomap_rt/region_chunk_t.hpp"
+#include "query/box_count.h"
+#include "query/point_query.h"
+#include "query/projected_grid.h"
+#include "server/scan_fixtures.h"
+
+namespace ort::test {
+namespace {
+
+using Reply = octomap_rt::occupancy_reply_t;
+const std::string kReply = "QUERY_TEST_REPLY";
+
+// Collects raw messages on the reply channel through the server's own LCM loop (on a
+// shared memq:// instance only the server's thread may call handle).
+struct Replies {
+  std::mutex m;
+  std::condition_variable cv;
+  std::vector<std::vector<uint8_t>> got;
+  explicit Replies(daemon::MappingServer& s) {
+    s.lcm_loop().subscribe(kReply, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
+      std::lock_guard lock(m);
+      got.emplace_back(static_cast<const uint8_t*>(rb.data), static_cast<const uint8_t*>(rb.data) + rb.data_size);
+      cv.notify_all();
+    });
+  }
+  // The first reply of type M with this request id (fails the test after 20 s).
+  template <class M>
+  M wait_for(int64_t request_id) {
+    std::unique_lock lock(m);
+    M out;
+    const bool ok = cv.wait_for(lock, std::chrono::seconds(20), [&] {
+      for (const auto& b : got)
+        if (out.decode(b.data(), 0, static_cast<int>(b.size())) >= 0 && out.request_id == request_id) return true;
+      return false;
+    });
+    EXPECT_TRUE(ok) << "no reply to request " << request_id;
+    return out;
+  }
+};
+
+template <class Q>
+void address(Q& q, int64_t id, const std::string& client = "tester") {
+  q.request_id = id;
+  q.wait_seq = -1;
+  q.client_id = client;
+  q.reply_channel = kReply;
+}
+
+octomap_rt::occupancy_query_t point_query(int64_t id, const std::vector<float>& xyz,
+                                          const std::string& client = "tester") {
+  octomap_rt::occupancy_query_t q{};
+  address(q, id, client);
+  q.xyz = xyz;
+  q.num_xyz = static_cast<int32_t>(xyz.size());
+  return q;
+}
+
+// Scan k of robot "alpha": a wall of points at x = 3 + k (map frame), sensor at the origin.
+octomap_rt::scan_t wall_scan(int64_t k) {
+  octomap_rt::scan_t s = small_scan("alpha", k, 1);
+  s.points_frame = octomap_rt::scan_t::POINTS_IN_MAP_FRAME;
+  s.sensor_position[0] = s.sensor_position[1] = s.sensor_position[2] = 0;
+  s.xyz.clear();
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 10; ++j) s.xyz.insert(s.xyz.end(), {3.05f + k, -1.f + 0.1f * i, 0.05f + 0.1f * j});
+  s.num_xyz = static_cast<int32_t>(s.xyz.size());
+  return s;
+}
+
+TEST(QueryService, ReadYourWritesSeesTheScanJustSent) {
+  lcm::LCM lc("memq://");
+  daemon::MappingServer server(test_config(0.1, true), lc, std::cerr);
+  Replies replies(server);
+  server.start();
+  for (int64_t k = 0; k < 6; ++k) {
+    const octomap_rt::scan_t scan = wall_scan(k);
+    lc.publish("OCTOMAP_RT_SCAN_ALPHA", &scan);
+    // Right after the scan: ask about its own end points, waiting for its seq.
+    auto q = point_query(100 + k, scan.xyz);
+    q.wait_seq = k, q.wait_robot_id = "alpha", q.wait_timeout_ms = 20000;
+    lc.publish("OCTOMAP_RT_QUERY", &q);
+    const Reply r = replies.wait_for<Reply>(100 + k);
+    ASSERT_EQ(r.status, Reply::REPLY_OK) << r.error;
+    EXPECT_GE(r.snapshot_id, k + 1);
+    ASSERT_EQ(r.num_results, scan.num_xyz / 3);
+    for (int8_t o : r.occupancy) ASSERT_EQ(o, Reply::OCC_OCCUPIED) << "scan " << k;
+  }
+  // Without waiting for a seq that never comes: NOT_READY after the timeout, counted.
+  auto late = point_query(200, {0, 0, 0});
+  late.wait_seq = 99, late.wait_robot_id = "alpha", late.wait_timeout_ms = 200;
+  lc.publish("OCTOMAP_RT_QUERY", &late);
+  const Reply nr = replies.wait_for<Reply>(200);
+  EXPECT_EQ(nr.status, Reply::REPLY_NOT_READY);
+  EXPECT_NE(nr.error.find("wait_seq 99"), std::string::npos) << nr.error;
+  server.stop();
+  for (const auto& c : server.query_stats())
+    if (c.client_id == "tester") {
+      EXPECT_EQ(c.not_ready, 1);
+    }
+}
+
+TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
+  lcm::LCM lc("memq://");
+  daemon::MappingServer server(test_config(0.1, true), lc, std::cerr);
+  Replies replies(server);
+  server.start();
+  for (int64_t k = 0; k < 3; ++k) {
+    const auto s = wall_scan(k);
+    lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);
+  }
+  ASSERT_TRUE(wait_until_done(server, 3));
+  std::vector<float> pts;
+  for (int i = 0; i < 300; ++i) pts.insert(pts.end(), {-1.f + 0.023f * i, -1.2f + 0.0087f * i, 0.31f});
+  auto pq = point_query(1, pts);
+  pq.depth = 14;
+  lc.publish("OCTOMAP_RT_QUERY", &pq);
+  const Reply pr = replies.wait_for<Reply>(1);
+  ASSERT_EQ(pr.status, Reply::REPLY_OK) << pr.error;
+  server.with_map([&](const octomap::OcTree& t) {
+    const auto want = query::query_points(t, pts, 14);
+    for (size_t i = 0; i < want.size(); ++i) {
+      EXPECT_EQ(pr.occupancy[i], int8_t(want[i].state));
+      EXPECT_EQ(pr.probability[i], want[i].probability);
+    }
+    return 0;
+  });
+
+  octomap_rt::ray_query_t rq{};
+  address(rq, 2);
+  rq.max_range = 20;
+  for (int i = 0; i < 50; ++i) {
+    rq.origin_xyz.insert(rq.origin_xyz.end(), {0.05f, 0.05f, 0.25f});
+    rq.direction_xyz.insert(rq.direction_xyz.end(), {1.f, -0.5f + 0.02f * i, 0.f});
+  }
+  rq.num_xyz = static_cast<int32_t>(rq.origin_xyz.size());
+  lc.publish("OCTOMAP_RT_QUERY_RAYS", &rq);
+  const auto rr = replies.wait_for<octomap_rt::ray_reply_t>(2);
+  ASSERT_EQ(rr.status, Reply::REPLY_OK) << rr.error;
+  server.with_map([&](const octomap::OcTree& t) {
+    for (int i = 0; i < 50; ++i) {
+      octomap::point3d end;
+      const bool hit = t.castRay(octomap::point3d(0.05f, 0.05f, 0.25f),
+                                 octomap::point3d(1.f, -0.5f + 0.02f * i, 0.f), end, false, 20);
+      EXPECT_EQ(rr.hit[i], hit);
+      EXPECT_EQ(rr.end_xyz[3 * i], end.x());
+    }
+    return 0;
+  });
+
+  octomap_rt::box_query_t bq{};
+  address(bq, 3);
+  bq.boxes = {2.9, -1.0, 0.0, 3.3, 1.0, 1.0, -0.5, -0.5, 0.0, 0.5, 0.5, 0.5};
+  bq.num_values = 12;
+  lc.publish("OCTOMAP_RT_QUERY_BOXES", &bq);
+  const auto br = replies.wait_for<octomap_rt::box_reply_t>(3);
+  ASSERT_EQ(br.status, Reply::REPLY_OK) << br.error;
+  server.with_map([&](const octomap::OcTree& t) {
+    for (int b = 0; b < 2; ++b) {
+      const auto c = query::count_box(t, query::key_box(t, &bq.boxes[6 * b], &bq.boxes[6 * b + 3]));
+      EXPECT_EQ(br.occupied[b], c.occupied);
+      EXPECT_EQ(br.free[b], c.free);
+      EXPECT_EQ(br.unknown[b], c.unknown);
+    }
+    return 0;
+  });
+  EXPECT_GT(br.occupied[0], 0);
+
+  octomap_rt::grid_query_t gq{};
+  address(gq, 4);
+  gq.z_min = 0.0, gq.z_max = 0.5, gq.cell_size = 0.2;
+  lc.publish("OCTOMAP_RT_QUERY_GRID", &gq);
+  const auto g = replies.wait_for<octomap_rt::grid_t>(4);
+  ASSERT_EQ(g.status, Reply::REPLY_OK) << g.error;
+  server.with_map([&](const octomap::OcTree& t) {
+    query::GridRequest req;
+    req.z_min = 0, req.z_max = 0.5, req.cell_voxels = 2;
+    const auto want = query::projected_grid(t, req);
+    EXPECT_EQ(g.width, want.width);
+    EXPECT_EQ(g.height, want.height);
+    EXPECT_EQ(g.num_chunks, 1);
+    int differing = 0;
+    for (int i = 0; i < g.num_cells && i < int(want.cells.size()); ++i) differing += g.cells[i] != int8_t(want.cells[i]);
+    EXPECT_EQ(differing, 0);
+    return 0;
+  });
+  server.stop();
+}
+
+TEST(QueryService, EditsNeedTheTokenAndApplyInOrderWithTheScans) {
+  lcm::LCM lc("memq://");
+  auto cfg = test_config(0.1, true);
+  cfg.queries.control_token = "s3cret";
+  daemon::MappingServer server(cfg, lc, std::cerr);
+  Replies replies(server);
+  server.start();
+  const auto s = wall_scan(0);
+  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);
+  octomap_rt::map_edit_t e{};
+  e.request_id = 1, e.client_id = "op", e.reply_channel = kReply, e.token = "wrong";
+  e.op = octomap_rt::map_edit_t::OP_CLEAR_TO_FREE;
+  double lo[3] = {2.5, -2, 0}, hi[3] = {3.5, 2, 1};
+  std::copy(lo, lo + 3, e.box_min), std::copy(hi, hi + 3, e.box_max);
+  lc.publish("OCTOMAP_RT_MAP_EDIT", &e);
+  EXPECT_EQ(replies.wait_for<octomap_rt::map_edit_ack_t>(1).status, Reply::REPLY_REFUSED);
+  e.request_id = 2, e.token = "s3cret";
+  lc.publish("OCTOMAP_RT_MAP_EDIT", &e);  // queued behind the scan: the wall is cleared
+  const auto ack = replies.wait_for<octomap_rt::map_edit_ack_t>(2);
+  ASSERT_EQ(ack.status, Reply::REPLY_OK) << ack.error;
+  EXPECT_EQ(ack.snapshot_id, 2);  // one scan, then the edit
+  octomap_rt::box_query_t bq{};
+  address(bq, 3);
+  bq.min_snapshot_id = ack.snapshot_id;
+  bq.boxes = {lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]};
+  bq.num_values = 6;
+  lc.publish("OCTOMAP_RT_QUERY_BOXES", &bq);
+  const auto br = replies.wait_for<octomap_rt::box_reply_t>(3);
+  ASSERT_EQ(br.status, Reply::REPLY_OK);
+  EXPECT_EQ(br.occupied[0], 0);
+  EXPECT_EQ(br.unknown[0], 0);
+  e.request_id = 4, e.op = octomap_rt::map_edit_t::OP_RESET;
+  lc.publish("OCTOMAP_RT_MAP_EDIT", &e);
+  EXPECT_EQ(replies.wait_for<octomap_rt::map_edit_ack_t>(4).snapshot_id, 3);
+  EXPECT_EQ(server.with_map([](const octomap::OcTree& t) { return t.size(); }), 0u);
+  server.stop();
+}
+
+TEST(QueryService, BadQueriesAreRefusedOrDroppedAndCounted) {
+  lcm::LCM lc("memq://");
+  auto cfg = test_config(0.1, true);
+  cfg.queries.per_client_queue = 2;
+  daemon::MappingServer server(cfg, lc, std::cerr);
+  Replies replies(server);
+  server.start();
+  auto nan = point_query(1, {0, NAN, 0});
+  lc.publish("OCTOMAP_RT_QUERY", &nan);
+  EXPECT_EQ(replies.wait_for<Reply>(1).status, Reply::REPLY_BAD_REQUEST);
+  auto deep = point_query(2, {0, 0, 0});
+  deep.depth = 17;
+  lc.publish("OCTOMAP_RT_QUERY", &deep);
+  EXPECT_NE(replies.wait_for<Reply>(2).error.find("depth"), std::string::npos);
+  // Dropped (no trustworthy address): too many points, empty / over-long reply channel,
+  // garbage, a huge count in the raw bytes.
+  auto many = point_query(3, std::vector<float>(3 * (daemon::kMaxQueryPoints + 1), 0.f));
+  lc.publish("OCTOMAP_RT_QUERY", &many);
+  auto empty = point_query(4, {0, 0, 0});
+  empty.reply_channel = "";
+  lc.publish("OCTOMAP_RT_QUERY", &empty);
+  auto longer = point_query(5, {0, 0, 0});
+  longer.reply_channel = std::string(200, 'R');
+  lc.publish("OCTOMAP_RT_QUERY", &longer);
+  auto reflect = point_query(6, {0, 0, 0});
+  reflect.reply_channel = "OCTOMAP_RT_SCAN_ALPHA";
+  lc.publish("OCTOMAP_RT_QUERY", &reflect);
+  std::vector<uint8_t> raw(point_query(7, {0, 0, 0}).getEncodedSize());
+  point_query(7, {0, 0, 0}).encode(raw.data(), 0, static_cast<int>(raw.size()));
+  std::vector<uint8_t> huge = raw;
+  huge[8 + 40] = 0x7f;  // num_xyz's high byte
+  lc.publish("OCTOMAP_RT_QUERY", huge.data(), static_cast<unsigned>(huge.size()));
+  lc.publish("OCTOMAP_RT_QUERY", raw.data(), 20);
+  // Edits without a server token are refused.
+  octomap_rt::map_edit_t e{};
+  e.request_id = 8, e.client_id = "op", e.reply_channel = kReply, e.token = "x", e.op = 3;
+  lc.publish("OCTOMAP_RT_MAP_EDIT", &e);
+  EXPECT_NE(replies.wait_for<octomap_rt::map_edit_ack_t>(8).error.find("--control-token"), std::string::npos);
+  // A flood from one client: its queue holds 2, the rest are BUSY; another client is served.
+  for (int i = 0; i < 200; ++i) {
+    auto q = point_query(1000 + i, std::vector<float>(3 * 5000, 0.5f), "flooder");
+    lc.publish("OCTOMAP_RT_QUERY", &q);
+  }
+  auto calm = point_query(9, {0, 0, 0}, "calm");
+  lc.publish("OCTOMAP_RT_QUERY", &calm);
+  EXPECT_EQ(replies.wait_for<Reply>(9).status, Reply::REPLY_OK);
+  // ... and mapping goes on.
+  const auto s = wall_scan(0);
+  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);
+  ASSERT_TRUE(wait_until_done(server, 1));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  server.stop();
+  std::map<std::string, daemon::QueryClientStats> by;
+  for (const auto& c : server.query_stats()) by[c.client_id] = c;
+  EXPECT_EQ(by["tester"].bad, 2);
+  EXPECT_EQ(by["?"].dropped, 6);
+  EXPECT_EQ(by["op"].edits_refused, 1);
+  EXPECT_GT(by["flooder"].busy, 0);
+  EXPECT_EQ(by["flooder"].busy + by["flooder"].answered, 200);
+  EXPECT_EQ(by["calm"].answered, 1);
+}
+
+}  // namespace
+}  // namespace ort::test
