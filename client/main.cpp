@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   ort::cli::register_bench_command(app);
   ort::cli::register_render_command(app);
   ort::cli::register_status_command(app);
+  ort::cli::register_query_command(app);
   ort::cli::register_map_command(app);
   try {
     app.parse(argc, argv);

@@ -92,6 +92,7 @@ void register_map_command(CLI::App& app) {
   auto out = std::make_shared<std::string>();
   CLI::App* map = app.add_subcommand("map", "get the map from octomap-rt-server: snapshots, info, live deltas");
   map->require_subcommand(1);
+  add_map_edit_commands(map);  // clear-box, reset (map_edit_command.cpp)
   CLI::App* get = map->add_subcommand("get", "fetch a snapshot of the server's map into a .bt or .ot file");
   get->add_option("-o,--output", *out, "FILE.bt or FILE.ot")->required();
   add_common(get, *args);

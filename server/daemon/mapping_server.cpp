@@ -381,6 +381,7 @@ void MappingServer::print_summary(std::ostream& out) {
   if (deltas_) in.deltas = deltas_->stats();
   in.deltas_on = deltas_ != nullptr;
   print_run_summary(out, in);
+  print_query_summary(out, query_stats());
 }
 
 }  // namespace ort::daemon

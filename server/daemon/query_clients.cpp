@@ -72,4 +72,16 @@ std::vector<QueryClientStats> QueryClients::snapshot() const {
   return out;
 }
 
+void print_query_summary(std::ostream& out, const std::vector<QueryClientStats>& clients) {
+  if (clients.empty()) return;
+  out << "  queries (per client: received = answered + bad + busy + not ready; dropped: no usable reply address):\n";
+  for (const QueryClientStats& c : clients) {
+    out << "    " << c.client_id << ": received " << c.received << ", answered " << c.answered << ", bad " << c.bad
+        << ", busy " << c.busy << ", not ready " << c.not_ready << ", dropped " << c.dropped;
+    if (c.edits_applied || c.edits_refused) out << ", edits applied " << c.edits_applied << " refused " << c.edits_refused;
+    if (!c.last_error.empty()) out << " (last: " << c.last_error << ")";
+    out << "\n";
+  }
+}
+
 }  // namespace ort::daemon

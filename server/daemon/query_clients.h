@@ -9,6 +9,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <ostream>
 #include <string>
 #include <variant>
 #include <vector>
@@ -62,5 +63,8 @@ class QueryClients {
   std::string next_;                     // round-robin position: first client after this name
   size_t queued_ = 0;
 };
+
+// The end-of-run lines of the query service (one per client; nothing without queries).
+void print_query_summary(std::ostream& out, const std::vector<QueryClientStats>& clients);
 
 }  // namespace ort::daemon

@@ -1,0 +1,134 @@
+// octomap-rt-plan: an example planner on the query service. It asks the server for the 2D
+// grid of a z band, plans a path between two points with A* over free cells (8-connected),
+// checks the robot's footprint along the path with box queries (any occupied voxel in a
+// box of --radius around each cell, over the band), replans around cells that fail, and
+// prints the path.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <queue>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "lcm_url.h"
+#include "octomap_rt/box_query_t.hpp"
+#include "query/query_args.h"
+#include "query/query_client.h"
+
+namespace {
+
+using ort::client::Grid;
+
+struct Cell {
+  int i, j;
+};
+
+// A* over cells whose state is free and not blocked; empty when there is no path.
+std::vector<Cell> astar(const Grid& g, const std::vector<bool>& blocked, Cell from, Cell to) {
+  const int w = g.header.width, h = g.header.height;
+  auto idx = [w](int i, int j) { return size_t(j) * w + i; };
+  auto ok = [&](int i, int j) { return i >= 0 && j >= 0 && i < w && j < h && g.cells[idx(i, j)] == 1 && !blocked[idx(i, j)]; };
+  std::vector<double> cost(size_t(w) * h, INFINITY);
+  std::vector<size_t> parent(size_t(w) * h, SIZE_MAX);
+  using Item = std::pair<double, size_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  auto heuristic = [&](int i, int j) { return std::hypot(i - to.i, j - to.j); };
+  if (!ok(from.i, from.j) || !ok(to.i, to.j)) return {};
+  cost[idx(from.i, from.j)] = 0;
+  open.push({heuristic(from.i, from.j), idx(from.i, from.j)});
+  while (!open.empty()) {
+    const size_t cur = open.top().second;
+    open.pop();
+    const int ci = int(cur % w), cj = int(cur / w);
+    if (ci == to.i && cj == to.j) break;
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        if ((!di && !dj) || !ok(ci + di, cj + dj)) continue;
+        // No corner cutting: a diagonal step needs both side cells free.
+        if (di && dj && (!ok(ci + di, cj) || !ok(ci, cj + dj))) continue;
+        const size_t n = idx(ci + di, cj + dj);
+        const double c = cost[cur] + std::hypot(di, dj);
+        if (c < cost[n]) {
+          cost[n] = c, parent[n] = cur;
+          open.push({c + heuristic(ci + di, cj + dj), n});
+        }
+      }
+  }
+  std::vector<Cell> path;
+  for (size_t at = idx(to.i, to.j); at != SIZE_MAX; at = parent[at]) {
+    path.push_back({int(at % w), int(at / w)});
+    if (at == idx(from.i, from.j)) break;
+  }
+  if (path.empty() || path.back().i != from.i || path.back().j != from.j) return {};
+  return {path.rbegin(), path.rend()};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"octomap-rt-plan: A* on the server's 2D grid, footprint checked with box queries"};
+  std::string from_s, to_s, z_s = "0.1:1.5", lcm_url;
+  double cell = 0, radius = 0.3, timeout_s = 10;
+  app.add_option("--from", from_s, "start X,Y [m]")->required();
+  app.add_option("--to", to_s, "goal X,Y [m]")->required();
+  app.add_option("--z", z_s, "z band MIN:MAX [m] the robot occupies")->capture_default_str();
+  app.add_option("--cell", cell, "grid cell [m] (a multiple of the resolution; 0: the resolution)");
+  app.add_option("--radius", radius, "footprint half-width [m]")->capture_default_str();
+  app.add_option("--lcm-url", lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else the host-local udpm URL)");
+  app.add_option("--timeout", timeout_s, "seconds to wait for each answer")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  try {
+    const auto from = ort::client::parse_numbers(from_s, 2), to = ort::client::parse_numbers(to_s, 2);
+    double z0, z1;
+    ort::client::parse_range(z_s, z0, z1);
+    ort::client::QueryClient client(ort::cli::client_lcm_url(lcm_url), "planner-" + std::to_string(::getpid()),
+                                    std::chrono::milliseconds(static_cast<int64_t>(timeout_s * 1000)));
+    const Grid g = client.grid(z0, z1, cell, nullptr);
+    if (g.header.status != 0) throw std::runtime_error("grid refused: " + g.header.error);
+    const double cs = g.header.cell_size;
+    auto cell_of = [&](double x, double y) { return Cell{int(std::floor((x - g.header.origin_x) / cs)), int(std::floor((y - g.header.origin_y) / cs))}; };
+    auto centre = [&](Cell c, int k) { return (k ? g.header.origin_y + (c.j + 0.5) * cs : g.header.origin_x + (c.i + 0.5) * cs); };
+    std::printf("grid: %d x %d cells of %g m, map state %lld\n", g.header.width, g.header.height, cs,
+                (long long)g.header.snapshot_id);
+    std::vector<bool> blocked(g.cells.size(), false);
+    for (int attempt = 1; attempt <= 8; ++attempt) {
+      const std::vector<Cell> path = astar(g, blocked, cell_of(from[0], from[1]), cell_of(to[0], to[1]));
+      if (path.empty()) {
+        std::printf("no path from (%g, %g) to (%g, %g) through free cells\n", from[0], from[1], to[0], to[1]);
+        return 3;
+      }
+      std::vector<ort::client::Box> boxes;
+      for (const Cell& c : path)
+        boxes.push_back({{centre(c, 0) - radius, centre(c, 1) - radius, z0}, {centre(c, 0) + radius, centre(c, 1) + radius, z1}});
+      int failed = 0;
+      for (size_t first = 0; first < boxes.size(); first += 1000) {
+        const std::vector<ort::client::Box> part(boxes.begin() + first, boxes.begin() + std::min(boxes.size(), first + 1000));
+        const auto r = client.boxes(part, octomap_rt::box_query_t::MODE_ANY_OCCUPIED);
+        if (r.status != 0) throw std::runtime_error("box query refused: " + r.error);
+        for (int k = 0; k < r.num_boxes; ++k)
+          if (r.any_occupied[k]) {
+            const Cell c = path[first + k];
+            blocked[size_t(c.j) * g.header.width + c.i] = true;
+            ++failed;
+          }
+      }
+      if (failed) {
+        std::printf("attempt %d: %zu cells, %d fail the %g m footprint check; replanning\n", attempt, path.size(), failed, radius);
+        continue;
+      }
+      double length = 0;
+      for (size_t k = 1; k < path.size(); ++k) length += cs * std::hypot(path[k].i - path[k - 1].i, path[k].j - path[k - 1].j);
+      std::printf("path: %zu cells, %.2f m, footprint %g m clear (%d box queries)\n", path.size(), length, radius, attempt);
+      for (const Cell& c : path) std::printf("  %.3f %.3f\n", centre(c, 0), centre(c, 1));
+      return 0;
+    }
+    std::printf("no footprint-clear path after 8 attempts\n");
+    return 3;
+  } catch (const std::exception& e) {
+    std::cerr << "octomap-rt-plan: " << e.what() << "\n";
+    return 1;
+  }
+}
