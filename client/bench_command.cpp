@@ -17,6 +17,7 @@
 #include "bench_plot.h"
 #include "bench_results.h"
 #include "commands.h"
+#include "core/clock.h"
 #include "engine/map_engine.h"
 #include "map_summary.h"
 #include "scene/scan_set.h"
@@ -28,7 +29,6 @@ namespace {
 using bench::BenchRow;
 using Clock = std::chrono::steady_clock;
 
-double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 struct BenchArgs {
   std::vector<std::string> presets = {"fr079", "campus", "skt-corridor"};
@@ -162,8 +162,7 @@ std::vector<std::pair<std::string, std::string>> backend_configs(const BenchArgs
 }
 
 void run_engine(const ScanSet& set, const EngineOptions& opts, const BenchArgs& a, const Reference& ref, BenchRow& r) {
-  std::string log;
-  MapEngine engine(opts, &log);
+  MapEngine engine(opts);  // the device is in the row; the creation notes are not wanted here
   r.device = engine.backend().device_name();
   const size_t warm = std::min<size_t>(a.warmup, set.scans.size());
   {  // warm-up: pipelines, first allocations, page faults of the grid

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "core/clock.h"
 #include "engine/engine_flags.h"
 #include "map_summary.h"
 #include "scene/scan_set.h"
@@ -38,11 +39,9 @@ int run_build(const BuildArgs& a) {
   const auto t_load = std::chrono::steady_clock::now();
   const ScanSet set = a.input == "synthetic" ? make_synthetic_rooms() : load_scan_graph(a.input);
   const double load_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_load).count();
+      ms_since(t_load);
 
-  std::string log;
-  MapEngine engine(opts, &log);
-  if (!log.empty()) std::cerr << log;
+  MapEngine engine(opts, log_to(std::cerr));
   std::cerr << "octomap-rt build: " << set.scans.size() << " scans, " << set.total_points() << " points from "
             << set.name << " (" << load_ms << " ms)\n"
             << "  back end " << to_string(engine.backend().kind()) << " on " << engine.backend().device_name()
@@ -78,7 +77,7 @@ int run_build(const BuildArgs& a) {
     }
   }
   const double wall_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      ms_since(t0);
   write_map(*tree, a.output);
 
   const MapSummary s = summarize(*tree);

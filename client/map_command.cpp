@@ -9,6 +9,7 @@
 
 #include "commands.h"
 #include "lcm_url.h"
+#include "octomap_rt/wire_contract.hpp"
 #include "map_client/map_client.h"
 #include "map_commands.h"
 #include "progress_bar.h"
@@ -79,7 +80,7 @@ void run_info(const MapArgs& a) {
 }
 
 void add_common(CLI::App* cmd, MapArgs& a) {
-  cmd->add_option("--lcm-url", a.lcm_url, std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + kHostLocalLcmUrl + ")");
+  cmd->add_option("--lcm-url", a.lcm_url, std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + octomap_rt::wire::kDefaultLcmUrl + ")");
   cmd->add_option("--timeout", a.timeout_s, "seconds to wait for the server")->capture_default_str();
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   cmd->add_flag("-q,--quiet", a.quiet, "no progress output");

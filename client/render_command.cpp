@@ -5,6 +5,7 @@
 #include <map>
 
 #include "commands.h"
+#include "core/clock.h"
 #include "render/map_file.h"
 #include "render/map_render.h"
 #include "render/png_file.h"
@@ -42,7 +43,7 @@ int run_render(RenderArgs a) {
   if (!a.z_range.empty()) a.options.heights = parse_z_range(a.z_range);
   const auto t0 = std::chrono::steady_clock::now();
   const auto tree = render::load_map_file(a.input);
-  const double load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const double load_ms = ms_since(t0);
   const render::MapPicture picture = render::render_map(*tree, a.options);
   render::write_png(picture.canvas, a.output);
   const auto& s = picture.stats;

@@ -14,9 +14,11 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "commands.h"
+#include "core/clock.h"
 #include "lcm_log_scans.h"
 #include "lcm_server_wait.h"
 #include "lcm_url.h"
+#include "octomap_rt/wire_contract.hpp"
 #include "progress_bar.h"
 #include "scan_message.h"
 #include "scan_selection.h"
@@ -35,8 +37,8 @@ struct ReplayArgs {
   bool rate_given = false;  // logs: --rate replaces the recorded timing
   double speed = 1.0;       // logs: playback speed factor on the recorded timing
   std::string lcm_url;
-  std::string channel_prefix = "OCTOMAP_RT_SCAN_";
-  std::string status_channel = "OCTOMAP_RT_STATUS";
+  std::string channel_prefix = octomap_rt::wire::kScanChannelPrefix;
+  std::string status_channel = octomap_rt::wire::kStatusChannel;
   double max_range = -1.0;
   std::string points_frame = "sensor";
   std::string part;
@@ -46,11 +48,6 @@ struct ReplayArgs {
   double wait_for_server_s = 0.0;
   bool quiet = false;
 };
-
-int64_t now_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 // Keeps publications `period` apart without bursts: when publishing falls behind (a large
 // message took longer than the period), the schedule restarts from now instead of sending
@@ -269,7 +266,7 @@ void register_replay_command(CLI::App& app) {
                    ->capture_default_str();
   cmd->add_option("--speed", args->speed, "logs: speed factor on the recorded timing")->capture_default_str();
   cmd->add_option("--lcm-url", args->lcm_url,
-                  std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + kHostLocalLcmUrl + ")");
+                  std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + octomap_rt::wire::kDefaultLcmUrl + ")");
   cmd->add_option("--channel-prefix", args->channel_prefix, "scan channel prefix")->capture_default_str();
   cmd->add_option("--status-channel", args->status_channel, "the server's status channel (for --wait-for-server)")
       ->capture_default_str();

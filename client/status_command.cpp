@@ -10,7 +10,9 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "commands.h"
+#include "core/clock.h"
 #include "lcm_url.h"
+#include "octomap_rt/wire_contract.hpp"
 #include "status/status_json.h"
 #include "status/status_text.h"
 
@@ -18,16 +20,11 @@ namespace ort::cli {
 namespace {
 
 struct StatusArgs {
-  std::string lcm_url, channel = "OCTOMAP_RT_STATUS";
+  std::string lcm_url, channel = octomap_rt::wire::kStatusChannel;
   bool watch = false, json = false;
   double timeout_s = 5;
   int64_t count = 0;  // --watch: stop after this many statuses (0: never)
 };
-
-int64_t now_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 // What the LCM handler leaves for the main loop: the newest status that decoded.
 struct Inbox {

@@ -1,5 +1,5 @@
 // Compaction: one invocation per touched word of the window. Emits one VoxelUpdate
-// (uvec2: x | y << 16, z | state << 16; server/engine/voxel_update.h) per voxel with a
+// (uvec2: x | y << 16, z | state << 16; server/core/voxel_update.h) per voxel with a
 // state, occupied winning over free, and clears the word, so the grid is clean for the
 // next window without a pass over it.
 #version 450

@@ -1,5 +1,5 @@
 // The closed segment / closed voxel box test of `exact` traversal, the same double
-// operations in the same order as ort::segment_touches_voxel (server/engine/
+// operations in the same order as ort::segment_touches_voxel (server/core/
 // exact_traversal.cpp), so GPU and CPU decide ties (faces, edges, corners) identically.
 #ifndef EXACT_SLAB_GLSL
 #define EXACT_SLAB_GLSL

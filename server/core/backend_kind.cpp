@@ -1,17 +1,28 @@
 // Names of the back ends and traversal modes, as the command line and the status spell them.
 #include "core/backend_kind.h"
 
+#include <array>
+#include <utility>
+
 namespace ort {
+namespace {
+
+// The one list of back-end names: to_string, parse_backend and --backend's choices use it.
+constexpr std::array<std::pair<BackendKind, const char*>, 5> kBackendNames{{
+    {BackendKind::kAuto, "auto"},
+    {BackendKind::kCpu, "cpu"},
+    {BackendKind::kCpuGrid, "cpu-grid"},
+    {BackendKind::kVulkan, "vulkan"},
+    {BackendKind::kRt, "rt"},
+}};
+
+}  // namespace
 
 const char* to_string(Traversal t) { return t == Traversal::kOctomap ? "octomap" : "exact"; }
 
 const char* to_string(BackendKind b) {
-  switch (b) {
-    case BackendKind::kAuto: return "auto";
-    case BackendKind::kCpu: return "cpu";
-    case BackendKind::kCpuGrid: return "cpu-grid";
-    case BackendKind::kVulkan: return "vulkan";
-    case BackendKind::kRt: return "rt";
+  for (const auto& [kind, name] : kBackendNames) {
+    if (kind == b) return name;
   }
   return "?";
 }
@@ -24,13 +35,19 @@ bool parse_traversal(const std::string& s, Traversal& out) {
 }
 
 bool parse_backend(const std::string& s, BackendKind& out) {
-  if (s == "auto") out = BackendKind::kAuto;
-  else if (s == "cpu") out = BackendKind::kCpu;
-  else if (s == "cpu-grid") out = BackendKind::kCpuGrid;
-  else if (s == "vulkan") out = BackendKind::kVulkan;
-  else if (s == "rt") out = BackendKind::kRt;
-  else return false;
-  return true;
+  for (const auto& [kind, name] : kBackendNames) {
+    if (s == name) {
+      out = kind;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::vector<std::string> backend_names() {
+  std::vector<std::string> names;
+  for (const auto& entry : kBackendNames) names.emplace_back(entry.second);
+  return names;
 }
 
 }  // namespace ort

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/traversal.h"
 
@@ -20,6 +21,8 @@ enum class BackendKind {
 
 const char* to_string(BackendKind b);
 bool parse_backend(const std::string& s, BackendKind& out);
+// Every name parse_backend takes, "auto" first (the choices of --backend).
+std::vector<std::string> backend_names();
 
 struct BackendOptions {
   BackendKind kind = BackendKind::kAuto;

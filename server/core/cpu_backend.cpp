@@ -4,15 +4,13 @@
 
 #include <octomap/OcTree.h>
 
+#include "core/clock.h"
 #include "core/exact_traversal.h"
 
 namespace ort {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
 
 class CpuBackend final : public RayBackend {
  public:

@@ -5,6 +5,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/clock.h"
 #include "core/exact_traversal.h"
 #include "core/octomap_ray_walk.h"
 #include "core/prepare_scan.h"
@@ -14,9 +15,6 @@ namespace ort {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
 
 constexpr uint32_t kVoxelsPerWord = 16;
 

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <mutex>
 
+#include "core/clock.h"
+
 namespace ort::daemon {
 namespace {
 
@@ -13,7 +15,7 @@ MapCopy copy_locked(const MapState& map, std::chrono::steady_clock::time_point t
   c.version = map.version;
   c.scans = map.order.size();
   c.last_scan_utime = map.last_scan_utime;
-  c.lock_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  c.lock_ms = ms_since(t0);
   return c;
 }
 

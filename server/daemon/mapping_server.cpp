@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 
+#include "core/clock.h"
 #include "daemon/kernel_udp_stats.h"
 #include "daemon/map_snapshot.h"
 #include "daemon/map_store.h"
@@ -31,11 +32,6 @@ std::string host_name() {
 
 }  // namespace
 
-int64_t now_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 MappingServer::MappingServer(const ServerConfig& cfg, std::ostream& log) : MappingServer(cfg, nullptr, log) {}
 MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM& shared, std::ostream& log)
     : MappingServer(cfg, &shared, log) {}
@@ -56,9 +52,7 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ost
                              " MiB per producer cannot hold one scan of --max-points " + std::to_string(cfg_.max_points));
 
   load_or_create_map();  // first: a wrong map file fails before any device is opened
-  std::string engine_log;
-  engine_ = std::make_unique<MapEngine>(cfg_.engine, &engine_log);
-  log_ << engine_log;
+  engine_ = std::make_unique<MapEngine>(cfg_.engine, log_to(log_));
   if (!cfg_.applied_log.empty()) map_.order.open_live_log(cfg_.applied_log);
 
   if (shared) {
@@ -223,7 +217,7 @@ void MappingServer::save(bool force) {
   saves_++;
   last_save_utime_ = now_utime();
   max_save_lock_ms_ = std::max(max_save_lock_ms_, copy->lock_ms);
-  last_save_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  last_save_ms_ = ms_since(t0);
 }
 
 void MappingServer::run_save_loop() {

@@ -113,7 +113,4 @@ class MappingServer {
   double max_save_lock_ms_ = 0, last_save_ms_ = 0;
 };
 
-// Microseconds since the Unix epoch.
-int64_t now_utime();
-
 }  // namespace ort::daemon

@@ -3,6 +3,7 @@
 #include <cctype>
 #include <iostream>
 
+#include "core/clock.h"
 #include "daemon/scan_to_map.h"
 
 namespace ort::daemon {
@@ -10,9 +11,6 @@ namespace {
 std::string lower_case(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
-}
-double ms_between(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double, std::milli>(b - a).count();
 }
 }  // namespace
 

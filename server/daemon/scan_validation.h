@@ -10,11 +10,12 @@
 
 #include "daemon/reject_reason.h"
 #include "octomap_rt/scan_t.hpp"
+#include "octomap_rt/wire_contract.hpp"
 
 namespace ort::daemon {
 
 struct ScanLimits {
-  uint64_t max_points = 4'000'000;  // per scan; bounds num_xyz before any allocation
+  uint64_t max_points = octomap_rt::wire::kDefaultMaxScanPoints;  // per scan; bounds num_xyz before any allocation
   double resolution = 0.1;          // map resolution: the origin must have a key
 };
 
@@ -22,8 +23,8 @@ struct ScanLimits {
 // only fixed-size fields before num_xyz so these are constants.
 inline constexpr size_t kScanNumXyzOffset = 85;
 inline constexpr size_t kScanXyzOffset = 89;
-inline constexpr size_t kMaxRobotIdLength = 32;
-inline constexpr size_t kMaxMapFrameLength = 256;
+inline constexpr size_t kMaxRobotIdLength = octomap_rt::wire::kMaxRobotIdLength;
+inline constexpr size_t kMaxMapFrameLength = octomap_rt::wire::kMaxMapFrameLength;
 
 // Robot ids: 1-32 of [A-Za-z0-9_-].
 bool valid_robot_id(const std::string& id);

@@ -1,6 +1,7 @@
 #include "daemon/server_cli.h"
 
 #include <regex>
+#include <string>
 
 namespace ort::daemon {
 
@@ -15,8 +16,8 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
       ->capture_default_str();
   app.add_option("--applied-log", s.applied_log, "also append each applied scan's (robot, seq) to this file as it happens");
   app.add_option("--lcm-url", s.lcm_url,
-                 "LCM URL (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0); udpm URLs get "
-                 "recv_buf_size=min(--recv-buf-size, net.core.rmem_max) unless they set it");
+                 std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + octomap_rt::wire::kDefaultLcmUrl +
+                     "); udpm URLs get recv_buf_size=min(--recv-buf-size, net.core.rmem_max) unless they set it");
   app.add_option("--recv-buf-size", s.recv_buf_size, "UDP receive buffer wanted [bytes]")->capture_default_str();
   app.add_option("--scan-channels", s.scan_channels,
                  "regex of scan channels; the part after its literal prefix is the robot id")

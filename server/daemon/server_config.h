@@ -7,6 +7,7 @@
 
 #include "daemon/query_config.h"
 #include "engine/map_engine.h"
+#include "octomap_rt/wire_contract.hpp"
 
 namespace ort::daemon {
 
@@ -22,8 +23,8 @@ struct ServerConfig {
   EngineOptions engine;                        // resolution, sensor model, max range, back end
   std::string lcm_url;                         // "": $LCM_DEFAULT_URL, else host-local udpm
   uint64_t recv_buf_size = 16u << 20;          // udpm receive buffer wanted (capped by rmem_max)
-  std::string scan_channels = "OCTOMAP_RT_SCAN_.*";  // regex; its literal prefix + robot id
-  std::string status_channel = "OCTOMAP_RT_STATUS";
+  std::string scan_channels = octomap_rt::wire::kScanChannelRegex;  // regex; its literal prefix + robot id
+  std::string status_channel = octomap_rt::wire::kStatusChannel;
   std::string map_path;                        // .ot; "": no persistence
   std::string applied_log;                     // live applied-order log; "": none
   double save_interval_s = 30;                 // <= 0: save only at exit
@@ -31,7 +32,7 @@ struct ServerConfig {
   bool pipeline = true;                        // false: both stages on one thread
   std::string server_id;                       // "": octomap-rt-server@<host>
   uint64_t queue_budget_bytes = 0;             // per producer; 0: automatic_queue_budget()
-  uint64_t max_points = 4'000'000;             // per scan
+  uint64_t max_points = octomap_rt::wire::kDefaultMaxScanPoints;  // per scan
   size_t max_producers = 64;
   int lcm_queue_capacity = 64;                 // LCM's own per-subscription queue (messages)
   OctomapRawConfig octomap_raw;

@@ -3,6 +3,8 @@
 #include <cstdlib>
 #include <fstream>
 
+#include "octomap_rt/wire_contract.hpp"
+
 namespace ort::daemon {
 
 int64_t read_rmem_max() {
@@ -17,7 +19,7 @@ LcmUrlChoice choose_lcm_url(const std::string& requested, uint64_t wanted, int64
   c.url = requested;
   if (c.url.empty()) {
     const char* env = std::getenv("LCM_DEFAULT_URL");
-    c.url = env && *env ? env : kDefaultLcmUrl;
+    c.url = env && *env ? env : octomap_rt::wire::kDefaultLcmUrl;
   }
   if (c.url.rfind("udpm://", 0) != 0) return c;
   if (rmem_max < 0) rmem_max = read_rmem_max();

@@ -9,14 +9,12 @@
 
 namespace ort::daemon {
 
-inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
-
 struct LcmUrlChoice {
   std::string url;
   std::string warning;  // non-empty: say it once at start-up (rmem_max too small, ...)
 };
 
-// `requested` if given, else $LCM_DEFAULT_URL, else kDefaultLcmUrl. For udpm URLs without a
+// `requested` if given, else $LCM_DEFAULT_URL, else the wire contract's kDefaultLcmUrl. For udpm URLs without a
 // recv_buf_size, adds recv_buf_size = min(wanted, rmem_max). `rmem_max` < 0: read it from
 // /proc/sys/net/core/rmem_max.
 LcmUrlChoice choose_lcm_url(const std::string& requested, uint64_t wanted_recv_buf, int64_t rmem_max = -1);

@@ -1,6 +1,7 @@
 // make_backend: picks and builds a ray-shooting back end. Automatic choice: rt where the
 // device has the ray-tracing extensions, else vulkan compute on a GPU, else cpu-grid (the
-// native walk), with a note saying why.
+// native walk), with a note saying why. Only a typed refusal (Unsupported: no device, no ray
+// tracing, traversal mode) moves the choice on; every other failure surfaces as it is.
 //
 // Why cpu-grid and not vulkan when the only Vulkan device is a CPU one (lavapipe, or any
 // VK_PHYSICAL_DEVICE_TYPE_CPU): both then run the same walk into the same 2-bit grid on the
@@ -12,10 +13,11 @@
 // the device type decides the same question deterministically.
 #include "engine/backend_factory.h"
 
-#include <stdexcept>
+#include <string>
 
 #include "core/cpu_backend.h"
 #include "core/cpu_grid_backend.h"
+#include "core/errors.h"
 #include "gpu/rt_backend.h"
 #include "gpu/vk/vk_context.h"
 #include "gpu/vulkan_backend.h"
@@ -32,10 +34,7 @@ bool automatic_device_is_cpu(const BackendOptions& opts) {
 
 }  // namespace
 
-std::unique_ptr<RayBackend> make_backend(const BackendOptions& opts, std::string* log) {
-  auto note = [&](const std::string& m) {
-    if (log) *log += m + "\n";
-  };
+std::unique_ptr<RayBackend> make_backend(const BackendOptions& opts, const Log& log) {
   switch (opts.kind) {
     case BackendKind::kCpu: return make_cpu_backend(opts.resolution);
     case BackendKind::kCpuGrid: return make_cpu_grid_backend({opts.resolution, opts.grid_budget_bytes, opts.threads});
@@ -45,18 +44,18 @@ std::unique_ptr<RayBackend> make_backend(const BackendOptions& opts, std::string
   }
   try {
     return make_rt_backend(opts, log);
-  } catch (const std::exception& e) {
-    note(std::string("rt back end not used: ") + e.what());
+  } catch (const Unsupported& e) {
+    log.info(std::string("rt back end not used: ") + e.what());
   }
   try {
     if (automatic_device_is_cpu(opts)) {
-      note("vulkan back end not used: the Vulkan device is a CPU implementation; using cpu-grid (the native walk "
-           "on the same cores)");
+      log.info("vulkan back end not used: the Vulkan device is a CPU implementation; using cpu-grid (the native "
+               "walk on the same cores)");
       return make_cpu_grid_backend({opts.resolution, opts.grid_budget_bytes, opts.threads});
     }
     return make_vulkan_backend(opts, log);
-  } catch (const std::exception& e) {
-    note(std::string("vulkan back end not used: ") + e.what() + "; using cpu-grid");
+  } catch (const Unsupported& e) {
+    log.info(std::string("vulkan back end not used: ") + e.what() + "; using cpu-grid");
   }
   return make_cpu_grid_backend({opts.resolution, opts.grid_budget_bytes, opts.threads});
 }

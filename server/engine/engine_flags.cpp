@@ -12,7 +12,7 @@ void add_engine_flags(CLI::App& cmd, EngineFlags& f, bool require_resolution) {
                  "ray shooting: auto, cpu (OctoMap's own walk, the reference), cpu-grid (native threads "
                  "into the 2-bit grid), vulkan (compute shaders) or rt (ray-tracing pipeline: --traversal exact "
                  "only; needs VK_KHR_ray_tracing_pipeline, else it reports unsupported)")
-      ->check(CLI::IsMember({"auto", "cpu", "cpu-grid", "vulkan", "rt"}))
+      ->check(CLI::IsMember(backend_names()))
       ->capture_default_str();
   cmd.add_option("--device", f.device, "Vulkan device: name substring or index (default: automatic)");
   cmd.add_option("--traversal", f.traversal,

@@ -1,19 +1,13 @@
 #include "engine/map_engine.h"
 
-#include <chrono>
 #include <vector>
 
+#include "core/clock.h"
 #include "core/map_frame.h"
 
 namespace ort {
-namespace {
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
-}  // namespace
 
-MapEngine::MapEngine(const EngineOptions& opts, std::string* log) : opts_(opts), octree_stage_(opts.octree) {
+MapEngine::MapEngine(const EngineOptions& opts, const Log& log) : opts_(opts), octree_stage_(opts.octree) {
   opts_.backend.resolution = opts.resolution;
   opts_.backend.max_range = opts.max_range;
   opts_.backend.traversal = opts.traversal;
@@ -29,7 +23,7 @@ std::unique_ptr<octomap::OcTree> MapEngine::make_tree() const {
 void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range,
                       ShotScan& out) {
   out = ShotScan{};
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   const RayBatch batch = prepare_scan(origin, points, max_range, opts_.resolution, out.prepare, opts_.octree.threads);
   out.shoot.times.prepare_ms = ms_since(t0);
   if (!out.prepare.origin_ok) return;
@@ -46,7 +40,7 @@ void MapEngine::shoot_posed(const octomap::pose6d& pose, const octomap::point3d&
     count_states(out);
     return;
   }
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   std::vector<octomap::point3d> world(sensor_points.begin(), sensor_points.end());
   transform_to_map_frame(world, pose, opts_.octree.threads);
   const double transform_ms = ms_since(t0);
@@ -59,7 +53,7 @@ void MapEngine::count_states(ShotScan& out) const {
 }
 
 void MapEngine::apply(ShotScan& scan, octomap::OcTree& tree) const {
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   octree_stage_.apply(tree, scan.voxels);
   scan.shoot.times.octree_ms += ms_since(t0);
 }

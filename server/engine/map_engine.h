@@ -13,6 +13,7 @@
 
 #include <octomap/OcTree.h>
 
+#include "core/log.h"
 #include "core/prepare_scan.h"
 #include "core/ray_backend.h"
 #include "engine/backend_factory.h"
@@ -40,9 +41,9 @@ struct ShotScan {
 
 class MapEngine {
  public:
-  // Throws std::runtime_error when the requested back end cannot be made. Messages about
-  // the device choice (or the fallback to cpu) go to `log`.
-  explicit MapEngine(const EngineOptions& opts, std::string* log = nullptr);
+  // Throws std::runtime_error (or Unsupported) when the requested back end cannot be made.
+  // Messages about the device choice (or the fallback to cpu) go to `log`.
+  explicit MapEngine(const EngineOptions& opts, const Log& log = {});
 
   // A fresh map with this engine's resolution and sensor model.
   std::unique_ptr<octomap::OcTree> make_tree() const;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/clock.h"
 #include "gpu/vk/vk_check.h"
 #include "shaders/compact_touched_spv.h"
 
@@ -14,9 +15,6 @@ namespace ort::gpu {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
 
 constexpr uint64_t kMinRayCapacity = 1 << 16;
 constexpr VkBufferUsageFlags kStorage =

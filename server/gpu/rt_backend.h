@@ -5,11 +5,13 @@
 #include <memory>
 #include <string>
 
+#include "core/log.h"
 #include "core/ray_backend.h"
 
 namespace ort {
 
-// Throws std::runtime_error naming the missing extensions where the device lacks them.
-std::unique_ptr<RayBackend> make_rt_backend(const BackendOptions& opts, std::string* log);
+// Throws Unsupported (core/errors.h) naming the missing extensions where the device lacks
+// them, and for --traversal octomap; any other failure as std::runtime_error.
+std::unique_ptr<RayBackend> make_rt_backend(const BackendOptions& opts, const Log& log = {});
 
 }  // namespace ort

@@ -50,7 +50,7 @@ gpu::RaySpaceSizing sizing_for(const vk::Context& ctx, const BackendOptions& opt
 
 class VulkanBackend final : public RayBackend {
  public:
-  VulkanBackend(const BackendOptions& opts, const VulkanTuning& tuning, std::string* log)
+  VulkanBackend(const BackendOptions& opts, const VulkanTuning& tuning, const Log& log)
       : ctx_(make_context(opts)),
         space_(ctx_, {.sizing = sizing_for(*ctx_, opts, tuning)}),
         shoot_octomap_(*ctx_, shoot_octomap_spv, 4, sizeof(gpu::ShootPush)),
@@ -64,12 +64,10 @@ class VulkanBackend final : public RayBackend {
       }
     });
     name_ = ctx_->device_name() + " (" + vk::device_type_name(ctx_->properties().deviceType) + ")";
-    if (log) {
-      const uint64_t words = space_.sizing().grid_words;
-      *log += "vulkan: " + name_ + ", grid " + std::to_string((words * 4 + 1023) >> 10) + " KiB (" +
-              std::to_string(space_.grid_voxels()) + " voxels), " +
-              (ctx_->unified_memory() ? "unified memory" : "device-local memory with staging") + "\n";
-    }
+    const uint64_t words = space_.sizing().grid_words;
+    log.info("vulkan: " + name_ + ", grid " + std::to_string((words * 4 + 1023) >> 10) + " KiB (" +
+             std::to_string(space_.grid_voxels()) + " voxels), " +
+             (ctx_->unified_memory() ? "unified memory" : "device-local memory with staging"));
   }
 
   BackendKind kind() const override { return BackendKind::kVulkan; }
@@ -135,12 +133,12 @@ class VulkanBackend final : public RayBackend {
 
 }  // namespace
 
-std::unique_ptr<RayBackend> make_vulkan_backend(const BackendOptions& opts, std::string* log) {
+std::unique_ptr<RayBackend> make_vulkan_backend(const BackendOptions& opts, const Log& log) {
   return make_vulkan_backend(opts, VulkanTuning{}, log);
 }
 
 std::unique_ptr<RayBackend> make_vulkan_backend(const BackendOptions& opts, const VulkanTuning& tuning,
-                                                std::string* log) {
+                                                const Log& log) {
   return std::make_unique<VulkanBackend>(opts, tuning, log);
 }
 

@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include "core/log.h"
 #include "core/ray_backend.h"
 
 namespace ort {
@@ -14,9 +15,10 @@ struct VulkanTuning {
   uint64_t output_voxels = 0;  // capacity of the voxel output (compaction chunks follow from it)
 };
 
-// Throws std::runtime_error (with the reason) when no usable Vulkan device exists.
-std::unique_ptr<RayBackend> make_vulkan_backend(const BackendOptions& opts, std::string* log);
+// Throws Unsupported (core/errors.h, with the reason) when no usable Vulkan device exists;
+// any other failure as std::runtime_error. The device and grid chosen go to `log`.
+std::unique_ptr<RayBackend> make_vulkan_backend(const BackendOptions& opts, const Log& log = {});
 std::unique_ptr<RayBackend> make_vulkan_backend(const BackendOptions& opts, const VulkanTuning& tuning,
-                                                std::string* log);
+                                                const Log& log = {});
 
 }  // namespace ort

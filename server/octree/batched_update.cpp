@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 
+#include "core/clock.h"
 #include "octree/node_count.h"
 #include "octree/split_top.h"
 #include "octree/subtree_update.h"
@@ -12,9 +13,6 @@ namespace ort {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_between(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double, std::milli>(b - a).count();
-}
 
 // Buckets larger than a thread's fair share / 4 first, so the last to finish are small;
 // the rest in Morton order (neighbours share the nodes above them in cache).

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/errors.h"
 #include "engine/backend_factory.h"
 #include "gpu/vk/vk_context.h"
 #include "gpu/vulkan_backend.h"
@@ -75,16 +76,16 @@ TEST(DeviceChoice, FactoryHonoursDeviceAndFallsBackToCpuGridOnlyInAuto) {
   o.kind = BackendKind::kVulkan;
   o.grid_budget_bytes = 1 << 20;
   o.device = "no-such-gpu-4711";
-  EXPECT_THROW(make_backend(o), std::runtime_error);
+  EXPECT_THROW(make_backend(o), Unsupported);  // the typed refusal: the one kAuto moves on after
   o.kind = BackendKind::kAuto;
   std::string log;
-  auto b = make_backend(o, &log);
+  auto b = make_backend(o, log_into(log));
   EXPECT_EQ(b->kind(), BackendKind::kCpuGrid);
   EXPECT_NE(log.find("no-such-gpu-4711"), std::string::npos) << log;
   o.kind = BackendKind::kVulkan;
   o.device.clear();
   log.clear();
-  auto v = make_backend(o, &log);
+  auto v = make_backend(o, log_into(log));
   EXPECT_EQ(v->kind(), BackendKind::kVulkan);
   EXPECT_FALSE(v->device_name().empty());
   EXPECT_NE(log.find(v->device_name()), std::string::npos) << log;
@@ -97,7 +98,7 @@ TEST(DeviceChoice, AutoTakesTheNativeWalkInsteadOfACpuVulkanDevice) {
   o.kind = BackendKind::kAuto;
   o.grid_budget_bytes = 1 << 20;
   std::string log;
-  auto b = make_backend(o, &log);
+  auto b = make_backend(o, log_into(log));
   const bool cpu_device = vk::Context(vk::ContextOptions{}).properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   if (cpu_device) {
     EXPECT_EQ(b->kind(), BackendKind::kCpuGrid);
@@ -105,6 +106,24 @@ TEST(DeviceChoice, AutoTakesTheNativeWalkInsteadOfACpuVulkanDevice) {
   } else {
     EXPECT_TRUE(b->kind() == BackendKind::kVulkan || b->kind() == BackendKind::kRt) << log;
   }
+}
+
+// `auto` moves on only after a typed refusal. rt refuses --traversal octomap (Unsupported)
+// on every device; on a GPU the vulkan back end then fails for a reason that is not a refusal
+// (a grid budget that holds no voxel), and that failure must surface instead of a silent
+// fallback. (On a CPU Vulkan device auto does not try vulkan at all: nothing to check there.)
+TEST(DeviceChoice, AutoFallsBackOnlyOnUnsupported) {
+  if (vk::Context(vk::ContextOptions{}).properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) {
+    GTEST_SKIP() << "the Vulkan device is a CPU implementation: auto takes cpu-grid without trying vulkan";
+  }
+  BackendOptions o;
+  o.kind = BackendKind::kAuto;
+  o.traversal = Traversal::kOctomap;
+  o.grid_budget_bytes = 3;
+  std::string log;
+  EXPECT_THROW(make_backend(o, log_into(log)), std::invalid_argument);
+  EXPECT_NE(log.find("rt back end not used: unsupported"), std::string::npos) << log;
+  EXPECT_EQ(log.find("using cpu"), std::string::npos) << log;
 }
 
 }  // namespace

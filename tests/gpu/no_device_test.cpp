@@ -25,7 +25,7 @@ TEST(NoVulkanDevice, ClearErrorAndCpuGridFallback) {
   o.kind = BackendKind::kAuto;
   std::string log;
   o.grid_budget_bytes = 1 << 20;
-  auto b = make_backend(o, &log);
+  auto b = make_backend(o, log_into(log));
   EXPECT_EQ(b->kind(), BackendKind::kCpuGrid);
   EXPECT_NE(log.find("no Vulkan device"), std::string::npos) << log;
   EXPECT_NE(log.find("using cpu-grid"), std::string::npos) << log;

@@ -103,7 +103,7 @@ TEST(VulkanRaySpace, ChunkedCompactionWhenTouchedWordsExceedOnePass) {
   if (const char* d = std::getenv("OCTOMAP_RT_TEST_DEVICE")) o.device = d;
   VulkanTuning tuning;
   tuning.output_voxels = 1 << 16;
-  auto gpu = make_vulkan_backend(o, tuning, nullptr);
+  auto gpu = make_vulkan_backend(o, tuning);
   for (Traversal mode : {Traversal::kOctomap, Traversal::kExact}) {
     const RayBatch batch = synthetic_batch(2, 0.05, -1.0, 3);
     VoxelList got;

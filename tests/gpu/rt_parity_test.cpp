@@ -48,7 +48,7 @@ BackendOptions rt_options(double res, double max_range, Traversal mode = Travers
 std::unique_ptr<RayBackend> try_rt(double res, double max_range, const rt::RtOptions& knobs, std::string* why,
                                    rt::RtBvhInfo* info = nullptr) {
   try {
-    return rt::make_rt_backend(rt_options(res, max_range), knobs, nullptr, info);
+    return rt::make_rt_backend(rt_options(res, max_range), knobs, Log{}, info);
   } catch (const std::exception& e) {
     *why = e.what();
     return nullptr;
@@ -66,7 +66,7 @@ std::unique_ptr<RayBackend> try_vulkan(double res, double max_range) {
 
 TEST(RtBackend, RefusesOctomapModeClearly) {
   try {
-    rt::make_rt_backend(rt_options(0.1, -1.0, Traversal::kOctomap), rt::RtOptions{}, nullptr);
+    rt::make_rt_backend(rt_options(0.1, -1.0, Traversal::kOctomap), rt::RtOptions{});
     FAIL() << "rt accepted --traversal octomap";
   } catch (const std::runtime_error& e) {
     const std::string m = e.what();
@@ -92,7 +92,7 @@ TEST(RtBackend, IsMadeOrRefusedCleanly) {
   BackendOptions o = rt_options(0.1, -1.0);
   o.kind = BackendKind::kAuto;
   std::string log;
-  auto any = make_backend(o, &log);
+  auto any = make_backend(o, log_into(log));
   ASSERT_TRUE(any);
   EXPECT_NE(any->kind(), BackendKind::kRt);
   EXPECT_NE(log.find("rt back end not used: unsupported"), std::string::npos) << log;

@@ -25,6 +25,7 @@
 #include <octomap/OcTree.h>
 
 #include "octomap_rt/server_status_t.hpp"
+#include "octomap_rt/wire_contract.hpp"
 
 namespace ort::test {
 
@@ -79,7 +80,7 @@ class ChildProcess {
 // Decodes every OCTOMAP_RT_STATUS on its own LCM instance and thread.
 class StatusWatcher {
  public:
-  StatusWatcher(const std::string& url, const std::string& channel = "OCTOMAP_RT_STATUS");
+  StatusWatcher(const std::string& url, const std::string& channel = octomap_rt::wire::kStatusChannel);
   ~StatusWatcher();
   bool good() const { return good_; }
   // Waits until a status satisfying `pred` arrives (or already has); returns it.

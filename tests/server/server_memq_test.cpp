@@ -12,6 +12,7 @@
 #include "daemon/map_store.h"
 #include "daemon/scan_validation.h"
 #include "octomap_rt/server_status_t.hpp"
+#include "octomap_rt/wire_contract.hpp"
 #include "scene/synthetic_scene.h"
 #include "server/scan_fixtures.h"
 #include "support/octomap_reference.h"
@@ -24,7 +25,7 @@ namespace {
 using daemon::Reject;
 
 std::string channel_of(const std::string& robot) {
-  std::string c = "OCTOMAP_RT_SCAN_";
+  std::string c = octomap_rt::wire::kScanChannelPrefix;
   for (char ch : robot) c += static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
   return c;
 }
@@ -328,7 +329,7 @@ TEST(ServerMemq, StatusIsPublished) {
       got.push_back(*s);
     }
   } sink;
-  lc.subscribe("OCTOMAP_RT_STATUS", &Sink::on, &sink);  // before the server's thread handles
+  lc.subscribe(octomap_rt::wire::kStatusChannel, &Sink::on, &sink);  // before the server's thread handles
   auto cfg = test_config(0.1, true);
   std::ostringstream log;
   daemon::MappingServer server(cfg, lc, log);

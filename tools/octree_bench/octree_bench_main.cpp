@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <octomap/OcTree.h>
 
+#include "core/clock.h"
 #include "engine/map_engine.h"
 #include "octree/batched_update.h"
 #include "octree/morton_order.h"
@@ -27,7 +28,7 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+using ort::ms_since;
 
 struct DataSet {
   std::string name;

@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <octomap/OcTree.h>
 
+#include "core/clock.h"
 #include "core/prepare_scan.h"
 #include "core/ray_backend.h"
 #include "engine/backend_factory.h"
@@ -33,7 +34,7 @@ std::string one_line(std::string s) {
 }
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+using ort::ms_since;
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -189,7 +190,7 @@ int main(int argc, char** argv) {
         ort::BackendOptions bo = vo;
         bo.kind = ort::BackendKind::kRt;
         try {
-          auto rt = ort::rt::make_rt_backend(bo, ro, nullptr, &info);
+          auto rt = ort::rt::make_rt_backend(bo, ro, ort::Log{}, &info);
           Timing t = run(*rt, scans, reps);
           bool equal = true;
           if (have_vk)

@@ -6,6 +6,7 @@
 #include <vector>
 #include <utility>
 
+#include "core/clock.h"
 #include "gpu/rt/rt_functions.h"
 #include "gpu/vk/vk_check.h"
 #include "gpu/vk/vk_timestamps.h"
@@ -206,7 +207,7 @@ SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const 
   bvh.scratch_bytes = blas.scratch_bytes + tlas.scratch_bytes;
 
   bvh.gpu_build_ms = run_builds(ctx, fn, runner, blas, tlas);
-  bvh.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  bvh.build_ms = ms_since(t0);
   return bvh;
 }
 

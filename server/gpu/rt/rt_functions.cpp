@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/errors.h"
 #include "gpu/vk/vk_context.h"
 
 namespace ort::rt {
@@ -11,7 +12,7 @@ RtFunctions load_rt_functions(VkDevice device) {
   RtFunctions f;
   auto load = [&](auto& fn, const char* name) {
     fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(vkGetDeviceProcAddr(device, name));
-    if (!fn) throw std::runtime_error(std::string("unsupported: the Vulkan driver gives no ") + name);
+    if (!fn) throw Unsupported(std::string("unsupported: the Vulkan driver gives no ") + name);
   };
   load(f.create_acceleration_structure, "vkCreateAccelerationStructureKHR");
   load(f.destroy_acceleration_structure, "vkDestroyAccelerationStructureKHR");

@@ -10,6 +10,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "core/errors.h"
 #include "gpu/gpu_ray_space.h"
 #include "gpu/rt/rt_accel.h"
 #include "gpu/rt/rt_functions.h"
@@ -50,8 +51,8 @@ std::shared_ptr<vk::Context> make_context(const BackendOptions& opts) {
   co.feature_chain = &as_features;
   try {
     return std::make_shared<vk::Context>(co);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(std::string("unsupported: the rt back end needs a Vulkan device with ") + kNeeded +
+  } catch (const Unsupported& e) {  // no device or no ray tracing; other failures surface as they are
+    throw Unsupported(std::string("unsupported: the rt back end needs a Vulkan device with ") + kNeeded +
                              "; " + e.what());
   }
 }
@@ -92,7 +93,7 @@ SharedBvh build_bvh(const vk::Context& ctx, const RtFunctions& fn, const BlockGr
 
 class RtBackend final : public RayBackend {
  public:
-  RtBackend(const BackendOptions& opts, const RtOptions& rt, std::string* log, RtBvhInfo* info)
+  RtBackend(const BackendOptions& opts, const RtOptions& rt, const Log& log, RtBvhInfo* info)
       : ctx_(make_context(opts)),
         fn_(load_rt_functions(ctx_->device())),
         block_grid_(block_grid_for(*ctx_, opts, rt)),
@@ -103,20 +104,18 @@ class RtBackend final : public RayBackend {
       pipeline_.bind(b.rays, b.grid, b.touched, b.counters, bvh_.tlas.handle());
     });
     if (info) describe(*info);
-    if (log) {
-      *log += "rt back end on " + ctx_->device_name() + ": block grid " + std::to_string(block_grid_.voxels(0)) + "x" +
-              std::to_string(block_grid_.voxels(1)) + "x" + std::to_string(block_grid_.voxels(2)) + " voxels, BLAS of " +
-              std::to_string(block_grid_.block) + "^3 boxes instanced " + std::to_string(block_grid_.instance_count()) +
-              " times; BVH built in " + std::to_string(bvh_.build_ms) + " ms (BLAS " + std::to_string(bvh_.blas.size()) +
-              " B, TLAS " + std::to_string(bvh_.tlas.size()) + " B)\n";
-    }
+    log.info("rt back end on " + ctx_->device_name() + ": block grid " + std::to_string(block_grid_.voxels(0)) + "x" +
+             std::to_string(block_grid_.voxels(1)) + "x" + std::to_string(block_grid_.voxels(2)) + " voxels, BLAS of " +
+             std::to_string(block_grid_.block) + "^3 boxes instanced " + std::to_string(block_grid_.instance_count()) +
+             " times; BVH built in " + std::to_string(bvh_.build_ms) + " ms (BLAS " + std::to_string(bvh_.blas.size()) +
+             " B, TLAS " + std::to_string(bvh_.tlas.size()) + " B)");
   }
 
   BackendKind kind() const override { return BackendKind::kRt; }
   std::string device_name() const override { return ctx_->device_name(); }
 
   void shoot(const RayBatch& batch, Traversal mode, VoxelList& out, ShootStats& stats) override {
-    if (mode != Traversal::kExact) throw std::runtime_error(kOctomapModeRefusal);
+    if (mode != Traversal::kExact) throw Unsupported(kOctomapModeRefusal);
     const std::vector<KeyBox> windows = tile_windows(batch.keys, block_grid_, kWindowMargin);
     space_.shoot(
         batch, windows, [&](VkCommandBuffer cmd, gpu::ShootPush push) { record_trace(cmd, push); }, out, stats);
@@ -150,9 +149,9 @@ class RtBackend final : public RayBackend {
 
 }  // namespace
 
-std::unique_ptr<RayBackend> make_rt_backend(const BackendOptions& opts, const RtOptions& rt, std::string* log,
+std::unique_ptr<RayBackend> make_rt_backend(const BackendOptions& opts, const RtOptions& rt, const Log& log,
                                             RtBvhInfo* info) {
-  if (opts.traversal == Traversal::kOctomap) throw std::runtime_error(kOctomapModeRefusal);
+  if (opts.traversal == Traversal::kOctomap) throw Unsupported(kOctomapModeRefusal);
   return std::make_unique<RtBackend>(opts, rt, log, info);
 }
 

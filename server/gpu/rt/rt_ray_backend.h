@@ -4,6 +4,7 @@
 #include <memory>
 #include <string>
 
+#include "core/log.h"
 #include "core/ray_backend.h"
 #include "gpu/rt/block_grid.h"
 
@@ -29,9 +30,9 @@ struct RtBvhInfo {
 
 // The device must have VK_KHR_acceleration_structure, VK_KHR_ray_tracing_pipeline,
 // VK_KHR_deferred_host_operations, bufferDeviceAddress and shaderFloat64; otherwise this
-// throws std::runtime_error("unsupported: ... lacks ..."). It also refuses
+// throws Unsupported("unsupported: ... lacks ...") (core/errors.h). It also refuses
 // Traversal::kOctomap (OctoMap's sequential DDA is not a geometric predicate per voxel).
-std::unique_ptr<RayBackend> make_rt_backend(const BackendOptions& opts, const RtOptions& rt, std::string* log,
+std::unique_ptr<RayBackend> make_rt_backend(const BackendOptions& opts, const RtOptions& rt, const Log& log = {},
                                             RtBvhInfo* info = nullptr);
 
 // The message of the refusal of --traversal octomap (also used by --help texts and docs).

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "core/errors.h"
 #include "gpu/vk/vk_check.h"
 
 namespace ort::vk {
@@ -121,14 +122,14 @@ int choose_device(const std::vector<DeviceInfo>& devices, const std::string& wan
       if (!d.unusable.empty()) continue;
       if (chosen < 0 || type_rank(d.type) < type_rank(devices[chosen].type)) chosen = int(d.index);
     }
-    if (chosen < 0) throw std::runtime_error("no usable Vulkan device:" + describe_devices(devices));
+    if (chosen < 0) throw Unsupported("no usable Vulkan device:" + describe_devices(devices));
     return chosen;
   }
   if (all_digits(wanted)) {
     const unsigned long idx = std::stoul(wanted);
-    if (idx >= devices.size()) throw std::runtime_error("no Vulkan device with index " + wanted + ":" + describe_devices(devices));
+    if (idx >= devices.size()) throw Unsupported("no Vulkan device with index " + wanted + ":" + describe_devices(devices));
     if (!devices[idx].unusable.empty())
-      throw std::runtime_error("Vulkan device " + wanted + " (" + devices[idx].name + ") " + devices[idx].unusable);
+      throw Unsupported("Vulkan device " + wanted + " (" + devices[idx].name + ") " + devices[idx].unusable);
     return int(idx);
   }
   const std::string name = lower(wanted);
@@ -138,8 +139,8 @@ int choose_device(const std::vector<DeviceInfo>& devices, const std::string& wan
     matched = true;
     if (d.unusable.empty()) return int(d.index);
   }
-  throw std::runtime_error((matched ? "no usable Vulkan device matches '" : "no Vulkan device matches '") + wanted +
-                           "':" + describe_devices(devices));
+  throw Unsupported((matched ? "no usable Vulkan device matches '" : "no Vulkan device matches '") + wanted +
+                    "':" + describe_devices(devices));
 }
 
 }  // namespace
@@ -159,7 +160,7 @@ Context::Context(const ContextOptions& opts) {
 void Context::create_instance() {
   uint32_t loader_version = 0;
   if (vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS || loader_version < VK_API_VERSION_1_2) {
-    throw std::runtime_error("no Vulkan device: the Vulkan loader does not support Vulkan 1.2");
+    throw Unsupported("no Vulkan device: the Vulkan loader does not support Vulkan 1.2");
   }
   VkApplicationInfo app{};
   app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
@@ -172,8 +173,8 @@ void Context::create_instance() {
   const VkResult ir = vkCreateInstance(&ici, nullptr, &instance_);
   if (ir != VK_SUCCESS) {
     instance_ = VK_NULL_HANDLE;
-    throw std::runtime_error(std::string("no Vulkan device: vkCreateInstance failed (") + result_name(ir) +
-                             "); is a Vulkan driver installed?");
+    throw Unsupported(std::string("no Vulkan device: vkCreateInstance failed (") + result_name(ir) +
+                      "); is a Vulkan driver installed?");
   }
 }
 
@@ -182,7 +183,7 @@ void Context::choose_physical_device(const ContextOptions& opts) {
   vkEnumeratePhysicalDevices(instance_, &n, nullptr);
   std::vector<VkPhysicalDevice> pds(n);
   if (n) vkEnumeratePhysicalDevices(instance_, &n, pds.data());
-  if (n == 0) throw std::runtime_error("no Vulkan device found");
+  if (n == 0) throw Unsupported("no Vulkan device found");
   for (uint32_t i = 0; i < n; ++i) {
     VkPhysicalDeviceProperties p;
     vkGetPhysicalDeviceProperties(pds[i], &p);

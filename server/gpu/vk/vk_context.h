@@ -5,7 +5,8 @@
 // shaderFloat64/shaderInt64 when asked for, a compute queue), best type first: discrete GPU,
 // then integrated, virtual, CPU (lavapipe). ContextOptions::device ("2" or a case-insensitive
 // name substring) overrides the choice. With no usable device the constructor throws
-// std::runtime_error saying why, per device.
+// ort::Unsupported (core/errors.h) saying why, per device; a device that is there but fails
+// to start throws std::runtime_error.
 #pragma once
 
 #include <cstdint>

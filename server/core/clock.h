@@ -1,0 +1,31 @@
+// The two clocks the code reads: steady time for durations (stage times, timeouts) and the
+// wall clock for LCM utimes. One spelling of each, so a stage time is always the same unit.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+
+namespace ort {
+
+using SteadyClock = std::chrono::steady_clock;
+
+// Milliseconds from `a` to `b`.
+inline double ms_between(SteadyClock::time_point a, SteadyClock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+// Milliseconds elapsed since `t`.
+inline double ms_since(SteadyClock::time_point t) { return ms_between(t, SteadyClock::now()); }
+
+// Seconds elapsed since `t`.
+inline double seconds_since(SteadyClock::time_point t) {
+  return std::chrono::duration<double>(SteadyClock::now() - t).count();
+}
+
+// Microseconds since the Unix epoch (LCM's utime).
+inline int64_t now_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace ort

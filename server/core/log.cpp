@@ -1,0 +1,37 @@
+#include "core/log.h"
+
+#include <ostream>
+
+namespace ort {
+
+const char* to_string(LogLevel level) {
+  switch (level) {
+    case LogLevel::kInfo: return "info";
+    case LogLevel::kWarning: return "warning";
+    case LogLevel::kError: return "error";
+  }
+  return "?";
+}
+
+void Log::lines(LogLevel level, std::string_view text) const {
+  while (!text.empty()) {
+    const size_t end = text.find('\n');
+    const std::string_view line = text.substr(0, end);
+    if (!line.empty()) (*this)(level, line);
+    if (end == std::string_view::npos) break;
+    text.remove_prefix(end + 1);
+  }
+}
+
+Log log_to(std::ostream& out) {
+  return Log([&out](LogLevel, std::string_view message) { out << message << '\n'; });
+}
+
+Log log_into(std::string& text) {
+  return Log([&text](LogLevel, std::string_view message) {
+    text += message;
+    text += '\n';
+  });
+}
+
+}  // namespace ort
