@@ -18,6 +18,8 @@ MapEditResult apply_map_edit(MapState& map, const MapEditItem& edit) {
     query::clear_box(tree, box, edit.op == Msg::OP_CLEAR_TO_FREE ? query::ClearTo::kFree : query::ClearTo::kUnknown);
   }
   map.version++;
+  // Deltas cannot carry an edit (a box back to unknown, a reset): mirrors resync from a snapshot.
+  if (map.observer) map.observer->replaced(tree, map.version);
   r.ok = true;
   r.version = map.version;
   r.map_utime = map.last_scan_utime;

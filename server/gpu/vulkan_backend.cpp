@@ -84,7 +84,7 @@ class VulkanBackend final : public RayBackend {
 
   void shoot_posed(const PosedPoints& scan, Traversal mode, VoxelList& out, ShootStats& stats,
                    PrepareReport& report) override {
-    if (!prepare_) RayBackend::shoot_posed(scan, mode, out, stats, report);
+    if (!prepare_) return RayBackend::shoot_posed(scan, mode, out, stats, report);  // CPU preparation
     out.clear();
     report.points_in += scan.points.size();
     RayBatch header;  // origin, origin key, key box; the ends stay on the device
