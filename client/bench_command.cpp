@@ -2,9 +2,6 @@
 // in the same process on the same scans. Per run: stage breakdown (paper Fig. 6), end-to-end
 // ratio, leaf counts against OctoMap's (Fig. 10), tree and process memory, the GPU grid.
 // Writes CSV, Markdown tables and gnuplot charts; progress goes to stderr.
-#include <sys/resource.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,6 +17,7 @@
 #include "core/clock.h"
 #include "engine/map_engine.h"
 #include "map_summary.h"
+#include "process_memory.h"
 #include "scene/scan_set.h"
 #include "scene/scene_presets.h"
 
@@ -28,7 +26,6 @@ namespace {
 
 using bench::BenchRow;
 using Clock = std::chrono::steady_clock;
-
 
 struct BenchArgs {
   std::vector<std::string> presets = {"fr079", "campus", "skt-corridor"};
@@ -49,19 +46,6 @@ struct BenchArgs {
   std::string csv, png_dir, markdown;
   std::vector<std::string> replot;
 };
-
-uint64_t current_rss_bytes() {
-  std::ifstream statm("/proc/self/statm");
-  uint64_t pages = 0, resident = 0;
-  statm >> pages >> resident;
-  return resident * uint64_t(sysconf(_SC_PAGESIZE));
-}
-
-uint64_t peak_rss_bytes() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return uint64_t(u.ru_maxrss) * 1024;  // Linux reports KiB
-}
 
 // The same leaves in the same order, with the same depth and log-odds: the trees are equal
 // node for node at the leaves (pruning included). Both iterate depth first in child order.
