@@ -24,11 +24,11 @@ class QueriesTest(ServerTestCase):
         occ, prob = self.client.query_points([[50.0, 50.0, 50.0]])
         self.assertEqual((int(occ[0]), float(prob[0])), (octomap_rt.UNKNOWN, -1.0))
         # Rays from the sensor towards the wall stop in its voxels (x in [4.0, 4.1)).
-        hit, state, ends = self.client.cast_rays((0.0, 0.0, 0.5), [[1.0, 0.0, 0.0], [1.0, 0.2, 0.0]], max_range=10,
+        hit, state, ray_ends = self.client.cast_rays((0.0, 0.0, 0.5), [[1.0, 0.0, 0.0], [1.0, 0.2, 0.0]], max_range=10,
                                                 ignore_unknown=True)
         self.assertTrue(hit.all())
         self.assertTrue((state == octomap_rt.OCCUPIED).all())
-        self.assertTrue(((ends[:, 0] >= 4.0) & (ends[:, 0] < 4.1 + 1e-4)).all(), ends)
+        self.assertTrue(((ray_ends[:, 0] >= 4.0) & (ray_ends[:, 0] < 4.1 + 1e-4)).all(), ray_ends)
         # Boxes: the wall's voxels counted; the grid of its band shows them.
         counts = self.client.box([[3.95, -1.05, 0.45, 4.05, 1.05, 1.55]])
         self.assertEqual(int(counts["occupied"][0]), len(voxel_keys(ends)))
