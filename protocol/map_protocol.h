@@ -6,12 +6,15 @@
 #include <string>
 #include <string_view>
 
+#include "octomap_rt/wire_contract.hpp"
+
 namespace ort::protocol {
 
-inline constexpr const char* kMapRequestChannel = "OCTOMAP_RT_MAP_REQUEST";
-inline constexpr const char* kMapInfoChannel = "OCTOMAP_RT_MAP_INFO";
-inline constexpr const char* kMapDeltaChannel = "OCTOMAP_RT_MAP_DELTA";
-inline constexpr const char* kMapReplyPrefix = "OCTOMAP_RT_MAP_REPLY_";
+// Channel names are the wire contract's (spelled once, beside the message types).
+inline constexpr const char* kMapRequestChannel = octomap_rt::wire::kMapRequestChannel;
+inline constexpr const char* kMapInfoChannel = octomap_rt::wire::kMapInfoChannel;
+inline constexpr const char* kMapDeltaChannel = octomap_rt::wire::kMapDeltaChannel;
+inline constexpr const char* kMapReplyPrefix = octomap_rt::wire::kMapReplyPrefix;
 
 // One LCM message that fits one UDP datagram: LCM's small-message path is a single
 // datagram up to 64 KB; 60 KB leaves room for the header and keeps clear of fragmentation.

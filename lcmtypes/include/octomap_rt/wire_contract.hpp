@@ -20,6 +20,10 @@ inline constexpr const char* kStatusChannel = "OCTOMAP_RT_STATUS";
 inline constexpr const char* kMapRequestChannel = "OCTOMAP_RT_MAP_REQUEST";
 // map_info_t, server -> all: a snapshot is available.
 inline constexpr const char* kMapInfoChannel = "OCTOMAP_RT_MAP_INFO";
+// map_delta_t, server -> all: the changes of each applied scan (coalesced).
+inline constexpr const char* kMapDeltaChannel = "OCTOMAP_RT_MAP_DELTA";
+// map_chunk_t to one client: the prefix a client's reply_channel starts with by convention.
+inline constexpr const char* kMapReplyPrefix = "OCTOMAP_RT_MAP_REPLY_";
 // map_chunk_t broadcast (a request's reply_channel otherwise).
 inline constexpr const char* kMapChunkChannel = "OCTOMAP_RT_MAP_CHUNK";
 // occupancy_query_t, client -> server; the reply goes to the query's reply_channel.
