@@ -112,7 +112,6 @@ void QueryService::on_query(const lcm::ReceiveBuffer& rb, std::string (*check)(c
   PendingQuery q{QueryMessage(std::move(msg)), Clock::now(), {}};
   const QueryHeader h = header_of(q.msg);
   std::string bad = validate_query(q.msg, resolution_);
-  if (bad.empty() && h.wait_seq >= 0 && h.wait_robot_id.empty()) bad = "wait_seq needs wait_robot_id";
   if (bad.empty() && (h.wait_timeout_ms < 0 || h.wait_timeout_ms > cfg_.max_wait_ms))
     bad = "wait_timeout_ms must be in 0.." + std::to_string(cfg_.max_wait_ms);
   if (!bad.empty()) {
@@ -190,12 +189,15 @@ bool QueryService::try_answer(PendingQuery& q) {
   {
     std::shared_lock lock(map_.mutex);
     const MapStamp stamp{static_cast<int64_t>(map_.version), map_.last_scan_utime};
+    // The robot id keys the wait: "" = no wait, whatever wait_seq holds (a default message
+    // has wait_seq 0), so a plain query is never parked for a robot that does not exist.
+    const bool waits_for_scan = !h.wait_robot_id.empty();
     int64_t applied = -1;
-    if (h.wait_seq >= 0) {
+    if (waits_for_scan) {
       auto it = map_.applied_seq.find(lower(h.wait_robot_id));
       if (it != map_.applied_seq.end()) applied = it->second;
     }
-    const bool ready = stamp.snapshot_id >= h.min_snapshot_id && (h.wait_seq < 0 || applied >= h.wait_seq);
+    const bool ready = stamp.snapshot_id >= h.min_snapshot_id && (!waits_for_scan || applied >= h.wait_seq);
     if (!ready) {
       if (Clock::now() < q.deadline) return false;
       const std::string why = "map state " + std::to_string(stamp.snapshot_id) + " (robot '" + h.wait_robot_id +

@@ -121,6 +121,33 @@ TEST(QueryService, ReadYourWritesSeesTheScanJustSent) {
     }
 }
 
+TEST(QueryService, AnEmptyWaitRobotIdMeansNoWaitWhateverWaitSeqHolds) {
+  lcm::LCM lc("memq://");
+  daemon::MappingServer server(test_config(0.1, true), lc, std::cerr);
+  Replies replies(server);
+  server.start();
+  // A default-initialised query has wait_seq 0 and no robot: answered at once, no scan needed.
+  auto plain = point_query(1, {3.05f, 0.f, 0.05f});
+  plain.wait_seq = 0, plain.wait_robot_id = "", plain.wait_timeout_ms = 0;
+  lc.publish("OCTOMAP_RT_QUERY", &plain);
+  const Reply r = replies.wait_for<Reply>(1);
+  ASSERT_EQ(r.status, Reply::REPLY_OK) << r.error;
+  EXPECT_EQ(r.occupancy[0], Reply::OCC_UNKNOWN);
+  // With the robot named, the same wait_seq 0 waits for that robot's scan 0.
+  auto waiting = plain;
+  waiting.request_id = 2, waiting.wait_robot_id = "alpha", waiting.wait_timeout_ms = 300;
+  lc.publish("OCTOMAP_RT_QUERY", &waiting);
+  EXPECT_EQ(replies.wait_for<Reply>(2).status, Reply::REPLY_NOT_READY);
+  const auto scan = wall_scan(0);
+  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &scan);
+  waiting.request_id = 3, waiting.wait_timeout_ms = 20000;
+  lc.publish("OCTOMAP_RT_QUERY", &waiting);
+  const Reply seen = replies.wait_for<Reply>(3);
+  ASSERT_EQ(seen.status, Reply::REPLY_OK) << seen.error;
+  EXPECT_EQ(seen.occupancy[0], Reply::OCC_OCCUPIED);
+  server.stop();
+}
+
 TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
   lcm::LCM lc("memq://");
   daemon::MappingServer server(test_config(0.1, true), lc, std::cerr);
