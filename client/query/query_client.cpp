@@ -10,9 +10,12 @@
 #include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/occupancy_query_t.hpp"
 #include "octomap_rt/ray_query_t.hpp"
+#include "octomap_rt/wire_contract.hpp"
 
 namespace ort::client {
 namespace {
+
+namespace wire = octomap_rt::wire;
 
 int64_t now_us() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -29,7 +32,7 @@ std::string upper(std::string s) {
 QueryClient::QueryClient(const std::string& url, std::string client_id, std::chrono::milliseconds timeout)
     : lcm_(std::make_unique<lcm::LCM>(url)), client_id_(std::move(client_id)), timeout_(timeout) {
   if (!lcm_->good()) throw std::runtime_error("LCM could not start on '" + url + "'");
-  reply_channel_ = "OCTOMAP_RT_REPLY_" + upper(client_id_);
+  reply_channel_ = std::string(wire::kQueryReplyPrefix) + upper(client_id_);
   // Request ids differ between runs of the same client id (stale replies are ignored).
   next_request_ = now_us();
 }
@@ -92,7 +95,7 @@ octomap_rt::occupancy_reply_t QueryClient::points(const std::vector<float>& xyz,
   q.depth = depth;
   q.xyz = xyz;
   q.num_xyz = static_cast<int32_t>(xyz.size());
-  return exchange<octomap_rt::occupancy_reply_t>("OCTOMAP_RT_QUERY", q, one<octomap_rt::occupancy_reply_t>).front();
+  return exchange<octomap_rt::occupancy_reply_t>(wire::kQueryChannel, q, one<octomap_rt::occupancy_reply_t>).front();
 }
 
 octomap_rt::ray_reply_t QueryClient::rays(const std::vector<float>& origins, const std::vector<float>& directions,
@@ -104,7 +107,7 @@ octomap_rt::ray_reply_t QueryClient::rays(const std::vector<float>& origins, con
   q.origin_xyz = origins;
   q.direction_xyz = directions;
   q.num_xyz = static_cast<int32_t>(origins.size());
-  return exchange<octomap_rt::ray_reply_t>("OCTOMAP_RT_QUERY_RAYS", q, one<octomap_rt::ray_reply_t>).front();
+  return exchange<octomap_rt::ray_reply_t>(wire::kQueryRaysChannel, q, one<octomap_rt::ray_reply_t>).front();
 }
 
 octomap_rt::box_reply_t QueryClient::boxes(const std::vector<Box>& boxes, int8_t mode, const WaitFor& w) {
@@ -113,7 +116,7 @@ octomap_rt::box_reply_t QueryClient::boxes(const std::vector<Box>& boxes, int8_t
   q.mode = mode;
   for (const Box& b : boxes) q.boxes.insert(q.boxes.end(), {b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]});
   q.num_values = static_cast<int32_t>(q.boxes.size());
-  return exchange<octomap_rt::box_reply_t>("OCTOMAP_RT_QUERY_BOXES", q, one<octomap_rt::box_reply_t>).front();
+  return exchange<octomap_rt::box_reply_t>(wire::kQueryBoxesChannel, q, one<octomap_rt::box_reply_t>).front();
 }
 
 std::vector<octomap_rt::region_chunk_t> QueryClient::region(const Box& b, int depth, bool include_free,
@@ -125,7 +128,7 @@ std::vector<octomap_rt::region_chunk_t> QueryClient::region(const Box& b, int de
   q.include_free = include_free;
   q.boxes = {b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]};
   q.num_values = 6;
-  auto chunks = exchange<octomap_rt::region_chunk_t>("OCTOMAP_RT_QUERY_BOXES", q, [](const auto& r) {
+  auto chunks = exchange<octomap_rt::region_chunk_t>(wire::kQueryBoxesChannel, q, [](const auto& r) {
     return !r.empty() && (r[0].status != 0 || static_cast<int>(r.size()) >= r[0].num_chunks);
   });
   std::sort(chunks.begin(), chunks.end(), [](const auto& a, const auto& b) { return a.chunk_index < b.chunk_index; });
@@ -141,7 +144,7 @@ Grid QueryClient::grid(double z_min, double z_max, double cell_size, const Box* 
     q.window_min[0] = window->min[0], q.window_min[1] = window->min[1];
     q.window_max[0] = window->max[0], q.window_max[1] = window->max[1];
   }
-  auto rows = exchange<octomap_rt::grid_t>("OCTOMAP_RT_QUERY_GRID", q, [](const auto& r) {
+  auto rows = exchange<octomap_rt::grid_t>(wire::kQueryGridChannel, q, [](const auto& r) {
     return !r.empty() && (r[0].status != 0 || static_cast<int>(r.size()) >= r[0].num_chunks);
   });
   Grid g;
@@ -165,7 +168,7 @@ octomap_rt::map_edit_ack_t QueryClient::edit(int8_t op, const Box& b, const std:
   e.client_id = client_id_;
   e.reply_channel = reply_channel_;
   e.token = token;
-  return exchange<octomap_rt::map_edit_ack_t>("OCTOMAP_RT_MAP_EDIT", e, one<octomap_rt::map_edit_ack_t>).front();
+  return exchange<octomap_rt::map_edit_ack_t>(wire::kMapEditChannel, e, one<octomap_rt::map_edit_ack_t>).front();
 }
 
 }  // namespace ort::client

@@ -4,14 +4,16 @@
 #include <cstddef>
 #include <string>
 
+#include "octomap_rt/wire_contract.hpp"
+
 namespace ort::daemon {
 
 struct QueryServiceConfig {
-  std::string points_channel = "OCTOMAP_RT_QUERY";
-  std::string rays_channel = "OCTOMAP_RT_QUERY_RAYS";
-  std::string boxes_channel = "OCTOMAP_RT_QUERY_BOXES";
-  std::string grid_channel = "OCTOMAP_RT_QUERY_GRID";
-  std::string edit_channel = "OCTOMAP_RT_MAP_EDIT";
+  std::string points_channel = octomap_rt::wire::kQueryChannel;
+  std::string rays_channel = octomap_rt::wire::kQueryRaysChannel;
+  std::string boxes_channel = octomap_rt::wire::kQueryBoxesChannel;
+  std::string grid_channel = octomap_rt::wire::kQueryGridChannel;
+  std::string edit_channel = octomap_rt::wire::kMapEditChannel;
   std::string control_token;       // "": every edit is refused
   size_t per_client_queue = 16;    // queued queries per client; more get BUSY
   size_t max_clients = 256;        // distinct client ids tracked; the rest share "*"

@@ -9,6 +9,7 @@
 #include "octomap_rt/map_edit_ack_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/occupancy_reply_t.hpp"
+#include "octomap_rt/wire_contract.hpp"
 #include "query/query_types.h"
 
 namespace ort::daemon {
@@ -82,7 +83,7 @@ std::string QueryService::check_addressing(const std::string& client, const std:
   for (const std::string* own : {&cfg_.points_channel, &cfg_.rays_channel, &cfg_.boxes_channel, &cfg_.grid_channel,
                                  &cfg_.edit_channel})
     if (channel == *own) return "reply_channel is one of the server's request channels";
-  if (channel.rfind("OCTOMAP_RT_SCAN_", 0) == 0 || channel == "OCTOMAP_RT_STATUS")
+  if (channel.rfind(octomap_rt::wire::kScanChannelPrefix, 0) == 0 || channel == octomap_rt::wire::kStatusChannel)
     return "reply_channel is one of the server's scan or status channels";
   return "";
 }

@@ -21,6 +21,7 @@
 #include "octomap_rt/ray_query_t.hpp"
 #include "octomap_rt/ray_reply_t.hpp"
 #include "octomap_rt/region_chunk_t.hpp"
+#include "octomap_rt/wire_contract.hpp"
 #include "query/box_count.h"
 #include "query/point_query.h"
 #include "query/projected_grid.h"
@@ -29,6 +30,7 @@
 namespace ort::test {
 namespace {
 
+namespace wire = octomap_rt::wire;
 using Reply = octomap_rt::occupancy_reply_t;
 const std::string kReply = "QUERY_TEST_REPLY";
 
@@ -100,7 +102,7 @@ TEST(QueryService, ReadYourWritesSeesTheScanJustSent) {
     // Right after the scan: ask about its own end points, waiting for its seq.
     auto q = point_query(100 + k, scan.xyz);
     q.wait_seq = k, q.wait_robot_id = "alpha", q.wait_timeout_ms = 20000;
-    lc.publish("OCTOMAP_RT_QUERY", &q);
+    lc.publish(wire::kQueryChannel, &q);
     const Reply r = replies.wait_for<Reply>(100 + k);
     ASSERT_EQ(r.status, Reply::REPLY_OK) << r.error;
     EXPECT_GE(r.snapshot_id, k + 1);
@@ -110,7 +112,7 @@ TEST(QueryService, ReadYourWritesSeesTheScanJustSent) {
   // Without waiting for a seq that never comes: NOT_READY after the timeout, counted.
   auto late = point_query(200, {0, 0, 0});
   late.wait_seq = 99, late.wait_robot_id = "alpha", late.wait_timeout_ms = 200;
-  lc.publish("OCTOMAP_RT_QUERY", &late);
+  lc.publish(wire::kQueryChannel, &late);
   const Reply nr = replies.wait_for<Reply>(200);
   EXPECT_EQ(nr.status, Reply::REPLY_NOT_READY);
   EXPECT_NE(nr.error.find("wait_seq 99"), std::string::npos) << nr.error;
@@ -129,19 +131,19 @@ TEST(QueryService, AnEmptyWaitRobotIdMeansNoWaitWhateverWaitSeqHolds) {
   // A default-initialised query has wait_seq 0 and no robot: answered at once, no scan needed.
   auto plain = point_query(1, {3.05f, 0.f, 0.05f});
   plain.wait_seq = 0, plain.wait_robot_id = "", plain.wait_timeout_ms = 0;
-  lc.publish("OCTOMAP_RT_QUERY", &plain);
+  lc.publish(wire::kQueryChannel, &plain);
   const Reply r = replies.wait_for<Reply>(1);
   ASSERT_EQ(r.status, Reply::REPLY_OK) << r.error;
   EXPECT_EQ(r.occupancy[0], Reply::OCC_UNKNOWN);
   // With the robot named, the same wait_seq 0 waits for that robot's scan 0.
   auto waiting = plain;
   waiting.request_id = 2, waiting.wait_robot_id = "alpha", waiting.wait_timeout_ms = 300;
-  lc.publish("OCTOMAP_RT_QUERY", &waiting);
+  lc.publish(wire::kQueryChannel, &waiting);
   EXPECT_EQ(replies.wait_for<Reply>(2).status, Reply::REPLY_NOT_READY);
   const auto scan = wall_scan(0);
   lc.publish("OCTOMAP_RT_SCAN_ALPHA", &scan);
   waiting.request_id = 3, waiting.wait_timeout_ms = 20000;
-  lc.publish("OCTOMAP_RT_QUERY", &waiting);
+  lc.publish(wire::kQueryChannel, &waiting);
   const Reply seen = replies.wait_for<Reply>(3);
   ASSERT_EQ(seen.status, Reply::REPLY_OK) << seen.error;
   EXPECT_EQ(seen.occupancy[0], Reply::OCC_OCCUPIED);
@@ -162,7 +164,7 @@ TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
   for (int i = 0; i < 300; ++i) pts.insert(pts.end(), {-1.f + 0.023f * i, -1.2f + 0.0087f * i, 0.31f});
   auto pq = point_query(1, pts);
   pq.depth = 14;
-  lc.publish("OCTOMAP_RT_QUERY", &pq);
+  lc.publish(wire::kQueryChannel, &pq);
   const Reply pr = replies.wait_for<Reply>(1);
   ASSERT_EQ(pr.status, Reply::REPLY_OK) << pr.error;
   server.with_map([&](const octomap::OcTree& t) {
@@ -182,7 +184,7 @@ TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
     rq.direction_xyz.insert(rq.direction_xyz.end(), {1.f, -0.5f + 0.02f * i, 0.f});
   }
   rq.num_xyz = static_cast<int32_t>(rq.origin_xyz.size());
-  lc.publish("OCTOMAP_RT_QUERY_RAYS", &rq);
+  lc.publish(wire::kQueryRaysChannel, &rq);
   const auto rr = replies.wait_for<octomap_rt::ray_reply_t>(2);
   ASSERT_EQ(rr.status, Reply::REPLY_OK) << rr.error;
   server.with_map([&](const octomap::OcTree& t) {
@@ -200,7 +202,7 @@ TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
   address(bq, 3);
   bq.boxes = {2.9, -1.0, 0.0, 3.3, 1.0, 1.0, -0.5, -0.5, 0.0, 0.5, 0.5, 0.5};
   bq.num_values = 12;
-  lc.publish("OCTOMAP_RT_QUERY_BOXES", &bq);
+  lc.publish(wire::kQueryBoxesChannel, &bq);
   const auto br = replies.wait_for<octomap_rt::box_reply_t>(3);
   ASSERT_EQ(br.status, Reply::REPLY_OK) << br.error;
   server.with_map([&](const octomap::OcTree& t) {
@@ -217,7 +219,7 @@ TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
   octomap_rt::grid_query_t gq{};
   address(gq, 4);
   gq.z_min = 0.0, gq.z_max = 0.5, gq.cell_size = 0.2;
-  lc.publish("OCTOMAP_RT_QUERY_GRID", &gq);
+  lc.publish(wire::kQueryGridChannel, &gq);
   const auto g = replies.wait_for<octomap_rt::grid_t>(4);
   ASSERT_EQ(g.status, Reply::REPLY_OK) << g.error;
   server.with_map([&](const octomap::OcTree& t) {
@@ -249,10 +251,10 @@ TEST(QueryService, EditsNeedTheTokenAndApplyInOrderWithTheScans) {
   e.op = octomap_rt::map_edit_t::OP_CLEAR_TO_FREE;
   double lo[3] = {2.5, -2, 0}, hi[3] = {3.5, 2, 1};
   std::copy(lo, lo + 3, e.box_min), std::copy(hi, hi + 3, e.box_max);
-  lc.publish("OCTOMAP_RT_MAP_EDIT", &e);
+  lc.publish(wire::kMapEditChannel, &e);
   EXPECT_EQ(replies.wait_for<octomap_rt::map_edit_ack_t>(1).status, Reply::REPLY_REFUSED);
   e.request_id = 2, e.token = "s3cret";
-  lc.publish("OCTOMAP_RT_MAP_EDIT", &e);  // queued behind the scan: the wall is cleared
+  lc.publish(wire::kMapEditChannel, &e);  // queued behind the scan: the wall is cleared
   const auto ack = replies.wait_for<octomap_rt::map_edit_ack_t>(2);
   ASSERT_EQ(ack.status, Reply::REPLY_OK) << ack.error;
   EXPECT_EQ(ack.snapshot_id, 2);  // one scan, then the edit
@@ -261,13 +263,13 @@ TEST(QueryService, EditsNeedTheTokenAndApplyInOrderWithTheScans) {
   bq.min_snapshot_id = ack.snapshot_id;
   bq.boxes = {lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]};
   bq.num_values = 6;
-  lc.publish("OCTOMAP_RT_QUERY_BOXES", &bq);
+  lc.publish(wire::kQueryBoxesChannel, &bq);
   const auto br = replies.wait_for<octomap_rt::box_reply_t>(3);
   ASSERT_EQ(br.status, Reply::REPLY_OK);
   EXPECT_EQ(br.occupied[0], 0);
   EXPECT_EQ(br.unknown[0], 0);
   e.request_id = 4, e.op = octomap_rt::map_edit_t::OP_RESET;
-  lc.publish("OCTOMAP_RT_MAP_EDIT", &e);
+  lc.publish(wire::kMapEditChannel, &e);
   EXPECT_EQ(replies.wait_for<octomap_rt::map_edit_ack_t>(4).snapshot_id, 3);
   EXPECT_EQ(server.with_map([](const octomap::OcTree& t) { return t.size(); }), 0u);
   server.stop();
@@ -281,43 +283,43 @@ TEST(QueryService, BadQueriesAreRefusedOrDroppedAndCounted) {
   Replies replies(server);
   server.start();
   auto nan = point_query(1, {0, NAN, 0});
-  lc.publish("OCTOMAP_RT_QUERY", &nan);
+  lc.publish(wire::kQueryChannel, &nan);
   EXPECT_EQ(replies.wait_for<Reply>(1).status, Reply::REPLY_BAD_REQUEST);
   auto deep = point_query(2, {0, 0, 0});
   deep.depth = 17;
-  lc.publish("OCTOMAP_RT_QUERY", &deep);
+  lc.publish(wire::kQueryChannel, &deep);
   EXPECT_NE(replies.wait_for<Reply>(2).error.find("depth"), std::string::npos);
   // Dropped (no trustworthy address): too many points, empty / over-long reply channel,
   // garbage, a huge count in the raw bytes.
   auto many = point_query(3, std::vector<float>(3 * (daemon::kMaxQueryPoints + 1), 0.f));
-  lc.publish("OCTOMAP_RT_QUERY", &many);
+  lc.publish(wire::kQueryChannel, &many);
   auto empty = point_query(4, {0, 0, 0});
   empty.reply_channel = "";
-  lc.publish("OCTOMAP_RT_QUERY", &empty);
+  lc.publish(wire::kQueryChannel, &empty);
   auto longer = point_query(5, {0, 0, 0});
   longer.reply_channel = std::string(200, 'R');
-  lc.publish("OCTOMAP_RT_QUERY", &longer);
+  lc.publish(wire::kQueryChannel, &longer);
   auto reflect = point_query(6, {0, 0, 0});
   reflect.reply_channel = "OCTOMAP_RT_SCAN_ALPHA";
-  lc.publish("OCTOMAP_RT_QUERY", &reflect);
+  lc.publish(wire::kQueryChannel, &reflect);
   std::vector<uint8_t> raw(point_query(7, {0, 0, 0}).getEncodedSize());
   point_query(7, {0, 0, 0}).encode(raw.data(), 0, static_cast<int>(raw.size()));
   std::vector<uint8_t> huge = raw;
   huge[8 + 40] = 0x7f;  // num_xyz's high byte
-  lc.publish("OCTOMAP_RT_QUERY", huge.data(), static_cast<unsigned>(huge.size()));
-  lc.publish("OCTOMAP_RT_QUERY", raw.data(), 20);
+  lc.publish(wire::kQueryChannel, huge.data(), static_cast<unsigned>(huge.size()));
+  lc.publish(wire::kQueryChannel, raw.data(), 20);
   // Edits without a server token are refused.
   octomap_rt::map_edit_t e{};
   e.request_id = 8, e.client_id = "op", e.reply_channel = kReply, e.token = "x", e.op = 3;
-  lc.publish("OCTOMAP_RT_MAP_EDIT", &e);
+  lc.publish(wire::kMapEditChannel, &e);
   EXPECT_NE(replies.wait_for<octomap_rt::map_edit_ack_t>(8).error.find("--control-token"), std::string::npos);
   // A flood from one client: its queue holds 2, the rest are BUSY; another client is served.
   for (int i = 0; i < 200; ++i) {
     auto q = point_query(1000 + i, std::vector<float>(3 * 5000, 0.5f), "flooder");
-    lc.publish("OCTOMAP_RT_QUERY", &q);
+    lc.publish(wire::kQueryChannel, &q);
   }
   auto calm = point_query(9, {0, 0, 0}, "calm");
-  lc.publish("OCTOMAP_RT_QUERY", &calm);
+  lc.publish(wire::kQueryChannel, &calm);
   EXPECT_EQ(replies.wait_for<Reply>(9).status, Reply::REPLY_OK);
   // ... and mapping goes on.
   const auto s = wall_scan(0);

@@ -26,8 +26,21 @@ inline constexpr const char* kMapDeltaChannel = "OCTOMAP_RT_MAP_DELTA";
 inline constexpr const char* kMapReplyPrefix = "OCTOMAP_RT_MAP_REPLY_";
 // map_chunk_t broadcast (a request's reply_channel otherwise).
 inline constexpr const char* kMapChunkChannel = "OCTOMAP_RT_MAP_CHUNK";
-// occupancy_query_t, client -> server; the reply goes to the query's reply_channel.
+// Queries, client -> server; each reply goes to the query's reply_channel (the C++ client
+// uses kQueryReplyPrefix + its id in upper case).
+// occupancy_query_t -> occupancy_reply_t.
 inline constexpr const char* kQueryChannel = "OCTOMAP_RT_QUERY";
+// ray_query_t -> ray_reply_t.
+inline constexpr const char* kQueryRaysChannel = "OCTOMAP_RT_QUERY_RAYS";
+// box_query_t -> box_reply_t (counts, any occupied) or region_chunk_t (a region's voxels).
+inline constexpr const char* kQueryBoxesChannel = "OCTOMAP_RT_QUERY_BOXES";
+// grid_query_t -> grid_t rows.
+inline constexpr const char* kQueryGridChannel = "OCTOMAP_RT_QUERY_GRID";
+// map_edit_t -> map_edit_ack_t: clear a box, reset (refused without the control token).
+inline constexpr const char* kMapEditChannel = "OCTOMAP_RT_MAP_EDIT";
+inline constexpr const char* kQueryReplyPrefix = "OCTOMAP_RT_REPLY_";
+// grid_t rows, server -> all: the 2D grid published at --grid-rate (request_id -1).
+inline constexpr const char* kGridChannel = "OCTOMAP_RT_GRID";
 
 // --- Transport ----------------------------------------------------------------------------
 // Host-local multicast (ttl=0: packets never leave the host). $LCM_DEFAULT_URL wins over it,
