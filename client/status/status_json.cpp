@@ -1,5 +1,6 @@
 #include "status_json.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -55,6 +56,54 @@ std::string robot_json(const octomap_rt::robot_stats_t& r) {
       .num("queue_bytes", r.queue_bytes)
       .num("last_end_to_end_ms", double(r.last_end_to_end_ms))
       .raw("reject_reasons", reasons.str());
+  o << "}";
+  return o.str();
+}
+
+std::string query_client_json(const octomap_rt::query_client_stats_t& c) {
+  std::ostringstream o;
+  o << "{";
+  Fields(o)
+      .str("client_id", c.client_id)
+      .str("reply_channel", c.reply_channel)
+      .num("received", c.received)
+      .num("answered", c.answered)
+      .num("bad", c.bad)
+      .num("busy", c.busy)
+      .num("not_ready", c.not_ready)
+      .num("dropped", c.dropped)
+      .num("edits_applied", c.edits_applied)
+      .num("edits_refused", c.edits_refused)
+      .num("queue_depth", int64_t(c.queue_depth))
+      .num("last_utime", c.last_utime)
+      .str("last_error", c.last_error);
+  o << "}";
+  return o.str();
+}
+
+// "queries": totals, refusal reasons (name -> count) and the clients.
+std::string queries_json(const octomap_rt::server_status_t& s) {
+  std::ostringstream o, reasons, clients;
+  reasons << "{";
+  for (size_t i = 0; i < std::min(s.query_refusal_reason.size(), s.query_refusal_count.size()); ++i)
+    reasons << (i ? "," : "") << json_string(s.query_refusal_reason[i]) << ":" << s.query_refusal_count[i];
+  reasons << "}";
+  clients << "[";
+  for (size_t i = 0; i < s.query_clients.size(); ++i) clients << (i ? "," : "") << query_client_json(s.query_clients[i]);
+  clients << "]";
+  o << "{";
+  Fields(o)
+      .num("received", s.queries_received)
+      .num("answered", s.queries_answered)
+      .num("bad", s.queries_bad)
+      .num("busy", s.queries_busy)
+      .num("not_ready", s.queries_not_ready)
+      .num("dropped", s.queries_dropped)
+      .num("edits_applied", s.edits_applied)
+      .num("edits_refused", s.edits_refused)
+      .num("grids_published", s.grids_published)
+      .raw("refusal_reasons", reasons.str())
+      .raw("clients", clients.str());
   o << "}";
   return o.str();
 }
@@ -128,7 +177,8 @@ std::string status_json(const octomap_rt::server_status_t& s) {
       .num("socket_rcvbuf_drops", s.socket_rcvbuf_drops)
       .num("latest_snapshot_id", s.latest_snapshot_id)
       .num("requests_served", s.requests_served)
-      .raw("robots", robots.str());
+      .raw("robots", robots.str())
+      .raw("queries", queries_json(s));
   o << "}";
   return o.str();
 }

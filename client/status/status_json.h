@@ -1,5 +1,6 @@
 // octomap-rt-server's status as one line of JSON (every field of server_status_t, robots as
-// objects with their reject reasons as a name -> count object), for scripts and `jq`.
+// objects with their reject reasons as a name -> count object; "queries": the query service's
+// totals, refusal reasons and clients), for scripts and `jq`.
 #pragma once
 
 #include <string>

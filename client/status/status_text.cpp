@@ -1,5 +1,6 @@
 #include "status_text.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -77,6 +78,35 @@ void robots(std::ostringstream& o, const Status& s, int64_t now) {
   }
 }
 
+void queries(std::ostringstream& o, const Status& s, int64_t now) {
+  if (s.queries_received == 0 && s.queries_dropped == 0 && s.grids_published == 0) {
+    o << "  queries   none yet (OCTOMAP_RT_QUERY...)\n";
+    return;
+  }
+  o << fmt("  queries   received %s: answered %s, bad %s, busy %s, not ready %s; dropped %s; edits %s applied, %s "
+           "refused; grids published %s\n",
+           with_commas(s.queries_received).c_str(), with_commas(s.queries_answered).c_str(),
+           with_commas(s.queries_bad).c_str(), with_commas(s.queries_busy).c_str(),
+           with_commas(s.queries_not_ready).c_str(), with_commas(s.queries_dropped).c_str(),
+           with_commas(s.edits_applied).c_str(), with_commas(s.edits_refused).c_str(),
+           with_commas(s.grids_published).c_str());
+  const size_t n = std::min(s.query_refusal_reason.size(), s.query_refusal_count.size());
+  if (n) {
+    o << "    refused:";
+    for (size_t i = 0; i < n; ++i)
+      o << (i ? ", " : " ") << s.query_refusal_reason[i] << " " << with_commas(s.query_refusal_count[i]);
+    o << "\n";
+  }
+  if (s.query_clients.empty()) return;
+  o << fmt("\n  %-16s %9s %9s %6s %7s %9s %7s %6s %10s  %s\n", "query client", "received", "answered", "bad", "busy",
+           "not ready", "dropped", "queued", "last", "reply channel");
+  for (const auto& c : s.query_clients)
+    o << fmt("  %-16s %9s %9s %6s %7s %9s %7s %6d %10s  %s\n", c.client_id.c_str(), with_commas(c.received).c_str(),
+             with_commas(c.answered).c_str(), with_commas(c.bad).c_str(), with_commas(c.busy).c_str(),
+             with_commas(c.not_ready).c_str(), with_commas(c.dropped).c_str(), c.queue_depth,
+             age_text(c.last_utime, now).c_str(), c.reply_channel.c_str());
+}
+
 }  // namespace
 
 std::string state_name(int8_t state) {
@@ -127,6 +157,8 @@ std::string format_status(const Status& s, int64_t now_utime) {
   rates_and_latencies(o, s);
   queue_and_kernel(o, s);
   robots(o, s, now_utime);
+  o << "\n";
+  queries(o, s, now_utime);
   return o.str();
 }
 

@@ -1,5 +1,6 @@
 // octomap-rt-server's status (OCTOMAP_RT_STATUS) laid out for a terminal: state, back end,
-// rates, latencies, queue, then one row per robot with its reject reasons.
+// rates, latencies, queue, then one row per robot with its reject reasons, then the query
+// service's totals, refusal reasons and one row per query client.
 #pragma once
 
 #include <cstdint>

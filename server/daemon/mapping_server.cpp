@@ -306,6 +306,7 @@ StatusInputs MappingServer::gather_status() {
     in.last_delta_seq = ds.last_seq;
   }
   in.last_save_utime = last_save_utime_;
+  if (queries_) in.queries = queries_->service_stats();
   in.metrics = metrics_.snapshot();
   in.producers = producers_.snapshot();
   for (size_t i = 0; i < in.producers.size(); ++i)

@@ -11,6 +11,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -34,7 +35,19 @@ struct QueryClientStats {
   std::string client_id;                 // "?": messages that named no usable client
   int64_t received = 0, answered = 0, bad = 0, busy = 0, not_ready = 0, dropped = 0;
   int64_t edits_applied = 0, edits_refused = 0;
+  int64_t last_utime = 0;                // when its last message arrived [us since the epoch]
+  int64_t queue_depth = 0;               // queued now (filled by snapshot())
+  std::string reply_channel;             // of its last message
   std::string last_error;
+};
+
+// What the status reports of the query service.
+struct QueryServiceStats {
+  std::vector<QueryClientStats> clients;
+  // Why messages were refused (bad, busy, not ready, dropped, edits refused), digits as '#'
+  // so that "depth 17 ..." and "depth 20 ..." count as one reason; at most kMaxReasons.
+  std::vector<std::pair<std::string, int64_t>> refusal_reasons;
+  int64_t grids_published = 0;
 };
 
 class QueryClients {
@@ -46,9 +59,14 @@ class QueryClients {
   std::optional<PendingQuery> pop();
   size_t queued() const;
 
-  enum class Count { kReceived, kAnswered, kBad, kBusy, kNotReady, kDropped, kEditApplied, kEditRefused };
+  // A message with a usable address arrived from `client`, to be answered on `reply_channel`.
+  void received(const std::string& client, const std::string& reply_channel, int64_t utime);
+  enum class Count { kAnswered, kBad, kBusy, kNotReady, kDropped, kEditApplied, kEditRefused };
+  // `error` says why (refusals); it becomes the client's last_error and a refusal reason.
   void count(const std::string& client, Count what, const std::string& error = "");
   std::vector<QueryClientStats> snapshot() const;
+  std::vector<std::pair<std::string, int64_t>> refusal_reasons() const;
+  static constexpr size_t kMaxReasons = 32;  // more distinct reasons are counted under "other"
 
  private:
   struct Client {
@@ -56,12 +74,14 @@ class QueryClients {
     std::deque<PendingQuery> queue;
   };
   Client& at(const std::string& client);  // under mutex_
+  void bump(QueryClientStats& s, Count what, const std::string& error);  // under mutex_
 
   mutable std::mutex mutex_;
   size_t per_client_queue_, max_clients_;
   std::map<std::string, Client> clients_;
   std::string next_;                     // round-robin position: first client after this name
   size_t queued_ = 0;
+  std::map<std::string, int64_t> reasons_;
 };
 
 // The end-of-run lines of the query service (one per client; nothing without queries).

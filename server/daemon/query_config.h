@@ -1,4 +1,5 @@
-// What the query service is configured with (server flags --control-token, --query-queue).
+// What the query service is configured with (server flags --control-token, --query-queue,
+// --grid-rate, --grid-z, --grid-cell: daemon/query_flags).
 #pragma once
 
 #include <cstddef>
@@ -7,6 +8,14 @@
 #include "octomap_rt/wire_contract.hpp"
 
 namespace ort::daemon {
+
+// The 2D grid published at a rate (daemon/grid_publisher.h).
+struct GridPublishConfig {
+  double rate_hz = 0;              // 0: not published
+  double z_min = 0, z_max = 0;     // the band [m]
+  double cell_size = 0;            // [m]; 0: the resolution; else a multiple of it
+  std::string channel = octomap_rt::wire::kGridChannel;
+};
 
 struct QueryServiceConfig {
   std::string points_channel = octomap_rt::wire::kQueryChannel;
@@ -18,6 +27,7 @@ struct QueryServiceConfig {
   size_t per_client_queue = 16;    // queued queries per client; more get BUSY
   size_t max_clients = 256;        // distinct client ids tracked; the rest share "*"
   int max_wait_ms = 30000;         // longest wait_timeout_ms honoured
+  GridPublishConfig grid;
 };
 
 }  // namespace ort::daemon

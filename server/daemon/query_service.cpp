@@ -38,7 +38,7 @@ int64_t now_us() {
 QueryService::QueryService(const QueryServiceConfig& cfg, MapState& map, ScanQueue& scans, LcmLoop& loop,
                            std::string server_id, double resolution)
     : cfg_(cfg), map_(map), scans_(scans), loop_(loop), server_id_(std::move(server_id)), resolution_(resolution),
-      clients_(cfg.per_client_queue, cfg.max_clients) {}
+      clients_(cfg.per_client_queue, cfg.max_clients), grids_(cfg.grid, map, loop, server_id_) {}
 
 QueryService::~QueryService() { stop(); }
 
@@ -60,7 +60,18 @@ void QueryService::open() {
                                   [this](const lcm::ReceiveBuffer& rb, const std::string&) { on_edit(rb); }));
 }
 
-void QueryService::start() { worker_ = std::thread([this] { run(); }); }
+QueryServiceStats QueryService::service_stats() const {
+  QueryServiceStats s;
+  s.clients = clients_.snapshot();
+  s.refusal_reasons = clients_.refusal_reasons();
+  s.grids_published = grids_.published();
+  return s;
+}
+
+void QueryService::start() {
+  worker_ = std::thread([this] { run(); });
+  grids_.start();
+}
 
 void QueryService::stop() {
   {
@@ -70,6 +81,7 @@ void QueryService::stop() {
   wake_.notify_all();
   map_.changed.notify_all();
   if (worker_.joinable()) worker_.join();
+  grids_.stop();
 }
 
 std::string QueryService::check_addressing(const std::string& client, const std::string& channel) const {
@@ -83,6 +95,7 @@ std::string QueryService::check_addressing(const std::string& client, const std:
   for (const std::string* own : {&cfg_.points_channel, &cfg_.rays_channel, &cfg_.boxes_channel, &cfg_.grid_channel,
                                  &cfg_.edit_channel})
     if (channel == *own) return "reply_channel is one of the server's request channels";
+  if (channel == cfg_.grid.channel) return "reply_channel is the server's grid channel";
   if (channel.rfind(octomap_rt::wire::kScanChannelPrefix, 0) == 0 || channel == octomap_rt::wire::kStatusChannel)
     return "reply_channel is one of the server's scan or status channels";
   return "";
@@ -109,7 +122,7 @@ void QueryService::on_query(const lcm::ReceiveBuffer& rb, std::string (*check)(c
     clients_.count(kNoClient, Count::kDropped, bad);
     return;
   }
-  clients_.count(msg.client_id, Count::kReceived);
+  clients_.received(msg.client_id, msg.reply_channel, now_us());
   PendingQuery q{QueryMessage(std::move(msg)), Clock::now(), {}};
   const QueryHeader h = header_of(q.msg);
   std::string bad = validate_query(q.msg, resolution_);
@@ -148,7 +161,7 @@ void QueryService::on_edit(const lcm::ReceiveBuffer& rb) {
     clients_.count(kNoClient, Count::kDropped, "map edit: " + why);
     return;
   }
-  clients_.count(msg.client_id, Count::kReceived);
+  clients_.received(msg.client_id, msg.reply_channel, now_us());
   auto ack = [this, msg](const MapEditResult& r, int8_t status, const std::string& error) {
     octomap_rt::map_edit_ack_t a;
     a.utime = now_us();

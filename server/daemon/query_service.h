@@ -11,6 +11,7 @@
 // state is >= min_snapshot_id and the robot's wait_seq was applied (read-your-writes), then
 // is answered under a shared map lock (stage 2 keeps mapping between queries) and its
 // replies are published, each naming the map state (snapshot_id = MapState::version).
+// With --grid-rate, its GridPublisher also publishes the 2D grid on OCTOMAP_RT_GRID.
 #pragma once
 
 #include <atomic>
@@ -20,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "daemon/grid_publisher.h"
 #include "daemon/lcm_loop.h"
 #include "daemon/map_state.h"
 #include "daemon/query_answers.h"
@@ -35,11 +37,13 @@ class QueryService {
   QueryService(const QueryServiceConfig& cfg, MapState& map, ScanQueue& scans, LcmLoop& loop, std::string server_id,
                double resolution);
   ~QueryService();
-  // Subscribes (call before the loop starts), then start() the worker; stop() joins it.
+  // Subscribes (call before the loop starts), then start() the worker (and the grid
+  // publisher); stop() joins them.
   void open();
   void start();
   void stop();
   std::vector<QueryClientStats> stats() const { return clients_.snapshot(); }
+  QueryServiceStats service_stats() const;
 
  private:
   template <class Message>
@@ -61,6 +65,7 @@ class QueryService {
   QueryClients clients_;
   std::vector<LcmLoop::SubscriptionId> subs_;
   std::thread worker_;
+  GridPublisher grids_;
   std::mutex wake_mutex_;
   std::condition_variable wake_;
   bool stopping_ = false;

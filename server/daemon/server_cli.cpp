@@ -1,7 +1,10 @@
 #include "daemon/server_cli.h"
 
 #include <regex>
+#include <stdexcept>
 #include <string>
+
+#include "daemon/query_answers.h"
 
 namespace ort::daemon {
 
@@ -43,6 +46,7 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                  "every edit is refused. LCM has no authentication: the token keeps mistakes out, not attackers");
   app.add_option("--query-queue", s.queries.per_client_queue, "queued queries per client; more get BUSY replies")
       ->capture_default_str();
+  add_grid_flags(app, s.queries.grid);
   app.add_option("--max-producers", s.max_producers, "most scan channels served; more are rejected")
       ->capture_default_str();
   app.add_option("--snapshot-zstd-level", s.snapshot_zstd_level, "zstd level of served snapshots (0: uncompressed)")
@@ -63,6 +67,34 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                "deltas carry every changed leaf with its log-odds (an exact mirror), not only class changes");
 }
 
+void add_grid_flags(CLI::App& app, GridPublishConfig& g) {
+  auto* z = app.add_option_function<std::string>(
+      "--grid-z",
+      [&g](const std::string& v) {
+        const size_t colon = v.find(':');
+        try {
+          size_t used = 0;
+          if (colon == std::string::npos) throw std::invalid_argument("no colon");
+          g.z_min = std::stod(v.substr(0, colon), &used);
+          if (used != colon) throw std::invalid_argument("trailing text");
+          g.z_max = std::stod(v.substr(colon + 1), &used);
+          if (used != v.size() - colon - 1) throw std::invalid_argument("trailing text");
+        } catch (const std::exception&) {
+          throw CLI::ValidationError("--grid-z", "'" + v + "' is not MIN:MAX in metres (e.g. 0.1:1.5)");
+        }
+      },
+      "z band of the published grid, MIN:MAX [m]");
+  app.add_option("--grid-rate", g.rate_hz,
+                 std::string("publish the 2D grid of the --grid-z band (projected_map rule, grid_t rows) on ") +
+                     octomap_rt::wire::kGridChannel + " at this rate [Hz]; 0: off")
+      ->check(CLI::Range(0.0, 50.0))
+      ->needs(z)
+      ->capture_default_str();
+  app.add_option("--grid-cell", g.cell_size, "cell size of the published grid [m], a multiple of the resolution; 0: "
+                                             "the resolution")
+      ->capture_default_str();
+}
+
 ServerConfig to_server_config(const ServerFlags& f) {
   ServerConfig c = f.server;
   c.engine = ort::cli::to_engine_options(f.engine);
@@ -78,6 +110,12 @@ ServerConfig to_server_config(const ServerFlags& f) {
     throw CLI::ValidationError("--snapshot-zstd-level", "must be within 0..19");
   if (c.snapshots_kept == 0) throw CLI::ValidationError("--snapshots-kept", "must be > 0");
   if (!(c.chunk_interval_ms >= 0)) throw CLI::ValidationError("--chunk-interval-ms", "must be >= 0");
+  if (c.queries.grid.rate_hz > 0) {  // the rule of grid queries (daemon/query_answers)
+    octomap_rt::grid_query_t q{};
+    q.z_min = c.queries.grid.z_min, q.z_max = c.queries.grid.z_max, q.cell_size = c.queries.grid.cell_size;
+    if (const std::string bad = validate_query(QueryMessage(q), c.engine.resolution); !bad.empty())
+      throw CLI::ValidationError("--grid-z/--grid-cell", bad);
+  }
   try {
     std::regex check(c.scan_channels);
   } catch (const std::regex_error& e) {

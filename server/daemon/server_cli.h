@@ -18,6 +18,8 @@ struct ServerFlags {
 };
 
 void add_server_flags(CLI::App& app, ServerFlags& f);
+// --grid-rate, --grid-z MIN:MAX, --grid-cell (the grid published on OCTOMAP_RT_GRID).
+void add_grid_flags(CLI::App& app, GridPublishConfig& g);
 // Validates and converts (after parsing); throws CLI::ValidationError with a clear message.
 ServerConfig to_server_config(const ServerFlags& f);
 

@@ -1,6 +1,59 @@
 #include "daemon/status_message.h"
 
+#include <algorithm>
+
 namespace ort::daemon {
+namespace {
+
+octomap_rt::query_client_stats_t client_message(const QueryClientStats& c) {
+  octomap_rt::query_client_stats_t m;
+  m.received = c.received;
+  m.answered = c.answered;
+  m.bad = c.bad;
+  m.busy = c.busy;
+  m.not_ready = c.not_ready;
+  m.dropped = c.dropped;
+  m.edits_applied = c.edits_applied;
+  m.edits_refused = c.edits_refused;
+  m.last_utime = c.last_utime;
+  m.queue_depth = static_cast<int32_t>(c.queue_depth);
+  m.client_id = c.client_id;
+  m.reply_channel = c.reply_channel;
+  m.last_error = c.last_error;
+  return m;
+}
+
+void add_queries(octomap_rt::server_status_t& s, const QueryServiceStats& q) {
+  s.queries_received = s.queries_answered = s.queries_bad = s.queries_busy = s.queries_not_ready = 0;
+  s.queries_dropped = s.edits_applied = s.edits_refused = 0;
+  for (const QueryClientStats& c : q.clients) {
+    s.queries_received += c.received;
+    s.queries_answered += c.answered;
+    s.queries_bad += c.bad;
+    s.queries_busy += c.busy;
+    s.queries_not_ready += c.not_ready;
+    s.queries_dropped += c.dropped;
+    s.edits_applied += c.edits_applied;
+    s.edits_refused += c.edits_refused;
+  }
+  s.grids_published = q.grids_published;
+  for (const auto& [reason, n] : q.refusal_reasons) {
+    s.query_refusal_reason.push_back(reason);
+    s.query_refusal_count.push_back(n);
+  }
+  s.num_query_refusal_reasons = static_cast<int32_t>(s.query_refusal_reason.size());
+  std::vector<const QueryClientStats*> recent;
+  for (const QueryClientStats& c : q.clients) recent.push_back(&c);
+  const size_t n = std::min(recent.size(), kStatusQueryClients);
+  std::partial_sort(recent.begin(), recent.begin() + n, recent.end(),
+                    [](auto* a, auto* b) { return a->last_utime > b->last_utime; });
+  recent.resize(n);
+  std::sort(recent.begin(), recent.end(), [](auto* a, auto* b) { return a->client_id < b->client_id; });
+  for (const QueryClientStats* c : recent) s.query_clients.push_back(client_message(*c));
+  s.num_query_clients = static_cast<int32_t>(s.query_clients.size());
+}
+
+}  // namespace
 
 octomap_rt::server_status_t make_status(const StatusInputs& in) {
   octomap_rt::server_status_t s;
@@ -78,6 +131,7 @@ octomap_rt::server_status_t make_status(const StatusInputs& in) {
   s.map_path = in.map_path;
   s.queue_policy = in.queue_policy;
   s.message = in.message;
+  add_queries(s, in.queries);
   return s;
 }
 

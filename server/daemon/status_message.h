@@ -7,6 +7,7 @@
 
 #include "daemon/pipeline_metrics.h"
 #include "daemon/producer_registry.h"
+#include "daemon/query_clients.h"
 #include "octomap_rt/server_status_t.hpp"
 
 namespace ort::daemon {
@@ -30,7 +31,12 @@ struct StatusInputs {
   MetricsSnapshot metrics;
   std::vector<ProducerStats> producers;
   std::vector<int64_t> producer_queue_bytes;  // parallel to producers
+  QueryServiceStats queries;
 };
+
+// Clients listed in server_status_t.query_clients (those heard from most recently); the
+// totals count every client.
+constexpr size_t kStatusQueryClients = 64;
 
 octomap_rt::server_status_t make_status(const StatusInputs& in);
 

@@ -63,6 +63,54 @@ TEST(StatusText, LaysOutStateRatesLatenciesAndRobotsWithReasons) {
   EXPECT_NE(text.find("rejected: non-finite point 3, truncated \"x\" 2"), std::string::npos) << text;
 }
 
+octomap_rt::server_status_t with_queries() {
+  auto s = example_status();
+  s.queries_received = 1500, s.queries_answered = 1480, s.queries_bad = 2, s.queries_busy = 17;
+  s.queries_not_ready = 1, s.queries_dropped = 3, s.edits_applied = 1, s.grids_published = 9;
+  s.query_refusal_reason = {"depth # is not in #..#", "busy: the client's queue is full (--query-queue)"};
+  s.query_refusal_count = {2, 17};
+  s.num_query_refusal_reasons = 2;
+  octomap_rt::query_client_stats_t c{};
+  c.client_id = "planner1", c.reply_channel = "OCTOMAP_RT_REPLY_PLANNER1";
+  c.received = 1500, c.answered = 1480, c.bad = 2, c.busy = 17, c.not_ready = 1, c.queue_depth = 3;
+  c.last_utime = s.utime - 1'000'000, c.last_error = "depth 17 is not in 0..16";
+  s.query_clients = {c};
+  s.num_query_clients = 1;
+  return s;
+}
+
+TEST(StatusText, ShowsQueryTotalsReasonsAndClients) {
+  EXPECT_NE(format_status(example_status(), 0).find("queries   none yet"), std::string::npos);
+  const auto s = with_queries();
+  const std::string text = format_status(s, s.utime + 2'000'000);
+  EXPECT_NE(text.find("queries   received 1,500: answered 1,480, bad 2, busy 17, not ready 1; dropped 3; edits 1 "
+                      "applied, 0 refused; grids published 9"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("refused: depth # is not in #..# 2, busy: the client's queue is full (--query-queue) 17"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("planner1             1,500     1,480      2      17         1       0      3    3 s ago  "
+                      "OCTOMAP_RT_REPLY_PLANNER1"),
+            std::string::npos)
+      << text;
+}
+
+TEST(StatusJson, CarriesTheQueryCounters) {
+  const std::string json = status_json(with_queries());
+  EXPECT_NE(json.find("\"queries\":{\"received\":1500,\"answered\":1480,\"bad\":2,\"busy\":17,\"not_ready\":1,"
+                      "\"dropped\":3,\"edits_applied\":1,\"edits_refused\":0,\"grids_published\":9,"
+                      "\"refusal_reasons\":{\"depth # is not in #..#\":2,"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find("\"clients\":[{\"client_id\":\"planner1\",\"reply_channel\":\"OCTOMAP_RT_REPLY_PLANNER1\","
+                      "\"received\":1500,\"answered\":1480,\"bad\":2,\"busy\":17,\"not_ready\":1,\"dropped\":0,"
+                      "\"edits_applied\":0,\"edits_refused\":0,\"queue_depth\":3,"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find("\"last_error\":\"depth 17 is not in 0..16\"}]}"), std::string::npos) << json;
+}
+
 TEST(StatusText, NumbersForPeople) {
   EXPECT_EQ(with_commas(0), "0");
   EXPECT_EQ(with_commas(999), "999");
