@@ -24,3 +24,6 @@ octomap_rt_add_integration_test(map_serving_integration_test 600)
 octomap_rt_add_integration_test(install_integration_test 900)
 target_compile_definitions(install_integration_test PRIVATE OCTOMAP_RT_BUILD_DIR="${CMAKE_BINARY_DIR}"
                            OCTOMAP_RT_SOURCE_DIR="${CMAKE_SOURCE_DIR}")
+# Read-your-writes: a robot's query right after its scan sees that scan (issue 11).
+octomap_rt_add_integration_test(query_integration_test 300)
+target_link_libraries(query_integration_test PRIVATE octomap_rt_query_client)
