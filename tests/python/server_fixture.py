@@ -6,6 +6,7 @@ import os
 import signal
 import subprocess
 import tempfile
+import time
 import unittest
 
 import numpy as np
@@ -41,6 +42,24 @@ class ServerTestCase(unittest.TestCase):
                                        "--octomap-raw-rate", "5", "--octomap-raw-max-kib", "4096"],
                                       stdout=cls.log, stderr=subprocess.STDOUT)
         cls.client = octomap_rt.MapClient(cls.url)
+        cls.wait_until_listening()
+
+    @classmethod
+    def wait_until_listening(cls, timeout_s: float = 60.0):
+        """Returns once the server has sent a status. It sends its first one after it has
+        subscribed to the scan and service channels, so from then on nothing a test publishes
+        is lost; a scan published earlier can reach no socket and is gone without a trace."""
+        deadline = time.monotonic() + timeout_s
+        while True:
+            if cls.server.poll() is not None:
+                with open(os.path.join(cls.dir, "server.log")) as f:
+                    raise RuntimeError(f"octomap-rt-server exited with {cls.server.returncode}:\n{f.read()}")
+            try:
+                cls.client.status(timeout_s=1.0)
+                return
+            except octomap_rt.ServerTimeout:
+                if time.monotonic() > deadline:
+                    raise
 
     @classmethod
     def tearDownClass(cls):

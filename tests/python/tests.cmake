@@ -15,10 +15,8 @@ endfunction()
 if(PYTHON3 AND LCM_LOGGER)
   octomap_rt_add_python_test(python_udpm_transport_test test_udpm_transport 180)
   octomap_rt_add_python_test(python_map_client_test test_map_client 300)
-  # test_queries.py and test_map_service.py are not registered yet: written before the query and
-  # map services landed, they wait for the server's status and at times (1 run in 4 for the query
-  # test, always for the map-service test here) that wait times out after 60 s. Mending the
-  # fixture's wait is open work on issue 14; the query test passes when the wait succeeds.
+  octomap_rt_add_python_test(python_map_service_test test_map_service 300)
+  octomap_rt_add_python_test(python_queries_test test_queries 300)
 else()
   message(WARNING "octomap-rt: python3 or lcm-logger missing: the Python client tests are not registered")
 endif()

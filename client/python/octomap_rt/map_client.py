@@ -48,6 +48,7 @@ class MapClient:
     def wait_for(self, channel: str, decode, accept=lambda m: True, timeout_s: float = 5.0):
         """The first message on `channel` that decodes and that `accept` takes."""
         found = []
+        seen = [0]  # messages that decoded but `accept` refused: said in the timeout's message
 
         def take(_channel, data):
             if found:
@@ -58,6 +59,8 @@ class MapClient:
                 return
             if accept(msg):
                 found.append(msg)
+            else:
+                seen[0] += 1
 
         sub = self.transport.subscribe(channel, take)
         try:
@@ -66,6 +69,9 @@ class MapClient:
                 self.transport.handle(min(0.1, max(0.0, deadline - time.monotonic())))
         finally:
             self.transport.unsubscribe(sub)
+        if not found and seen[0]:
+            raise ServerTimeout(f"{seen[0]} messages on {channel} within {timeout_s} s at {self.transport.url}, "
+                                "none of them the one waited for")
         if not found:
             raise ServerTimeout(f"nothing on {channel} within {timeout_s} s at {self.transport.url}: "
                                 "is octomap-rt-server running with this LCM URL?")
