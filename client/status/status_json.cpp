@@ -175,8 +175,14 @@ std::string status_json(const octomap_rt::server_status_t& s) {
       .num("overlapped_scans", s.overlapped_scans)
       .num("kernel_rcvbuf_errors", s.kernel_rcvbuf_errors)
       .num("socket_rcvbuf_drops", s.socket_rcvbuf_drops)
+      .num("map_version", s.map_version)
       .num("latest_snapshot_id", s.latest_snapshot_id)
+      .num("snapshots_taken", s.snapshots_taken)
       .num("requests_served", s.requests_served)
+      .num("requests_rejected", s.requests_rejected)
+      .num("chunks_sent", s.chunks_sent)
+      .num("deltas_sent", s.deltas_sent)
+      .num("last_delta_seq", s.last_delta_seq)
       .raw("robots", robots.str())
       .raw("queries", queries_json(s));
   o << "}";

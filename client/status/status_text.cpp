@@ -56,6 +56,17 @@ void queue_and_kernel(std::ostringstream& o, const Status& s) {
     << known(s.socket_rcvbuf_drops) << " dropped on the server's sockets\n";
 }
 
+// The map service (snapshots, chunks) and the delta stream: what mirrors and map clients got.
+void serving(std::ostringstream& o, const Status& s) {
+  const std::string snapshot = s.latest_snapshot_id > 0 ? "#" + with_commas(s.latest_snapshot_id) : "none";
+  const std::string delta = s.last_delta_seq >= 0 ? "last seq " + with_commas(s.last_delta_seq) : "none yet";
+  o << fmt("  serving   map version %s, latest snapshot %s (%s taken); requests %s served, %s rejected\n",
+           with_commas(s.map_version).c_str(), snapshot.c_str(), with_commas(s.snapshots_taken).c_str(),
+           with_commas(s.requests_served).c_str(), with_commas(s.requests_rejected).c_str());
+  o << fmt("  sent      %s snapshot chunks, %s deltas (%s)\n", with_commas(s.chunks_sent).c_str(),
+           with_commas(s.deltas_sent).c_str(), delta.c_str());
+}
+
 void robots(std::ostringstream& o, const Status& s, int64_t now) {
   if (s.robots.empty()) {
     o << "\n  no robots yet (scans on OCTOMAP_RT_SCAN_<ROBOT>)\n";
@@ -156,6 +167,7 @@ std::string format_status(const Status& s, int64_t now_utime) {
   engine_and_map(o, s, now_utime);
   rates_and_latencies(o, s);
   queue_and_kernel(o, s);
+  serving(o, s);
   robots(o, s, now_utime);
   o << "\n";
   queries(o, s, now_utime);

@@ -111,6 +111,36 @@ TEST(StatusJson, CarriesTheQueryCounters) {
   EXPECT_NE(json.find("\"last_error\":\"depth 17 is not in 0..16\"}]}"), std::string::npos) << json;
 }
 
+octomap_rt::server_status_t serving() {
+  auto s = example_status();
+  s.map_version = 1236, s.latest_snapshot_id = 1230, s.snapshots_taken = 4, s.requests_served = 7;
+  s.requests_rejected = 2, s.chunks_sent = 1350, s.deltas_sent = 412, s.last_delta_seq = 411;
+  return s;
+}
+
+TEST(StatusText, ShowsTheServingCounters) {
+  auto s = example_status();
+  s.last_delta_seq = -1;
+  const std::string none = format_status(s, 0);
+  EXPECT_NE(none.find("serving   map version 0, latest snapshot none (0 taken); requests 0 served, 0 rejected\n"
+                      "  sent      0 snapshot chunks, 0 deltas (none yet)\n"),
+            std::string::npos)
+      << none;
+  const std::string text = format_status(serving(), 0);
+  EXPECT_NE(text.find("serving   map version 1,236, latest snapshot #1,230 (4 taken); requests 7 served, 2 rejected\n"
+                      "  sent      1,350 snapshot chunks, 412 deltas (last seq 411)\n"),
+            std::string::npos)
+      << text;
+}
+
+TEST(StatusJson, CarriesTheServingCounters) {
+  const std::string json = status_json(serving());
+  EXPECT_NE(json.find("\"map_version\":1236,\"latest_snapshot_id\":1230,\"snapshots_taken\":4,\"requests_served\":7,"
+                      "\"requests_rejected\":2,\"chunks_sent\":1350,\"deltas_sent\":412,\"last_delta_seq\":411"),
+            std::string::npos)
+      << json;
+}
+
 TEST(StatusText, NumbersForPeople) {
   EXPECT_EQ(with_commas(0), "0");
   EXPECT_EQ(with_commas(999), "999");
