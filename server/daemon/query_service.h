@@ -9,8 +9,9 @@
 //
 // Worker thread: clients in turn; a query waits (parked, up to its timeout) until the map
 // state is >= min_snapshot_id and the robot's wait_seq was applied (read-your-writes), then
-// is answered under a shared map lock (stage 2 keeps mapping between queries) and its
-// replies are published, each naming the map state (snapshot_id = MapState::version).
+// is answered under a shared map lock, with every other query ready then (a turn of at most
+// 10 ms: stage 2 may be waiting), and its replies are published after the lock, each naming
+// the map state (snapshot_id = MapState::version).
 // With --grid-rate, its GridPublisher also publishes the 2D grid on OCTOMAP_RT_GRID.
 #pragma once
 
@@ -52,8 +53,9 @@ class QueryService {
   // "" when client_id and reply_channel are usable for a reply.
   std::string check_addressing(const std::string& client, const std::string& channel) const;
   void run();
-  // True when answered (or refused for good); false: not ready yet and within its deadline.
-  bool try_answer(PendingQuery& q);
+  // Under the map lock (shared): true when answered or refused for good, its replies added to
+  // `out` (published after the lock is released); false: not ready yet, within its deadline.
+  bool answer_locked(PendingQuery& q, std::vector<EncodedReplies>& out);
   void publish(const EncodedReplies& r);
 
   QueryServiceConfig cfg_;
