@@ -48,10 +48,13 @@ TEST(StatusIntegration, ShowsARunningServerAsTextJsonAndWatch) {
     const char junk[16] = "not a scan_t";
     lc.publish("OCTOMAP_RT_SCAN_ALPHA", junk, sizeof junk);
   }
+  ChildProcess query({client_program(), "query", "points", "0,0,0", "1,1,1", "--client-id", "planner1", "--lcm-url", url},
+                     dir + "/query.log");
+  ASSERT_EQ(query.wait(60), 0) << query.log();
   ASSERT_TRUE(status.wait_for(
       [](const octomap_rt::server_status_t& s) {
         const auto* r = find_robot_ci(s, "alpha");
-        return r && r->scans_applied == 3 && r->scans_rejected == 1;
+        return r && r->scans_applied == 3 && r->scans_rejected == 1 && s.queries_answered == 1;
       },
       120))
       << server.log();
@@ -62,6 +65,8 @@ TEST(StatusIntegration, ShowsARunningServerAsTextJsonAndWatch) {
   EXPECT_NE(t.find("(pid " + std::to_string(server.pid()) + " on "), std::string::npos) << t;
   EXPECT_NE(t.find("back end  cpu"), std::string::npos) << t;
   EXPECT_NE(t.find("rejected: wrong fingerprint 1"), std::string::npos) << t;
+  EXPECT_NE(t.find("queries   received 1: answered 1, bad 0"), std::string::npos) << t;
+  EXPECT_NE(t.find("  planner1 "), std::string::npos) << t;
 
   ChildProcess json({client_program(), "status", "--json", "--lcm-url", url}, dir + "/json.log");
   ASSERT_EQ(json.wait(30), 0) << json.log();
@@ -70,7 +75,8 @@ TEST(StatusIntegration, ShowsARunningServerAsTextJsonAndWatch) {
       "python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); r=[r for r in s[\"robots\"] if "
       "r[\"robot_id\"].lower()==\"alpha\"][0]; assert s[\"pid\"]==int(sys.argv[2]), s; "
       "assert r[\"scans_applied\"]==3 and r[\"reject_reasons\"]=={\"wrong fingerprint\":1}, r; "
-      "assert s[\"state_name\"] in (\"RUNNING\",\"DEGRADED\"), s' " +
+      "assert s[\"state_name\"] in (\"RUNNING\",\"DEGRADED\"), s; q=s[\"queries\"]; "
+      "assert q[\"answered\"]==1 and [c[\"client_id\"] for c in q[\"clients\"]]==[\"planner1\"], q' " +
       dir + "/status.json " + std::to_string(server.pid());
   EXPECT_EQ(std::system(check.c_str()), 0) << json.log();
 
