@@ -1,7 +1,10 @@
 // `octomap-rt build INPUT -r RES -o OUT.bt|OUT.ot`: builds a map from a ScanGraph file or
 // the built-in synthetic scene, with progress, stage times and leaf counts.
 #include <chrono>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
 #include <iostream>
 
 #include "commands.h"
@@ -21,17 +24,23 @@ struct BuildArgs {
   bool quiet = false;
 };
 
+// Writes the map and checks the stream only after closing it: a full disk shows when the
+// buffered bytes are flushed, not when OctoMap's writer returns. A failed write removes the
+// partial file and is an error (the command exits non-zero).
 void write_map(const octomap::OcTree& tree, const std::string& path) {
-  bool ok = false;
-  if (path.size() > 3 && path.compare(path.size() - 3, 3, ".bt") == 0) {
-    std::ofstream out(path, std::ios::binary);
-    ok = out && tree.writeBinaryConst(out) && out.good();
-  } else if (path.size() > 3 && path.compare(path.size() - 3, 3, ".ot") == 0) {
-    ok = tree.write(path);
-  } else {
-    throw std::runtime_error("output must end in .bt (OctoMap binary) or .ot (full, with log-odds): " + path);
+  const bool bt = path.size() > 3 && path.compare(path.size() - 3, 3, ".bt") == 0;
+  const bool ot = path.size() > 3 && path.compare(path.size() - 3, 3, ".ot") == 0;
+  if (!bt && !ot) throw std::runtime_error("output must end in .bt (OctoMap binary) or .ot (full, with log-odds): " + path);
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw std::runtime_error("cannot create " + path + ": " + std::strerror(errno));
+  const bool written = bt ? tree.writeBinaryConst(out) : tree.write(out);
+  errno = 0;
+  out.close();
+  if (!written || out.fail()) {
+    const std::string why = errno ? std::strerror(errno) : "write failed";
+    std::remove(path.c_str());
+    throw std::runtime_error("could not write the map to " + path + ": " + why + " (disk full?); nothing was written");
   }
-  if (!ok) throw std::runtime_error("could not write map to " + path);
 }
 
 int run_build(const BuildArgs& a) {
@@ -52,14 +61,17 @@ int run_build(const BuildArgs& a) {
   StageTimes total;
   PrepareReport prep_total;
   uint64_t voxels = 0, windows = 0;
+  size_t rejected = 0;
   const auto t0 = std::chrono::steady_clock::now();
   for (size_t i = 0; i < set.scans.size(); ++i) {
     const PosedScan& scan = set.scans[i];
     std::span<const octomap::point3d> pts(scan.points.size() ? &scan.points[0] : nullptr, scan.points.size());
     ShotScan shot;  // sensor-frame points: transformed on the GPU where the back end prepares there
     engine.insert_posed(scan.pose, sensor_origin(scan), pts, *tree, shot);
-    if (!shot.prepare.origin_ok) {
-      std::cerr << "  scan " << i << " rejected: " << shot.prepare.error << "\n";
+    if (!shot.prepare.origin_ok || shot.refusal != ShotRefusal::kNone) {
+      ++rejected;
+      std::cerr << "  scan " << i << " rejected: "
+                << (shot.prepare.origin_ok ? shot.refusal_detail : shot.prepare.error) << "\n";
       continue;
     }
     total.add(shot.shoot.times);
@@ -87,7 +99,17 @@ int run_build(const BuildArgs& a) {
   std::printf("  skipped points:  %llu non-finite, %llu outside the key range; %llu rays cut at max range\n",
               (unsigned long long)prep_total.nonfinite, (unsigned long long)prep_total.out_of_range,
               (unsigned long long)prep_total.cut_at_max_range);
-  if (prep_total.out_of_range)
+  if (rejected > 0 && rejected == set.scans.size())
+    std::fprintf(stderr,
+                 "octomap-rt build: warning: every scan was rejected (see above; the key range is +-%g m at -r %g): "
+                 "the map is empty; is the resolution right?\n",
+                 32768 * opts.resolution, opts.resolution);
+  else if (prep_total.out_of_range && prep_total.out_of_range == prep_total.points_in - prep_total.nonfinite)
+    std::fprintf(stderr,
+                 "octomap-rt build: warning: every point lies outside the map's key range (+-%g m at -r %g): the map "
+                 "is empty; is the resolution right?\n",
+                 32768 * opts.resolution, opts.resolution);
+  else if (prep_total.out_of_range)
     std::fprintf(stderr, "octomap-rt build: warning: %llu points lie outside the map's key range (+-%.1f m) and were skipped\n",
                  (unsigned long long)prep_total.out_of_range, 32768 * opts.resolution);
   std::printf("  stage times:     prepare %.1f ms, upload %.1f ms, shoot %.1f ms, compact+readback %.1f ms, octree %.1f ms\n",

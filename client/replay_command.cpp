@@ -33,7 +33,8 @@ using Clock = std::chrono::steady_clock;
 struct ReplayArgs {
   std::string input;
   std::string robot;
-  double rate = 2.0;        // scans/s; <= 0: as fast as publishing goes
+  double rate = 2.0;        // scans/s (finite, > 0)
+  bool unpaced = false;     // as fast as publishing goes
   bool rate_given = false;  // logs: --rate replaces the recorded timing
   double speed = 1.0;       // logs: playback speed factor on the recorded timing
   std::string lcm_url;
@@ -111,7 +112,7 @@ int replay_scan_set(const ReplayArgs& a, lcm::LCM& lc) {
   f.frame = a.points_frame == "map" ? PointsFrame::kMap : PointsFrame::kSensor;
   f.stride = a.decimate;
 
-  Pacer pacer(a.rate > 0 ? 1.0 / a.rate : 0.0);
+  Pacer pacer(a.unpaced ? 0.0 : 1.0 / a.rate);
   ProgressBar bar("replay " + a.robot, order.size(), !a.quiet);
   ReplayTotals t;
   std::vector<uint8_t> buf;
@@ -158,8 +159,8 @@ int replay_log(const ReplayArgs& a, lcm::LCM& lc) {
   const size_t total = picked.size() * a.sel.repeat;
   const std::string out_channel = a.robot.empty() ? "" : scan_channel(a.channel_prefix, a.robot);
 
-  const bool by_rate = a.rate_given;
-  Pacer pacer(by_rate && a.rate > 0 ? 1.0 / a.rate : 0.0);
+  const bool by_rate = a.rate_given || a.unpaced;
+  Pacer pacer(by_rate && !a.unpaced ? 1.0 / a.rate : 0.0);
   ProgressBar bar("replay " + (a.robot.empty() ? std::string("log") : a.robot), total, !a.quiet);
   ReplayTotals t;
   size_t skipped = 0, undecodable = 0;
@@ -200,7 +201,7 @@ int replay_log(const ReplayArgs& a, lcm::LCM& lc) {
           first_ts = e.timestamp;
           pass_start = Clock::now();
         }
-        const double offset_s = (e.timestamp - first_ts) / 1e6 / (a.speed > 0 ? a.speed : 1.0);
+        const double offset_s = (e.timestamp - first_ts) / 1e6 / a.speed;
         std::this_thread::sleep_until(pass_start + std::chrono::duration_cast<Clock::duration>(
                                                        std::chrono::duration<double>(offset_s)));
       }
@@ -222,7 +223,20 @@ int replay_log(const ReplayArgs& a, lcm::LCM& lc) {
   return t.publish_errors ? 1 : 0;
 }
 
+// Rates, speeds and ranges are refused unless they mean something: NaN, infinities and
+// rates <= 0 used to be accepted silently.
+void check_numbers(const ReplayArgs& a) {
+  if (!(std::isfinite(a.rate) && a.rate > 0 && a.rate <= 1e6))
+    throw CLI::ValidationError("--rate", "must be a number of scans per second in (0, 1e6] (--unpaced: no pacing)");
+  if (!(std::isfinite(a.speed) && a.speed > 0 && a.speed <= 1e6))
+    throw CLI::ValidationError("--speed", "must be a factor in (0, 1e6]");
+  if (!std::isfinite(a.max_range)) throw CLI::ValidationError("--max-range", "must be a finite number of metres");
+  if (!(std::isfinite(a.wait_for_server_s) && a.wait_for_server_s >= 0))
+    throw CLI::ValidationError("--wait-for-server", "must be a number of seconds >= 0");
+}
+
 int run_replay(ReplayArgs a) {
+  check_numbers(a);
   if (!a.part.empty()) {
     if (std::string why = parse_part(a.part, a.sel); !why.empty()) throw CLI::ValidationError("--part", why);
   }
@@ -262,8 +276,9 @@ void register_replay_command(CLI::App& app) {
   cmd->add_option("--robot", args->robot,
                   "robot id: publishes on <channel-prefix><ROBOT> (required, except for logs, whose scans "
                   "keep their robots unless this renames them)");
-  auto* rate = cmd->add_option("--rate", args->rate, "scans per second; <= 0: unpaced (logs: recorded timing unless set)")
+  auto* rate = cmd->add_option("--rate", args->rate, "scans per second, > 0 (logs: recorded timing unless set)")
                    ->capture_default_str();
+  cmd->add_flag("--unpaced", args->unpaced, "publish as fast as possible (no pacing)");
   cmd->add_option("--speed", args->speed, "logs: speed factor on the recorded timing")->capture_default_str();
   cmd->add_option("--lcm-url", args->lcm_url,
                   std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + octomap_rt::wire::kDefaultLcmUrl + ")");

@@ -1,11 +1,14 @@
 #include "scene/scan_set.h"
 
 #include <fstream>
+#include <iterator>
 #include <stdexcept>
 
 #include <octomap/ScanGraph.h>
 
 #include "core/map_frame.h"
+#include "core/memory_stream.h"
+#include "core/scan_graph_check.h"
 
 namespace ort {
 
@@ -15,22 +18,35 @@ size_t ScanSet::total_points() const {
   return n;
 }
 
-ScanSet load_scan_graph(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot open scan graph '" + path + "'");
-  octomap::ScanGraph graph;
-  graph.readBinary(in);
-  if (!in && !in.eof()) throw std::runtime_error("'" + path + "' is not a readable OctoMap ScanGraph");
-  if (graph.size() == 0) throw std::runtime_error("'" + path + "' holds no scans");
+ScanSet parse_scan_graph(std::string_view bytes, const std::string& name) {
+  // OctoMap's reader asserts on a short cloud and trusts the scan count (see
+  // core/scan_graph_check.h): the layout is checked first, then OctoMap reads each scan.
+  const ScanGraphCheck check = check_scan_graph(bytes);
+  if (!check.ok) throw std::runtime_error("'" + name + "' is not a valid OctoMap ScanGraph: " + check.error);
+  if (check.scans == 0) throw std::runtime_error("'" + name + "' holds no scans");
+  MemoryStream in(bytes);
+  uint32_t count = 0;
+  in.read(reinterpret_cast<char*>(&count), sizeof count);
   ScanSet set;
-  set.name = path;
-  for (auto it = graph.begin(); it != graph.end(); ++it) {
+  set.name = name;
+  for (uint32_t i = 0; i < count; ++i) {
+    octomap::ScanNode node;
+    node.readBinary(in);
+    if (!in) throw std::runtime_error("'" + name + "': OctoMap could not read scan " + std::to_string(i));
     PosedScan s;
-    s.pose = (*it)->pose;
-    s.points = *(*it)->scan;
+    s.pose = node.pose;
+    s.points = std::move(*node.scan);
     set.scans.push_back(std::move(s));
   }
   return set;
+}
+
+ScanSet load_scan_graph(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot open scan graph '" + path + "'");
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw std::runtime_error("cannot read scan graph '" + path + "'");
+  return parse_scan_graph(bytes, path);
 }
 
 void save_scan_graph(const ScanSet& set, const std::string& path) {
@@ -39,6 +55,7 @@ void save_scan_graph(const ScanSet& set, const std::string& path) {
   std::ofstream out(path, std::ios::binary);
   if (!out) throw std::runtime_error("cannot write '" + path + "'");
   graph.writeBinary(out);
+  out.close();  // flushes: a full disk shows here
   if (!out) throw std::runtime_error("write to '" + path + "' failed");
 }
 

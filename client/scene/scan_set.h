@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <octomap/Pointcloud.h>
@@ -21,8 +22,11 @@ struct ScanSet {
   size_t total_points() const;
 };
 
-// Reads an OctoMap ScanGraph (.graph, binary). Throws std::runtime_error with the reason.
+// Reads an OctoMap ScanGraph (.graph, binary). Throws std::runtime_error with the reason
+// (truncated and inconsistent files included: they are checked before OctoMap reads them).
 ScanSet load_scan_graph(const std::string& path);
+// The same on a whole file in memory; `name` is for messages.
+ScanSet parse_scan_graph(std::string_view bytes, const std::string& name);
 // Writes one (ScanGraph binary, no edges).
 void save_scan_graph(const ScanSet& set, const std::string& path);
 

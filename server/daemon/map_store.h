@@ -1,12 +1,15 @@
-// The map on disk: loading a .ot at start (refusing another resolution) and atomic saves.
+// The map on disk: loading a .ot at start (checked whole, refusing another resolution),
+// atomic saves, and the start-up check that saves can succeed.
 //
 // A save never leaves a half-written map under the map's name: the bytes go to FILE.tmp,
 // which is fsynced, renamed over FILE (rename is atomic on POSIX file systems), and then the
 // directory is fsynced so the rename itself survives a power cut. A crash at any point leaves
-// either the previous complete file or the new complete file.
+// either the previous complete file or the new complete file. A save that fails removes its
+// FILE.tmp (a full disk stays no fuller than before).
 #pragma once
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 
@@ -14,14 +17,50 @@
 
 namespace ort::daemon {
 
+// Every failure of the map store says what failed (kind) and why (message, with the path
+// and the system's reason).
+class MapStoreError : public std::runtime_error {
+ public:
+  enum class Kind {
+    kOpen,            // the file cannot be opened
+    kRead,            // reading it failed
+    kCorrupt,         // not a complete OctoMap .ot file (truncated, overwritten, inconsistent)
+    kWrongType,       // an OctoMap file, but not an OcTree
+    kWrongResolution, // an OcTree of another resolution than the server's
+    kWrite,           // creating or writing the temporary file failed (e.g. disk full)
+    kSync,            // fsync of the file or its directory failed
+    kRename,          // the atomic rename failed
+    kNotWritable,     // the start-up probe could not write and sync in the map's directory
+    kSerialize,       // OctoMap could not serialize the map
+  };
+  MapStoreError(Kind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
+  Kind kind() const { return kind_; }
+
+ private:
+  Kind kind_;
+};
+
+const char* to_string(MapStoreError::Kind kind);
+
 // OctoMap's full format (.ot: AbstractOcTree::write, with log-odds) in memory.
 std::string serialize_map(const octomap::OcTree& tree);
 
-// Reads a .ot file. Throws std::runtime_error when it is missing, unreadable, not an OcTree,
-// or its resolution differs from `resolution` (the message names both).
+// Reads a .ot file whole, checks it (core/octree_file_check.h: header, node stream to the
+// last byte, node count against the header) and only then lets OctoMap read it. Throws
+// MapStoreError: kOpen/kRead, kCorrupt, kWrongType, kWrongResolution (naming both values).
 std::unique_ptr<octomap::OcTree> load_map(const std::string& path, double resolution);
 
-// Writes `bytes` to `path` atomically (see above). Throws std::runtime_error with errno text.
+// Renames `path` to `path`.corrupt-<UTC time> so a new map can start without losing it;
+// returns the new name. Throws MapStoreError(kRename).
+std::string move_map_aside(const std::string& path);
+
+// Proves at start that saves to `map_path` can succeed: writes, fsyncs and removes a probe
+// file in its directory, and removes a FILE.tmp left by an interrupted save. Throws
+// MapStoreError(kNotWritable) saying why (read-only, missing directory, disk full, ...).
+void check_map_directory_writable(const std::string& map_path);
+
+// Writes `bytes` to `path` atomically (see above). Throws MapStoreError (kWrite, kSync,
+// kRename) with errno text; FILE.tmp is gone afterwards whatever happened.
 void write_file_atomically(const std::string& path, std::string_view bytes);
 
 }  // namespace ort::daemon

@@ -39,7 +39,7 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM& shared, std::ost
 MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ostream& log)
     : cfg_(cfg),
       log_(log),
-      producers_(literal_prefix(cfg.scan_channels), cfg.max_producers),
+      producers_(literal_prefix(cfg.scan_channels), producer_policy(cfg)),
       queue_(queue_budget(cfg), 8 * queue_budget(cfg)) {
   start_ = std::chrono::steady_clock::now();
   start_utime_ = now_utime();
@@ -74,10 +74,32 @@ MappingServer::~MappingServer() {
   }
 }
 
+// A map that is not complete is never loaded (and so never overwritten by a smaller one):
+// the server refuses to start, or with --move-corrupt-map-aside keeps it under another name
+// and starts anew.
+std::unique_ptr<octomap::OcTree> MappingServer::load_checked_map() {
+  try {
+    return load_map(cfg_.map_path, cfg_.engine.resolution);
+  } catch (const MapStoreError& e) {
+    if (e.kind() != MapStoreError::Kind::kCorrupt) throw;
+    if (!cfg_.move_corrupt_map_aside)
+      throw MapStoreError(e.kind(), std::string(e.what()) +
+                                        "; the file is left as it is (start with --move-corrupt-map-aside to keep it "
+                                        "under another name and start a new map)");
+    const std::string aside = move_map_aside(cfg_.map_path);
+    if (std::filesystem::exists(cfg_.map_path + ".order")) std::filesystem::rename(cfg_.map_path + ".order", aside + ".order");
+    log_ << "octomap-rt-server: warning: " << e.what() << "; moved it to " << aside << " and starting a new map\n";
+    return nullptr;
+  }
+}
+
 void MappingServer::load_or_create_map() {
   const double res = cfg_.engine.resolution;
-  if (!cfg_.map_path.empty() && std::filesystem::exists(cfg_.map_path)) {
-    map_.tree = load_map(cfg_.map_path, res);
+  if (!cfg_.map_path.empty()) check_map_directory_writable(cfg_.map_path);
+  std::unique_ptr<octomap::OcTree> loaded;
+  if (!cfg_.map_path.empty() && std::filesystem::exists(cfg_.map_path)) loaded = load_checked_map();
+  if (loaded) {
+    map_.tree = std::move(loaded);
     apply_sensor_model(*map_.tree, cfg_.engine.sensor);
     std::vector<AppliedEntry> previous;
     const std::string order_path = cfg_.map_path + ".order";
@@ -108,7 +130,8 @@ void MappingServer::start() {
   limits.max_points = cfg_.max_points;
   limits.resolution = cfg_.engine.resolution;
   open_map_serving();  // the delta observer is in place before the first scan is applied
-  pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, cfg_.pipeline);
+  pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, cfg_.pipeline,
+                                             std::chrono::duration<double>(cfg_.latency_bound_s));
   pipeline_->start();
   intake_ = std::make_unique<ScanIntake>(*loop_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
   intake_->open();  // services subscribe before the loop starts: 1.3.1's subscribe races with handle
@@ -157,12 +180,13 @@ void MappingServer::open_map_serving() {
                                               log_);
 }
 
-void MappingServer::stop() {
-  if (!started_ || stopped_) return;
+bool MappingServer::stop() {
+  if (!started_ || stopped_) return final_save_error_.empty();
   stopped_ = true;
   set_state(Status::STATE_STOPPING, "stopping: intake closed, draining queued scans");
   intake_->close();
   queue_.close();
+  drain_until_deadline();
   pipeline_->join();
   if (deltas_) deltas_->stop();  // sends the last change set
   map_.observer = nullptr;
@@ -174,9 +198,16 @@ void MappingServer::stop() {
   if (save_thread_.joinable()) save_thread_.join();
   if (!cfg_.map_path.empty()) {
     set_state(Status::STATE_STOPPING, "stopping: saving the map");
-    save(true);
+    // Nothing may throw before the threads below are joined: a failed final save is
+    // reported (log, summary, status, exit status), not thrown.
+    try {
+      save(true);
+    } catch (const std::exception& e) {
+      final_save_error_ = e.what();
+      log_ << "octomap-rt-server: error: the final save failed (the previous map file is intact): " << e.what() << "\n";
+    }
   }
-  set_state(Status::STATE_STOPPING, "stopped");
+  set_state(Status::STATE_STOPPING, final_save_error_.empty() ? "stopped" : "stopped; the final save failed: " + final_save_error_);
   {
     std::lock_guard lock(state_mutex_);
     status_exit_ = true;
@@ -187,6 +218,21 @@ void MappingServer::stop() {
   map_service_->stop();
   if (queries_) queries_->stop();
   loop_->stop();
+  return final_save_error_.empty();
+}
+
+// The bounded drain: queued scans go through the pipeline until the queue is empty or the
+// deadline passes; what is still queued then is dropped, counted ("left at shutdown").
+// Scans already in the pipeline (at most two) are finished either way.
+void MappingServer::drain_until_deadline() {
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(std::max(0.0, cfg_.drain_timeout_s)));
+  while (queue_.depth() > 0 && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const std::vector<QueuedScan> left = queue_.take_all();
+  for (const QueuedScan& s : left) producers_.count_dropped_in_flight(s.producer, Reject::kLeftAtShutdown);
+  if (!left.empty())
+    log_ << "octomap-rt-server: drain deadline (" << cfg_.drain_timeout_s << " s) passed: " << left.size()
+         << " queued scans dropped (left at shutdown); saving the map as applied\n";
 }
 
 void MappingServer::set_state(int8_t state, std::string message) {
@@ -226,12 +272,15 @@ void MappingServer::run_save_loop() {
   while (!stopping_) {
     if (wake_.wait_for(lock, period, [&] { return stopping_; })) break;
     lock.unlock();
+    std::string error;
     try {
       save(false);
     } catch (const std::exception& e) {
-      log_ << "octomap-rt-server: save failed (the previous map file is intact): " << e.what() << "\n";
+      error = e.what();
+      log_ << "octomap-rt-server: save failed (the previous map file is intact): " << error << "\n";
     }
     lock.lock();
+    last_save_error_ = error;  // the status is DEGRADED while it is set
   }
 }
 
@@ -271,19 +320,27 @@ StatusInputs MappingServer::gather_status() {
     // size() is O(1); the leaf count (and memoryUsage(), which needs it) walks the whole
     // tree under the map lock, stalling stage 2. So on big maps it is refreshed at most
     // every 10 s and memory is computed from the cached leaf count with OctoMap's formula.
-    std::shared_lock lock(map_.mutex);
-    const octomap::OcTree& t = *map_.tree;
-    const auto now = std::chrono::steady_clock::now();
-    if (t.size() <= 1'000'000 || now - leaves_time_ > std::chrono::seconds(10)) {
-      cached_leaves_ = t.getNumLeafNodes();
-      leaves_time_ = now;
+    // The status never waits long for the map lock: a stage stuck while holding it must
+    // still be reported (DEGRADED), so after ~100 ms the last figures are used again.
+    std::shared_lock lock(map_.mutex, std::defer_lock);
+    for (int i = 0; i < 100 && !lock.try_lock(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    if (lock.owns_lock()) {
+      const octomap::OcTree& t = *map_.tree;
+      const auto now = std::chrono::steady_clock::now();
+      if (t.size() <= 1'000'000 || now - leaves_time_ > std::chrono::seconds(10)) {
+        cached_leaves_ = t.getNumLeafNodes();
+        leaves_time_ = now;
+      }
+      const size_t leaves = std::min(cached_leaves_.load(), t.size());
+      cached_nodes_ = static_cast<int64_t>(t.size());
+      cached_version_ = static_cast<int64_t>(map_.version);
+      cached_memory_ = static_cast<int64_t>(sizeof(octomap::OcTree) + t.memoryUsageNode() * t.size() +
+                                            (t.size() - leaves) * sizeof(octomap::OcTreeNode* [8]));
     }
-    const size_t leaves = std::min(cached_leaves_, t.size());
-    in.num_nodes = static_cast<int64_t>(t.size());
-    in.map_version = static_cast<int64_t>(map_.version);
-    in.num_leaf_nodes = static_cast<int64_t>(leaves);
-    in.memory_bytes = static_cast<int64_t>(sizeof(octomap::OcTree) + t.memoryUsageNode() * t.size() +
-                                           (t.size() - leaves) * sizeof(octomap::OcTreeNode* [8]));
+    in.map_version = cached_version_;
+    in.num_nodes = cached_nodes_;
+    in.num_leaf_nodes = static_cast<int64_t>(std::min<size_t>(cached_leaves_.load(), static_cast<size_t>(cached_nodes_.load())));
+    in.memory_bytes = cached_memory_;
   }
   in.queue_depth = static_cast<int32_t>(queue_.depth());
   in.queue_bytes = static_cast<int64_t>(queue_.bytes());
@@ -322,37 +379,21 @@ octomap_rt::server_status_t MappingServer::status() { return make_status(gather_
 
 void MappingServer::publish_status() {
   StatusInputs in = gather_status();
-  // Running <-> degraded: degraded while the last period saw drops, rejections or kernel
-  // UDP receive-buffer drops; the message says which.
-  int64_t drops = 0, rejects = 0;
-  for (const ProducerStats& p : in.producers) {
-    drops += p.dropped;
-    rejects += p.rejected;
-  }
-  std::ostringstream why;
-  if (drops > last_drops_) why << (drops - last_drops_) << " scans dropped (queue full); ";
-  if (rejects > last_rejects_) why << (rejects - last_rejects_) << " scans rejected; ";
-  // The server's own socket drops when known (the namespace-wide count includes clients).
-  const int64_t kernel = in.socket_rcvbuf_drops >= 0 ? in.socket_rcvbuf_drops : in.kernel_rcvbuf_errors;
-  if (last_kernel_errors_ >= 0 && kernel > last_kernel_errors_)
-    why << (kernel - last_kernel_errors_) << " UDP datagrams dropped by the kernel on the server's socket (receive buffer full); ";
-  last_drops_ = drops;
-  last_rejects_ = rejects;
-  last_kernel_errors_ = kernel;
+  const std::string why = degraded_causes(in);
   {
     std::lock_guard lock(state_mutex_);
     if (loop_->failed()) {
       state_ = Status::STATE_ERROR;
       message_ = "LCM intake failed; no scans are received";
-    } else if (state_ == Status::STATE_RUNNING && !why.str().empty()) {
+    } else if (state_ == Status::STATE_RUNNING && !why.empty()) {
       state_ = Status::STATE_DEGRADED;
-      message_ = "degraded: " + why.str();
+      message_ = "degraded: " + why;
     } else if (state_ == Status::STATE_DEGRADED) {
-      if (why.str().empty()) {
+      if (why.empty()) {
         state_ = Status::STATE_RUNNING;
         message_ = "serving " + cfg_.scan_channels;
       } else {
-        message_ = "degraded: " + why.str();
+        message_ = "degraded: " + why;
       }
     }
     in.state = state_;
@@ -365,6 +406,40 @@ void MappingServer::publish_status() {
   loop_->publish(cfg_.status_channel, msg);
 }
 
+// Why the server is DEGRADED now ("" when it is not): trouble in the last status period
+// (drops, rejections, kernel UDP drops) and trouble that lasts (a failing save, a stage
+// stuck on one scan, a queue over its bound, latency over its bound).
+std::string MappingServer::degraded_causes(const StatusInputs& in) {
+  int64_t drops = 0, rejects = 0;
+  for (const ProducerStats& p : in.producers) {
+    drops += p.dropped;
+    rejects += p.rejected;
+  }
+  std::ostringstream why;
+  {
+    std::lock_guard lock(state_mutex_);
+    if (!last_save_error_.empty()) why << "save failing (" << last_save_error_ << "); ";
+  }
+  const double busy_s = pipeline_ ? std::chrono::duration<double>(pipeline_->longest_busy()).count() : 0.0;
+  if (cfg_.stuck_stage_s > 0 && busy_s > cfg_.stuck_stage_s)
+    why << "stage stuck (" << static_cast<int>(busy_s) << " s on one scan); ";
+  const double age_s = std::chrono::duration<double>(queue_.oldest_age()).count();
+  if (queue_.bytes() > queue_.total_budget() * 9 / 10 || (cfg_.latency_bound_s > 0 && age_s > cfg_.latency_bound_s))
+    why << "queue over its bound (" << (queue_.bytes() >> 20) << " MiB, oldest " << age_s << " s); ";
+  if (cfg_.latency_bound_s > 0 && in.metrics.e2e_p99 > cfg_.latency_bound_s * 1000.0)
+    why << "latency over its bound (p99 " << in.metrics.e2e_p99 / 1000.0 << " s > " << cfg_.latency_bound_s << " s); ";
+  if (drops > last_drops_) why << (drops - last_drops_) << " scans dropped; ";
+  if (rejects > last_rejects_) why << (rejects - last_rejects_) << " scans rejected; ";
+  // The server's own socket drops when known (the namespace-wide count includes clients).
+  const int64_t kernel = in.socket_rcvbuf_drops >= 0 ? in.socket_rcvbuf_drops : in.kernel_rcvbuf_errors;
+  if (last_kernel_errors_ >= 0 && kernel > last_kernel_errors_)
+    why << (kernel - last_kernel_errors_) << " UDP datagrams dropped by the kernel on the server's socket (receive buffer full); ";
+  last_drops_ = drops;
+  last_rejects_ = rejects;
+  last_kernel_errors_ = kernel;
+  return why.str();
+}
+
 void MappingServer::print_summary(std::ostream& out) {
   RunSummaryInputs in;
   in.status = gather_status();
@@ -375,6 +450,7 @@ void MappingServer::print_summary(std::ostream& out) {
   if (map_service_) in.map_service = map_service_->stats();
   if (deltas_) in.deltas = deltas_->stats();
   in.deltas_on = deltas_ != nullptr;
+  in.final_save_error = final_save_error_;
   print_run_summary(out, in);
   print_query_summary(out, query_stats());
 }

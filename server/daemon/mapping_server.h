@@ -44,8 +44,11 @@ class MappingServer {
   ~MappingServer();
 
   void start();
-  // Intake off, queue drained through the pipeline, final save and status. Idempotent.
-  void stop();
+  // Intake off, queued scans applied for at most drain_timeout_s (the rest dropped: "left at
+  // shutdown"), final save and status. Never throws; idempotent. Returns false when the
+  // final save failed (final_save_error() says why; the summary prints it too).
+  bool stop();
+  const std::string& final_save_error() const { return final_save_error_; }
 
   // Saves now if the map changed since the last save (or `force`). Thread-safe.
   void save(bool force = false);
@@ -70,9 +73,12 @@ class MappingServer {
   MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ostream& log);
   void load_or_create_map();
   void open_map_serving();
+  void drain_until_deadline();
+  std::unique_ptr<octomap::OcTree> load_checked_map();  // nullptr: moved aside, start anew
   void set_state(int8_t state, std::string message);
   StatusInputs gather_status();
   void publish_status();
+  std::string degraded_causes(const StatusInputs& in);
   void run_status_loop();
   void run_save_loop();
 
@@ -102,7 +108,9 @@ class MappingServer {
   std::string message_;
   bool state_changed_ = false, stopping_ = false, status_exit_ = false, started_ = false, stopped_ = false;
   int64_t status_seq_ = 0;
-  size_t cached_leaves_ = 0;                  // map's leaf count (under the map lock)
+  // The last map figures read under the map lock (atomic: read without it when the lock is busy).
+  std::atomic<size_t> cached_leaves_{0};
+  std::atomic<int64_t> cached_nodes_{0}, cached_memory_{0}, cached_version_{0};
   std::chrono::steady_clock::time_point leaves_time_;
   int64_t last_drops_ = 0, last_kernel_errors_ = -1, last_rejects_ = 0;
   std::thread status_thread_, save_thread_;
@@ -111,6 +119,8 @@ class MappingServer {
   uint64_t saved_version_ = UINT64_MAX;
   std::atomic<int64_t> saves_{0}, last_save_utime_{0};
   double max_save_lock_ms_ = 0, last_save_ms_ = 0;
+  std::string final_save_error_;              // "" unless the save at stop failed
+  std::string last_save_error_;               // "" unless the latest periodic save failed (under state_mutex_)
 };
 
 }  // namespace ort::daemon

@@ -25,7 +25,13 @@ const char* to_string(Reject r) {
     case Reject::kRobotIdMismatch: return "robot id does not match channel";
     case Reject::kOriginOutsideMap: return "origin outside map";
     case Reject::kTooManyProducers: return "too many producers";
+    case Reject::kRobotNotAllowed: return "robot not allowed";
     case Reject::kEngineError: return "engine error";
+    case Reject::kRayTooLong: return "ray too long";
+    case Reject::kTooMuchWork: return "too much work";
+    case Reject::kQueueFull: return "queue full";
+    case Reject::kOverLatencyBound: return "over latency bound";
+    case Reject::kLeftAtShutdown: return "left at shutdown";
     case Reject::kCount_: break;
   }
   return "unknown";

@@ -1,6 +1,6 @@
 // Why a scan message was not integrated. Every message on a scan channel ends as applied,
-// dropped (queue over budget) or rejected with exactly one of these reasons; the names are
-// what status messages, logs and tests show.
+// rejected (invalid) or dropped (valid, but not applied: queue full, ...) with exactly one
+// of these reasons; the names are what status messages, logs and tests show.
 #pragma once
 
 #include <cstddef>
@@ -32,7 +32,14 @@ enum class Reject {
   kRobotIdMismatch,     // robot_id differs from the channel's suffix
   kOriginOutsideMap,    // sensor origin outside the map's key range (OctoMap skips the scan)
   kTooManyProducers,    // more scan channels than --max-producers
+  kRobotNotAllowed,     // the channel's robot is not on the --allow-robot list
   kEngineError,         // the engine threw while shooting or applying this scan
+  kRayTooLong,          // a ray's walk is longer than OctoMap's KeyRay holds (points km away at fine -r)
+  kTooMuchWork,         // the scan's ray walks exceed the per-scan work bound (--max-scan-work)
+  // Why a valid scan was dropped (counted as dropped, not rejected).
+  kQueueFull,           // the producer's queue budget was full on arrival
+  kOverLatencyBound,    // waited in the queue longer than --max-queue-age (overload shedding)
+  kLeftAtShutdown,      // still queued when the drain deadline passed at stop
   kCount_
 };
 

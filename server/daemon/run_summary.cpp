@@ -21,6 +21,11 @@ void print_producers(std::ostream& out, const StatusInputs& s) {
       if (p.rejects[k]) reasons += std::string(reasons.empty() ? "" : ", ") + to_string(static_cast<Reject>(k)) + " " +
                                    std::to_string(p.rejects[k]);
     if (!reasons.empty()) out << "      rejected: " << reasons << "\n";
+    std::string drops;
+    for (size_t k = 0; k < kRejectReasonCount; ++k)
+      if (p.drop_reasons[k]) drops += std::string(drops.empty() ? "" : ", ") + to_string(static_cast<Reject>(k)) + " " +
+                                      std::to_string(p.drop_reasons[k]);
+    if (!drops.empty()) out << "      dropped: " << drops << "\n";
   }
 }
 
@@ -52,6 +57,8 @@ void print_files(std::ostream& out, const RunSummaryInputs& in) {
   } else {
     out << "  map file:     none (no --map given: the map was not saved)\n";
   }
+  if (!in.final_save_error.empty())
+    out << "  FINAL SAVE FAILED: " << in.final_save_error << " (the map file holds the last successful save)\n";
   if (!in.applied_log.empty()) out << "  applied log:  " << in.applied_log << "\n";
 }
 

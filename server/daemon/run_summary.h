@@ -20,6 +20,7 @@ struct RunSummaryInputs {
   MapServiceStats map_service;
   DeltaStats deltas;
   bool deltas_on = false;
+  std::string final_save_error;    // "": the final save worked (or there was none)
 };
 
 void print_run_summary(std::ostream& out, const RunSummaryInputs& in);

@@ -32,7 +32,7 @@ void ScanIntake::close() {
 void ScanIntake::on_message(const lcm::ReceiveBuffer& rbuf, const std::string& channel) {
   const size_t producer = producers_.producer_for(channel);
   if (producers_.is_overflow(producer)) {
-    producers_.count_rejected_arrival(producer, Reject::kTooManyProducers);
+    producers_.count_rejected_arrival(producer, producers_.refusal(producer));
     return;
   }
   const auto received = Clock::now();

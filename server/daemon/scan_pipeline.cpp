@@ -1,5 +1,6 @@
 #include "daemon/scan_pipeline.h"
 
+#include <algorithm>
 #include <cctype>
 #include <iostream>
 
@@ -15,8 +16,34 @@ std::string lower_case(std::string s) {
 }  // namespace
 
 ScanPipeline::ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, ProducerRegistry& producers,
-                           PipelineMetrics& metrics, bool pipelined)
-    : engine_(engine), map_(map), queue_(queue), producers_(producers), metrics_(metrics), pipelined_(pipelined) {}
+                           PipelineMetrics& metrics, bool pipelined, std::chrono::duration<double> max_queue_age)
+    : engine_(engine),
+      map_(map),
+      queue_(queue),
+      producers_(producers),
+      metrics_(metrics),
+      pipelined_(pipelined),
+      max_queue_age_(max_queue_age) {}
+
+void ScanPipeline::set_busy(int stage, bool busy) {
+  busy_since_ns_[stage] = busy ? std::max<int64_t>(1, Clock::now().time_since_epoch().count()) : 0;
+}
+
+Clock::duration ScanPipeline::longest_busy(Clock::time_point now) const {
+  Clock::duration longest = Clock::duration::zero();
+  for (const auto& since : busy_since_ns_) {
+    const int64_t t = since;
+    if (t) longest = std::max(longest, now - Clock::time_point(Clock::duration(t)));
+  }
+  return longest;
+}
+
+bool ScanPipeline::shed_if_stale(const QueuedScan& item) {
+  if (max_queue_age_.count() <= 0 || Clock::now() - item.received <= max_queue_age_) return false;
+  producers_.count_dropped_in_flight(item.producer, Reject::kOverLatencyBound);
+  shed_++;
+  return true;
+}
 
 ScanPipeline::~ScanPipeline() {
   queue_.close();
@@ -47,6 +74,7 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
     job.edit = std::move(item.edit);
     return true;
   }
+  set_busy(0, true);
   const double token = metrics_.overlap().begin(0);
   const auto t0 = Clock::now();
   bool ok = true;
@@ -62,12 +90,16 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
     if (!job.shot.prepare.origin_ok) {
       reject(item.producer, Reject::kOriginOutsideMap, "");
       ok = false;
+    } else if (job.shot.refusal != ShotRefusal::kNone) {
+      reject(item.producer, job.shot.refusal == ShotRefusal::kRayTooLong ? Reject::kRayTooLong : Reject::kTooMuchWork, "");
+      ok = false;
     }
   } catch (const std::exception& e) {
     reject(item.producer, Reject::kEngineError, e.what());
     ok = false;
   }
   metrics_.overlap().end(0, token);
+  set_busy(0, false);
   job.producer = item.producer;
   job.robot_id = item.msg.robot_id;
   job.seq = item.msg.seq;
@@ -95,6 +127,7 @@ void ScanPipeline::apply(ShotJob& job) {
   if (job.edit) return apply_edit(*job.edit);
   const double token = metrics_.overlap().begin(1);
   const auto t0 = Clock::now();
+  set_busy(1, true);
   try {
     std::lock_guard lock(map_.mutex);
     engine_.apply(job.shot, *map_.tree);
@@ -104,10 +137,12 @@ void ScanPipeline::apply(ShotJob& job) {
     if (map_.observer) map_.observer->applied(job.shot.voxels, *map_.tree, map_.version);
     map_.applied_seq[lower_case(job.robot_id)] = job.seq;
   } catch (const std::exception& e) {
+    set_busy(1, false);
     metrics_.overlap().end(1, token);
     reject(job.producer, Reject::kEngineError, e.what());
     return;
   }
+  set_busy(1, false);
   map_.changed.notify_all();
   const auto t1 = Clock::now();
   const double overlap_s = metrics_.overlap().end(1, token);
@@ -123,6 +158,7 @@ void ScanPipeline::apply(ShotJob& job) {
 
 void ScanPipeline::run_stage1() {
   while (auto item = queue_.pop()) {
+    if (shed_if_stale(*item)) continue;
     ShotJob job;
     if (shoot(*item, job)) handoff_.push(std::move(job));
   }
@@ -135,6 +171,7 @@ void ScanPipeline::run_stage2() {
 
 void ScanPipeline::run_sequential() {
   while (auto item = queue_.pop()) {
+    if (shed_if_stale(*item)) continue;
     ShotJob job;
     if (shoot(*item, job)) apply(job);
   }

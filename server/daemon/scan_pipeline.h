@@ -29,14 +29,22 @@ struct ShotJob {
 
 class ScanPipeline {
  public:
+  // `max_queue_age` > 0: overload shedding. A scan that waited longer than this in the
+  // queue is dropped when it comes out (counted: "over latency bound"), so end-to-end
+  // latency stays near the bound instead of growing without limit.
   ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, ProducerRegistry& producers,
-               PipelineMetrics& metrics, bool pipelined);
+               PipelineMetrics& metrics, bool pipelined,
+               std::chrono::duration<double> max_queue_age = std::chrono::duration<double>::zero());
   ~ScanPipeline();
   void start();
   // Call after queue.close(): returns once every queued scan was applied or rejected.
   void join();
   size_t shot_depth() const { return handoff_.size(); }
   int64_t engine_errors() const { return engine_errors_; }
+  int64_t shed() const { return shed_; }
+  // How long the stage busiest on one scan has been on it (zero when both are idle): a
+  // stage stuck on one scan shows here.
+  Clock::duration longest_busy(Clock::time_point now = Clock::now()) const;
 
  private:
   // Stage 1 on one scan; false when it ended as a rejection.
@@ -47,6 +55,9 @@ class ScanPipeline {
   void run_stage1();
   void run_stage2();
   void run_sequential();
+  // True (and counted as dropped) when the scan waited longer than max_queue_age_.
+  bool shed_if_stale(const QueuedScan& item);
+  void set_busy(int stage, bool busy);
 
   MapEngine& engine_;
   MapState& map_;
@@ -56,7 +67,9 @@ class ScanPipeline {
   bool pipelined_;
   BoundedHandoff<ShotJob> handoff_{1};
   std::thread stage1_, stage2_;
-  std::atomic<int64_t> engine_errors_{0};
+  std::atomic<int64_t> engine_errors_{0}, shed_{0};
+  std::chrono::duration<double> max_queue_age_;
+  std::atomic<int64_t> busy_since_ns_[2] = {0, 0};  // steady clock; 0: idle
 };
 
 }  // namespace ort::daemon

@@ -1,5 +1,7 @@
 #include "daemon/scan_queue.h"
 
+#include <algorithm>
+#include <iterator>
 #include <string>
 
 namespace ort::daemon {
@@ -56,6 +58,21 @@ std::optional<QueuedScan> ScanQueue::pop() {
   depth_by_producer_[s.producer]--;
   total_bytes_ -= s.bytes;
   return s;
+}
+
+std::vector<QueuedScan> ScanQueue::take_all() {
+  std::lock_guard lock(mutex_);
+  std::vector<QueuedScan> out(std::make_move_iterator(fifo_.begin()), std::make_move_iterator(fifo_.end()));
+  fifo_.clear();
+  std::fill(bytes_by_producer_.begin(), bytes_by_producer_.end(), 0);
+  std::fill(depth_by_producer_.begin(), depth_by_producer_.end(), 0);
+  total_bytes_ = 0;
+  return out;
+}
+
+Clock::duration ScanQueue::oldest_age(Clock::time_point now) const {
+  std::lock_guard lock(mutex_);
+  return fifo_.empty() ? Clock::duration::zero() : now - fifo_.front().received;
 }
 
 void ScanQueue::close() {

@@ -48,6 +48,12 @@ class ScanQueue {
   std::optional<QueuedScan> pop();
   // No more pushes; pop() drains what is left, then returns nullopt.
   void close();
+  // Removes and returns every queued scan (the drain deadline passed: the caller counts
+  // them as dropped). pop() then returns nullopt once closed.
+  std::vector<QueuedScan> take_all();
+  // How long the oldest queued scan has waited (zero when empty).
+  Clock::duration oldest_age(Clock::time_point now = Clock::now()) const;
+  uint64_t total_budget() const { return total_budget_; }
 
   size_t depth() const;
   uint64_t bytes() const;

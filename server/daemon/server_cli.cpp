@@ -1,10 +1,12 @@
 #include "daemon/server_cli.h"
 
+#include <cmath>
 #include <regex>
 #include <stdexcept>
 #include <string>
 
 #include "daemon/query_answers.h"
+#include "daemon/scan_validation.h"
 
 namespace ort::daemon {
 
@@ -15,6 +17,9 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
   app.add_option("--map", s.map_path,
                  "map file (.ot, with log-odds): loaded at start if it exists, saved every --save-interval "
                  "seconds and at exit (atomically); the applied scan order goes to FILE.order");
+  app.add_flag("--move-corrupt-map-aside", s.move_corrupt_map_aside,
+               "when --map exists but is not a complete .ot file: rename it to FILE.corrupt-<UTC time> and start a "
+               "new map (default: refuse to start)");
   app.add_option("--save-interval", s.save_interval_s, "seconds between periodic saves; 0: only at exit")
       ->capture_default_str();
   app.add_option("--applied-log", s.applied_log, "also append each applied scan's (robot, seq) to this file as it happens");
@@ -47,7 +52,9 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
   app.add_option("--query-queue", s.queries.per_client_queue, "queued queries per client; more get BUSY replies")
       ->capture_default_str();
   add_grid_flags(app, s.queries.grid);
-  app.add_option("--max-producers", s.max_producers, "most scan channels served; more are rejected")
+  app.add_option("--latency-bound", s.latency_bound_s,
+                 "overload bound [s]: a scan queued longer is dropped ('over latency bound') and the status is "
+                 "DEGRADED while the end-to-end p99 exceeds it; 0: never drop for age")
       ->capture_default_str();
   app.add_option("--snapshot-zstd-level", s.snapshot_zstd_level, "zstd level of served snapshots (0: uncompressed)")
       ->capture_default_str();
@@ -65,6 +72,26 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
   app.add_option("--map-delta-channel", s.map_delta_channel, "channel of map deltas")->capture_default_str();
   app.add_flag("--delta-exact", s.delta_exact,
                "deltas carry every changed leaf with its log-odds (an exact mirror), not only class changes");
+  app.add_option("--drain-timeout", s.drain_timeout_s,
+                 "at SIGTERM/SIGINT, apply queued scans for at most this long [s]; the rest are dropped ('left at "
+                 "shutdown') and the map as applied is saved")
+      ->capture_default_str();
+  app.add_option("--stuck-stage", s.stuck_stage_s, "DEGRADED when a pipeline stage is on one scan longer than this [s]")
+      ->capture_default_str();
+  app.add_option("--max-scan-work", f.max_scan_work,
+                 "most ray-walk steps one scan may cost (summed over its windows); a scan above it is rejected "
+                 "as 'too much work'; 0: no limit")
+      ->capture_default_str();
+  app.add_option("--max-producers", s.max_producers,
+                 "most scan channels served at once; more are rejected (too many producers) unless an idle "
+                 "one can be let go (--producer-idle-release)")
+      ->capture_default_str();
+  app.add_option("--producer-idle-release", s.producer_idle_release_s,
+                 "seconds without a message after which a producer's slot may go to a new robot; 0: never")
+      ->capture_default_str();
+  app.add_option("--allow-robot", s.allowed_robots,
+                 "accept scans only from this robot id (repeatable; case-insensitive); default: any robot. "
+                 "Not authentication: LCM has none (see docs/RELIABILITY.md)");
 }
 
 void add_grid_flags(CLI::App& app, GridPublishConfig& g) {
@@ -99,11 +126,14 @@ ServerConfig to_server_config(const ServerFlags& f) {
   ServerConfig c = f.server;
   c.engine = ort::cli::to_engine_options(f.engine);
   c.pipeline = !f.no_pipeline;
-  if (f.queue_mib < 0) throw CLI::ValidationError("--queue-mib", "must be >= 0");
+  c.engine.max_scan_walk_keys = f.max_scan_work;
+  if (!(f.queue_mib >= 0 && f.queue_mib <= 1e9)) throw CLI::ValidationError("--queue-mib", "must be a number >= 0");
   c.queue_budget_bytes = static_cast<uint64_t>(f.queue_mib * 1048576.0);
   if (f.octomap_raw_max_kib < 0) throw CLI::ValidationError("--octomap-raw-max-kib", "must be >= 0");
   c.octomap_raw.max_bytes = static_cast<size_t>(f.octomap_raw_max_kib * 1024.0);
-  if (!(c.status_period_s > 0)) throw CLI::ValidationError("--status-period", "must be > 0");
+  if (!(c.status_period_s > 0 && c.status_period_s < 1e6))
+    throw CLI::ValidationError("--status-period", "must be a number of seconds > 0");
+  if (!std::isfinite(c.save_interval_s)) throw CLI::ValidationError("--save-interval", "must be a finite number of seconds");
   if (c.max_points == 0) throw CLI::ValidationError("--max-points", "must be > 0");
   if (c.max_producers == 0) throw CLI::ValidationError("--max-producers", "must be > 0");
   if (c.snapshot_zstd_level < 0 || c.snapshot_zstd_level > 19)
@@ -116,6 +146,14 @@ ServerConfig to_server_config(const ServerFlags& f) {
     if (const std::string bad = validate_query(QueryMessage(q), c.engine.resolution); !bad.empty())
       throw CLI::ValidationError("--grid-z/--grid-cell", bad);
   }
+  for (const auto& [value, name] : {std::pair{c.latency_bound_s, "--latency-bound"}, std::pair{c.drain_timeout_s, "--drain-timeout"},
+                                    std::pair{c.stuck_stage_s, "--stuck-stage"}})
+    if (!(value >= 0 && value <= 1e6)) throw CLI::ValidationError(name, "must be a number of seconds in [0, 1e6]");
+  if (!std::isfinite(c.producer_idle_release_s))
+    throw CLI::ValidationError("--producer-idle-release", "must be a finite number of seconds");
+  for (const std::string& id : c.allowed_robots)
+    if (!valid_robot_id(id))
+      throw CLI::ValidationError("--allow-robot", "'" + id + "' is not a robot id (1-32 of [A-Za-z0-9_-])");
   try {
     std::regex check(c.scan_channels);
   } catch (const std::regex_error& e) {

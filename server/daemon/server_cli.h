@@ -15,6 +15,7 @@ struct ServerFlags {
   bool no_pipeline = false;
   double queue_mib = 0;
   double octomap_raw_max_kib = 0;  // 0: automatic
+  uint64_t max_scan_work = EngineOptions{}.max_scan_walk_keys;
 };
 
 void add_server_flags(CLI::App& app, ServerFlags& f);

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "daemon/query_config.h"
 #include "engine/map_engine.h"
@@ -26,6 +27,7 @@ struct ServerConfig {
   std::string scan_channels = octomap_rt::wire::kScanChannelRegex;  // regex; its literal prefix + robot id
   std::string status_channel = octomap_rt::wire::kStatusChannel;
   std::string map_path;                        // .ot; "": no persistence
+  bool move_corrupt_map_aside = false;         // corrupt map: keep it as FILE.corrupt-<time>, start anew
   std::string applied_log;                     // live applied-order log; "": none
   double save_interval_s = 30;                 // <= 0: save only at exit
   double status_period_s = 1.0;
@@ -34,6 +36,8 @@ struct ServerConfig {
   uint64_t queue_budget_bytes = 0;             // per producer; 0: automatic_queue_budget()
   uint64_t max_points = octomap_rt::wire::kDefaultMaxScanPoints;  // per scan
   size_t max_producers = 64;
+  double producer_idle_release_s = 600;        // an idle producer's slot goes to a new robot; <= 0: never
+  std::vector<std::string> allowed_robots;     // --allow-robot; empty: any valid robot id
   int lcm_queue_capacity = 64;                 // LCM's own per-subscription queue (messages)
   OctomapRawConfig octomap_raw;
   // Serving the map (docs/PROTOCOL.md).
@@ -47,7 +51,20 @@ struct ServerConfig {
   double delta_rate_hz = 10;                   // most change sets a second; <= 0: no deltas
   bool delta_exact = false;                    // deltas carry every changed leaf's log-odds
   QueryServiceConfig queries;                  // queries and map edits (daemon/query_service.h)
+  // Overload: a scan that waited longer than this in the queue is dropped ("over latency
+  // bound") instead of applied late, and the status is DEGRADED while the end-to-end p99
+  // exceeds it. <= 0: never shed.
+  double latency_bound_s = 5.0;
+  // Stop: queued scans are applied for at most this long; what is still queued then is
+  // dropped ("left at shutdown") and the map as applied is saved.
+  double drain_timeout_s = 5.0;
+  // DEGRADED when a pipeline stage has been on one scan for longer than this.
+  double stuck_stage_s = 30.0;
 };
+
+struct ProducerPolicy;
+// The producer admission policy (slots, idle release, allow-list) of `c`.
+ProducerPolicy producer_policy(const ServerConfig& c);
 
 // Per-producer queue budget sized by memory: 1/64 of physical memory, within [64 MiB, 1 GiB].
 uint64_t automatic_queue_budget();

@@ -1,16 +1,63 @@
 // octomap-rt-server: the LCM mapping daemon.
 //   octomap-rt-server -r RES --map FILE.ot [flags]      (--help lists them)
-// SIGINT/SIGTERM: stop intake, apply what is queued, save, print a summary, exit 0.
-// A second signal while stopping exits at once (1) without saving.
+//
+// Signals (docs/RELIABILITY.md, "Shutdown"):
+//   SIGTERM / SIGINT  stop intake, apply queued scans for at most --drain-timeout seconds
+//                     (the rest are dropped: "left at shutdown"), save, print the summary.
+//                     Exit 0, or 1 when the final save failed. A repeat during the drain is
+//                     idempotent: it is logged and changes nothing.
+//   SIGQUIT, or SIGTERM/SIGINT again after the drain deadline
+//                     exit at once (2), after saving the map as applied if a save can be made
+//                     (3 when it cannot).
 #include <signal.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <thread>
 
 #include "daemon/mapping_server.h"
 #include "daemon/server_cli.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+const char* signal_name(int sig) { return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "SIGQUIT"; }
+
+// The immediate exit: no drain, but the map as applied is saved when a save can be made
+// (an orderly save already running is waited for, not cut short).
+[[noreturn]] void exit_now(ort::daemon::MappingServer& server, int sig) {
+  std::cerr << "octomap-rt-server: " << signal_name(sig) << ": exiting now; saving the map as applied\n";
+  int code = 2;
+  try {
+    server.save(false);
+  } catch (const std::exception& e) {
+    std::cerr << "octomap-rt-server: the map could not be saved: " << e.what() << "\n";
+    code = 3;
+  }
+  std::cerr.flush();
+  std::_Exit(code);
+}
+
+// Takes every later signal while the orderly stop runs (detached: it ends with the process).
+void watch_signals(ort::daemon::MappingServer& server, sigset_t sigs, Clock::time_point drain_deadline) {
+  std::thread([&server, sigs, drain_deadline] {
+    for (;;) {
+      int sig = 0;
+      if (sigwait(&sigs, &sig) != 0) continue;
+      const double left = std::chrono::duration<double>(drain_deadline - Clock::now()).count();
+      if (sig == SIGQUIT || left <= 0) exit_now(server, sig);
+      std::fprintf(stderr,
+                   "octomap-rt-server: %s: already stopping; queued scans are applied for %.1f s more, then the "
+                   "map is saved (SIGQUIT exits at once)\n",
+                   signal_name(sig), left);
+    }
+  }).detach();
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"octomap-rt-server: LCM mapping daemon. Robots publish octomap_rt::scan_t on "
@@ -25,11 +72,12 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
 
-  // Signals are taken by sigwait on the main thread only: block them before any thread starts.
+  // Signals are taken by sigwait only: block them before any thread starts.
   sigset_t sigs;
   sigemptyset(&sigs);
   sigaddset(&sigs, SIGINT);
   sigaddset(&sigs, SIGTERM);
+  sigaddset(&sigs, SIGQUIT);
   pthread_sigmask(SIG_BLOCK, &sigs, nullptr);
 
   try {
@@ -38,18 +86,20 @@ int main(int argc, char** argv) {
     std::cerr << "octomap-rt-server: listening on " << server.lcm_url() << " for " << cfg.scan_channels
               << "; status on " << cfg.status_channel << "; pid " << ::getpid() << "\n";
     int sig = 0;
-    sigwait(&sigs, &sig);
-    std::cerr << "octomap-rt-server: " << (sig == SIGINT ? "SIGINT" : "SIGTERM")
-              << ": stopping intake, applying queued scans, saving\n";
-    std::thread([sigs] {
-      int again = 0;
-      sigwait(&sigs, &again);
-      std::cerr << "octomap-rt-server: second signal: exiting now without saving\n";
-      _exit(1);
-    }).detach();
-    server.stop();
+    while (sigwait(&sigs, &sig) != 0) {
+    }
+    if (sig == SIGQUIT) exit_now(server, sig);
+    std::cerr << "octomap-rt-server: " << signal_name(sig) << ": stopping intake, applying queued scans for at most "
+              << cfg.drain_timeout_s << " s, saving\n";
+    watch_signals(server, sigs, Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                   std::chrono::duration<double>(cfg.drain_timeout_s)));
+    const bool saved = server.stop();
     server.print_summary(std::cout);
     std::cout.flush();
+    if (!saved) {
+      std::cerr << "octomap-rt-server: error: the final save failed (see the summary); exit status 1\n";
+      return 1;
+    }
   } catch (const std::exception& e) {
     std::cerr << "octomap-rt-server: error: " << e.what() << "\n";
     return 1;

@@ -119,6 +119,13 @@ octomap_rt::server_status_t make_status(const StatusInputs& in) {
       r.reject_count.push_back(p.rejects[k]);
     }
     r.num_reject_reasons = static_cast<int32_t>(r.reject_reason.size());
+    for (size_t k = 0; k < kRejectReasonCount; ++k) {
+      if (p.drop_reasons[k] == 0) continue;
+      r.drop_reason.push_back(to_string(static_cast<Reject>(k)));
+      r.drop_count.push_back(p.drop_reasons[k]);
+    }
+    r.num_drop_reasons = static_cast<int32_t>(r.drop_reason.size());
+    r.seq_restarts = p.seq_restarts;
     r.robot_id = p.robot_id;
     r.channel = p.channel;
     s.robots.push_back(std::move(r));

@@ -1,5 +1,7 @@
 #include "engine/engine_flags.h"
 
+#include <cmath>
+
 namespace ort::cli {
 
 void add_engine_flags(CLI::App& cmd, EngineFlags& f, bool require_resolution) {
@@ -35,6 +37,12 @@ void add_engine_flags(CLI::App& cmd, EngineFlags& f, bool require_resolution) {
 
 EngineOptions to_engine_options(const EngineFlags& f) {
   EngineOptions o;
+  // OctoMap's keys have 16 bits a side, so the map spans 65536 voxels: outside this range a
+  // resolution gives a map of micrometres or of continents, and NaN gives no map at all.
+  if (!(f.resolution >= kMinResolution && f.resolution <= kMaxResolution))
+    throw CLI::ValidationError("--resolution", "must lie within [0.0001, 1000] m, not " + std::to_string(f.resolution));
+  if (!std::isfinite(f.max_range))
+    throw CLI::ValidationError("--max-range", "must be a finite number of metres (< 0: no limit)");
   o.resolution = f.resolution;
   o.max_range = f.max_range;
   if (!parse_backend(f.backend, o.backend.kind)) throw CLI::ValidationError("--backend", "unknown back end " + f.backend);

@@ -21,6 +21,10 @@ struct EngineFlags {
   SensorModel sensor;
 };
 
+// Accepted resolutions [m]: the key range (+-32768 voxels) spans 6.5 m to 65,000 km.
+inline constexpr double kMinResolution = 1e-4;
+inline constexpr double kMaxResolution = 1e3;
+
 void add_engine_flags(CLI::App& cmd, EngineFlags& f, bool require_resolution);
 // Validates and converts; throws CLI::ValidationError with a clear message.
 EngineOptions to_engine_options(const EngineFlags& f);

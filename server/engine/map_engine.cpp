@@ -5,6 +5,8 @@
 #include "core/clock.h"
 #include "core/map_frame.h"
 
+#include "core/ray_tiles.h"
+
 namespace ort {
 
 MapEngine::MapEngine(const EngineOptions& opts, const Log& log) : opts_(opts), octree_stage_(opts.octree) {
@@ -20,6 +22,28 @@ std::unique_ptr<octomap::OcTree> MapEngine::make_tree() const {
   return tree;
 }
 
+namespace {
+
+KeyBox widened(const KeyBox& b, int margin) {
+  KeyBox w = b;
+  for (int i = 0; i < 3; ++i) {
+    w.lo[i] = std::max(0, w.lo[i] - margin);
+    w.hi[i] = std::min(65535, w.hi[i] + margin);
+  }
+  return w;
+}
+
+bool inside(const KeyBox& b, const VoxelUpdate& v) {
+  return v.x >= b.lo[0] && v.x <= b.hi[0] && v.y >= b.lo[1] && v.y <= b.hi[1] && v.z >= b.lo[2] && v.z <= b.hi[2];
+}
+
+void refuse(ShotScan& out, ShotRefusal why, std::string detail) {
+  out.refusal = why;
+  out.refusal_detail = std::move(detail);
+}
+
+}  // namespace
+
 void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range,
                       ShotScan& out) {
   out = ShotScan{};
@@ -27,7 +51,29 @@ void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::p
   const RayBatch batch = prepare_scan(origin, points, max_range, opts_.resolution, out.prepare, opts_.octree.threads);
   out.shoot.times.prepare_ms = ms_since(t0);
   if (!out.prepare.origin_ok) return;
-  backend_->shoot(batch, opts_.traversal, out.voxels, out.shoot);
+  // Bounded work whatever the geometry: OctoMap's own limit per ray, then the scan's cost
+  // (tiles for a box too large for one window) against the configured bound.
+  uint64_t longest = 0, single = 0;
+  for (const RayEnd& e : batch.ends) {
+    const uint64_t k = ray_walk_keys(batch, e);
+    longest = std::max(longest, k);
+    single += k;
+  }
+  if (longest > kMaxRayWalkKeys)
+    return refuse(out, ShotRefusal::kRayTooLong,
+                  "a ray walks " + std::to_string(longest) + " keys; OctoMap's ray walk holds at most " +
+                      std::to_string(kMaxRayWalkKeys) + " (points too far from the sensor at this resolution)");
+  const bool tiled = backend_->kind() != BackendKind::kCpu && widened(batch.keys, 2).voxel_count() > kTiledAbove;
+  out.walk_keys = tiled ? tiled_walk_keys(batch, kTileSide) : single;
+  if (opts_.max_scan_walk_keys && out.walk_keys > opts_.max_scan_walk_keys)
+    return refuse(out, ShotRefusal::kTooMuchWork,
+                  "the scan needs " + std::to_string(out.walk_keys) + " ray-walk steps, above the limit of " +
+                      std::to_string(opts_.max_scan_walk_keys));
+  if (tiled) {
+    shoot_tiled(batch, out);
+  } else {
+    backend_->shoot(batch, opts_.traversal, out.voxels, out.shoot);
+  }
   count_states(out);
 }
 
@@ -50,6 +96,31 @@ void MapEngine::shoot_posed(const octomap::pose6d& pose, const octomap::point3d&
 
 void MapEngine::count_states(ShotScan& out) const {
   for (const VoxelUpdate& v : out.voxels) (v.occupied() ? out.occupied_voxels : out.free_voxels)++;
+}
+
+void MapEngine::shoot_tiled(const RayBatch& batch, ShotScan& out) {
+  const TilePlan plan = plan_ray_tiles(batch, kTileSide);
+  out.tiles = plan.tiles.size();
+  RayBatch sub;
+  sub.origin = batch.origin;
+  sub.origin_key = batch.origin_key;
+  sub.resolution = batch.resolution;
+  VoxelList part;
+  for (const RayTile& tile : plan.tiles) {
+    sub.ends.clear();
+    for (uint32_t r : tile.rays) sub.ends.push_back(batch.ends[r]);
+    sub.keys = tile.box;  // the back end widens it by its margin; what falls outside is the neighbours'
+    ShootStats stats;
+    backend_->shoot(sub, opts_.traversal, part, stats);
+    for (const VoxelUpdate& v : part)
+      if (inside(tile.box, v)) out.voxels.push_back(v);
+    out.shoot.times.add(stats.times);
+    out.shoot.windows += stats.windows;
+    out.shoot.words_touched += stats.words_touched;
+    out.shoot.words_read_back += stats.words_read_back;
+    out.shoot.grid_words = stats.grid_words;
+    out.shoot.grid_allocations = stats.grid_allocations;
+  }
 }
 
 void MapEngine::apply(ShotScan& scan, octomap::OcTree& tree) const {

@@ -29,6 +29,17 @@ struct EngineOptions {
   BackendOptions backend;   // resolution/max_range are filled in from above
   OctreeUpdateOptions octree;
   SensorModel sensor;
+  // Most key steps one scan may cost (the sum over its windows of the walks of their rays);
+  // a scan above it is refused before any ray is shot. 0: no limit. The default is 2.5x a
+  // 4M-point scan of 1000-voxel rays; far-flung but small scans stay far below it.
+  uint64_t max_scan_walk_keys = 10'000'000'000ull;
+};
+
+// Why shoot() refused a scan whose origin was fine (the scan is then not shot at all).
+enum class ShotRefusal {
+  kNone,
+  kRayTooLong,    // a ray's walk exceeds OctoMap's KeyRay (100,000 keys): OctoMap cannot insert it
+  kTooMuchWork,   // the scan's walk keys exceed EngineOptions::max_scan_walk_keys
 };
 
 // One scan on its way through the pipeline.
@@ -37,6 +48,10 @@ struct ShotScan {
   ShootStats shoot;
   VoxelList voxels;
   uint64_t free_voxels = 0, occupied_voxels = 0;
+  uint64_t walk_keys = 0;          // the scan's cost: key steps over all its windows
+  uint64_t tiles = 0;              // path-following tiles (0: the scan's box was shot whole)
+  ShotRefusal refusal = ShotRefusal::kNone;
+  std::string refusal_detail;      // says why, with the numbers
 };
 
 class MapEngine {
@@ -77,8 +92,16 @@ class MapEngine {
   const EngineOptions& options() const { return opts_; }
   const RayBackend& backend() const { return *backend_; }
 
+  // A scan whose widened key box holds more voxels than this is shot tile by tile
+  // (core/ray_tiles.h) by the back ends with a grid; tiles have kTileSide keys a side, so a
+  // tile with its margins fits a 1 GiB-voxel grid window.
+  static constexpr uint64_t kTiledAbove = 1ull << 30;
+  static constexpr int kTileSide = 1016;
+
  private:
   void count_states(ShotScan& out) const;
+  // Shoots a scan too large for one window tile by tile, each tile's voxels cut to it.
+  void shoot_tiled(const RayBatch& batch, ShotScan& out);
 
   EngineOptions opts_;
   std::unique_ptr<RayBackend> backend_;

@@ -5,6 +5,7 @@ set(ORT_IT_DIR ${CMAKE_CURRENT_LIST_DIR})
 add_library(octomap_rt_integration_harness STATIC ${CMAKE_CURRENT_LIST_DIR}/integration_harness.cpp)
 target_include_directories(octomap_rt_integration_harness PUBLIC ${CMAKE_CURRENT_LIST_DIR})
 target_link_libraries(octomap_rt_integration_harness PUBLIC octomap_rt_lcmtypes octomap_rt_test_support GTest::gtest)
+octomap_rt_lcm_handler_sources(octomap_rt_integration_harness ${CMAKE_CURRENT_LIST_DIR}/integration_harness.cpp)
 target_compile_definitions(octomap_rt_integration_harness PRIVATE
   OCTOMAP_RT_SERVER="$<TARGET_FILE:octomap-rt-server>" OCTOMAP_RT_CLI="$<TARGET_FILE:octomap-rt>")
 
@@ -27,3 +28,4 @@ target_compile_definitions(install_integration_test PRIVATE OCTOMAP_RT_BUILD_DIR
 # Read-your-writes: a robot's query right after its scan sees that scan (issue 11).
 octomap_rt_add_integration_test(query_integration_test 300)
 target_link_libraries(query_integration_test PRIVATE octomap_rt_query_client)
+octomap_rt_add_integration_test(server_signals_integration_test 300)

@@ -4,10 +4,19 @@ octomap_rt_add_test(server_validation_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/sca
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 120)
 octomap_rt_add_test(server_memq_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_memq_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 600)
+octomap_rt_lcm_handler_sources(server_memq_test ${CMAKE_CURRENT_LIST_DIR}/server_memq_test.cpp)
 octomap_rt_add_test(server_persistence_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_store_test.cpp
-                    ${CMAKE_CURRENT_LIST_DIR}/server_persistence_test.cpp ${SERVER_TEST_FIXTURES}
+                    ${CMAKE_CURRENT_LIST_DIR}/server_persistence_test.cpp ${CMAKE_CURRENT_LIST_DIR}/map_file_integrity_test.cpp
+                    ${SERVER_TEST_FIXTURES}
                     LIBS octomap_rt_daemon TIMEOUT 300)
 octomap_rt_add_test(lcm_loop_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/lcm_loop_test.cpp LIBS octomap_rt_daemon TIMEOUT 120)
+octomap_rt_lcm_handler_sources(lcm_loop_test ${CMAKE_CURRENT_LIST_DIR}/lcm_loop_test.cpp)
+octomap_rt_add_test(server_producer_registry_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/producer_registry_test.cpp
+                    LIBS octomap_rt_daemon TIMEOUT 60)
+octomap_rt_add_test(server_hardening_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_hardening_test.cpp
+                    ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 600)
+octomap_rt_add_test(server_shutdown_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_shutdown_test.cpp
+                    ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
 # The query service (issue 11): answers, read-your-writes, edits, bad queries, over memq://.
 octomap_rt_add_test(server_query_service_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/query_service_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)

@@ -1,0 +1,37 @@
+# libFuzzer targets (issue 13): every inbound decoder and validator, built only with
+# -DOCTOMAP_RT_FUZZ=ON and clang (-DCMAKE_CXX_COMPILER=clang++-14). Each target compiles just
+# the sources it exercises, with -fsanitize=fuzzer,address,undefined; the seed corpora are
+# tests/fuzz/corpus/<target>/. tools/run-tests runs each for a bounded time; longer runs:
+#   build-fuzz/tests/fuzz_octree_file -max_total_time=1800 CORPUS_COPY tests/fuzz/corpus/fuzz_octree_file
+#
+# To add a target for another inbound message (map_request_t, occupancy_query_t): write
+# tests/fuzz/fuzz_<name>.cpp around its validator, add one octomap_rt_add_fuzz_target line
+# here and a seed directory tests/fuzz/corpus/fuzz_<name>/ (tools/run-tests finds it).
+if(NOT OCTOMAP_RT_FUZZ)
+  return()
+endif()
+if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+  message(FATAL_ERROR "OCTOMAP_RT_FUZZ needs clang: -DCMAKE_CXX_COMPILER=clang++-14")
+endif()
+set(FUZZ_DIR ${CMAKE_CURRENT_LIST_DIR})
+set(FUZZ_FLAGS -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g)
+
+# octomap_rt_add_fuzz_target(<name> SOURCES ... [LIBS ...])
+function(octomap_rt_add_fuzz_target name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
+  add_executable(${name} ${FUZZ_DIR}/${name}.cpp ${ARG_SOURCES})
+  target_compile_options(${name} PRIVATE ${FUZZ_FLAGS})
+  target_link_options(${name} PRIVATE ${FUZZ_FLAGS})
+  target_include_directories(${name} PRIVATE ${CMAKE_SOURCE_DIR}/server ${CMAKE_SOURCE_DIR}/client)
+  target_link_libraries(${name} PRIVATE octomap_rt_octomap Threads::Threads ${ARG_LIBS})
+  set(OCTOMAP_RT_FUZZ_TARGETS ${OCTOMAP_RT_FUZZ_TARGETS} ${name} PARENT_SCOPE)
+endfunction()
+
+octomap_rt_add_fuzz_target(fuzz_scan_message
+  SOURCES ${CMAKE_SOURCE_DIR}/server/daemon/scan_validation.cpp ${CMAKE_SOURCE_DIR}/server/daemon/reject_reason.cpp
+          ${CMAKE_SOURCE_DIR}/server/core/prepare_scan.cpp
+  LIBS octomap_rt_lcmtypes octomap_rt_lcm)
+octomap_rt_add_fuzz_target(fuzz_scan_graph
+  SOURCES ${CMAKE_SOURCE_DIR}/server/core/scan_graph_check.cpp ${CMAKE_SOURCE_DIR}/client/scene/scan_set.cpp)
+octomap_rt_add_fuzz_target(fuzz_octree_file SOURCES ${CMAKE_SOURCE_DIR}/server/core/octree_file_check.cpp)
+add_custom_target(octomap_rt_fuzz_targets DEPENDS ${OCTOMAP_RT_FUZZ_TARGETS})
