@@ -8,3 +8,4 @@ target_include_directories(octomap_rt_map_client PUBLIC $<BUILD_INTERFACE:${CMAK
 target_link_libraries(octomap_rt_map_client PUBLIC octomap_rt_protocol octomap_rt_lcmtypes octomap_rt_lcm
                       octomap_rt_octomap)
 add_library(octomap_rt::map_client ALIAS octomap_rt_map_client)
+octomap_rt_lcm_handler_sources(octomap_rt_map_client ${CMAKE_CURRENT_LIST_DIR}/map_client.cpp)

@@ -21,6 +21,7 @@ struct PrepareReport {
   uint64_t cut_at_max_range = 0;// longer than max range: cut, free space only
   bool origin_ok = true;        // false: origin not finite or outside the key range; no rays
   std::string error;            // set when origin_ok is false
+  bool device_declined = false; // shoot_posed: over PosedPoints' bounds, the device shot nothing (CPU-prepared)
 };
 
 // Builds the rays of one scan. Points are in the map frame, as OctoMap's insertPointCloud

@@ -40,6 +40,7 @@ struct ShootStats {
   uint64_t words_read_back = 0;  // must equal words_touched: the window is never read whole
   uint64_t grid_words = 0;       // capacity of the persistent grid, in 32-bit words
   uint64_t grid_allocations = 0; // grid (re)allocations so far; stays 1 after start-up
+  uint64_t walk_overruns = 0;    // rays stopped by a GPU shader's step guard: 0 on every valid input
 };
 
 // One scan as a sensor delivers it: points in the sensor frame, the pose that takes them
@@ -49,6 +50,13 @@ struct PosedPoints {
   octomap::point3d origin;
   std::span<const octomap::point3d> points;
   double max_range = -1.0;  // < 0: no limit
+  // Bounds of what the device shoots in one go (0: none). When the scan's key box, widened by
+  // the window margin, holds more voxels than max_box_voxels, or its walk bound (rays x the
+  // box's key extents summed) exceeds max_walk_keys, nothing is shot and
+  // PrepareReport::device_declined is set: the caller prepares on the CPU, where far-flung
+  // scans are tiled along their rays and the per-scan limits apply (MapEngine::shoot).
+  uint64_t max_box_voxels = 0;
+  uint64_t max_walk_keys = 0;
 };
 
 class RayBackend {

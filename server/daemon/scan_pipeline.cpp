@@ -90,7 +90,11 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
     if (!job.shot.prepare.origin_ok) {
       reject(item.producer, Reject::kOriginOutsideMap, "");
       ok = false;
-    } else if (job.shot.refusal != ShotRefusal::kNone) {
+    } else if (job.shot.shoot.walk_overruns && overrun_warnings_++ < 10) {
+      // The shaders' step guard stopped a ray: the scan is applied, but this must never happen.
+      std::cerr << "octomap-rt-server: " << job.shot.shoot.walk_overruns << " ray walks hit the GPU step guard\n";
+    }
+    if (ok && job.shot.refusal != ShotRefusal::kNone) {
       reject(item.producer, job.shot.refusal == ShotRefusal::kRayTooLong ? Reject::kRayTooLong : Reject::kTooMuchWork, "");
       ok = false;
     }

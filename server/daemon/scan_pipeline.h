@@ -68,6 +68,7 @@ class ScanPipeline {
   BoundedHandoff<ShotJob> handoff_{1};
   std::thread stage1_, stage2_;
   std::atomic<int64_t> engine_errors_{0}, shed_{0};
+  int64_t overrun_warnings_ = 0;  // stage 1 only
   std::chrono::duration<double> max_queue_age_;
   std::atomic<int64_t> busy_since_ns_[2] = {0, 0};  // steady clock; 0: idle
 };

@@ -81,17 +81,23 @@ void MapEngine::shoot_posed(const octomap::pose6d& pose, const octomap::point3d&
                             std::span<const octomap::point3d> sensor_points, double max_range, ShotScan& out) {
   if (backend_->prepares_on_device()) {
     out = ShotScan{};
-    backend_->shoot_posed({&pose, origin, sensor_points, max_range}, opts_.traversal, out.voxels, out.shoot,
-                          out.prepare);
-    count_states(out);
-    return;
+    // The device shoots what fits one window plan; a far-flung scan comes back declined and
+    // takes the CPU path below (tiles along the rays, the per-scan limits), as shoot() does.
+    backend_->shoot_posed({&pose, origin, sensor_points, max_range, kTiledAbove, opts_.max_scan_walk_keys},
+                          opts_.traversal, out.voxels, out.shoot, out.prepare);
+    if (!out.prepare.device_declined) {
+      count_states(out);
+      return;
+    }
   }
+  const bool declined = out.prepare.device_declined;
   const auto t0 = SteadyClock::now();
   std::vector<octomap::point3d> world(sensor_points.begin(), sensor_points.end());
   transform_to_map_frame(world, pose, opts_.octree.threads);
   const double transform_ms = ms_since(t0);
   shoot(origin, world, max_range, out);
   out.shoot.times.prepare_ms += transform_ms;
+  out.prepare.device_declined = declined;  // said, so callers can count scans the device passed on
 }
 
 void MapEngine::count_states(ShotScan& out) const {
@@ -120,6 +126,7 @@ void MapEngine::shoot_tiled(const RayBatch& batch, ShotScan& out) {
     out.shoot.words_read_back += stats.words_read_back;
     out.shoot.grid_words = stats.grid_words;
     out.shoot.grid_allocations = stats.grid_allocations;
+    out.shoot.walk_overruns += stats.walk_overruns;
   }
 }
 

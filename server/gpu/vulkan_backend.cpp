@@ -104,6 +104,10 @@ class VulkanBackend final : public RayBackend {
     if (kept == 0) return;  // as prepare_scan: no rays, nothing shot
     header.keys.include(octomap::OcTreeKey(p.end_keys.lo[0], p.end_keys.lo[1], p.end_keys.lo[2]));
     header.keys.include(octomap::OcTreeKey(p.end_keys.hi[0], p.end_keys.hi[1], p.end_keys.hi[2]));
+    if (over_device_bounds(header.keys, kept, scan)) {
+      report.device_declined = true;  // far-flung: the engine tiles it along its rays on the CPU path
+      return;
+    }
     const vk::ComputePipeline& pass = mode == Traversal::kOctomap ? shoot_octomap_ : shoot_exact_;
     const std::vector<KeyBox> windows = plan_windows(header.keys, space_.grid_voxels(), kWindowMargin);
     space_.shoot_resident(
@@ -112,6 +116,18 @@ class VulkanBackend final : public RayBackend {
   }
 
  private:
+  // PosedPoints' bounds: the key box widened by the window margin, and a walk bound (no ray
+  // of the scan visits more keys than the box's extents summed, plus one).
+  static bool over_device_bounds(const KeyBox& keys, uint64_t rays, const PosedPoints& scan) {
+    uint64_t box = 1, extents = 1;
+    for (int i = 0; i < 3; ++i) {
+      const uint64_t side = uint64_t(keys.hi[i] - keys.lo[i]) + 1;
+      box *= side + 2 * uint64_t(kWindowMargin);
+      extents += side;
+    }
+    return (scan.max_box_voxels && box > scan.max_box_voxels) || (scan.max_walk_keys && rays * extents > scan.max_walk_keys);
+  }
+
   // One invocation per ray, in dispatches of at most max_groups_ groups.
   void record_shoot(VkCommandBuffer cmd, const vk::ComputePipeline& pass, gpu::ShootPush push) const {
     const uint64_t groups = (uint64_t(push.ray_count) + gpu::kShootGroup - 1) / gpu::kShootGroup;

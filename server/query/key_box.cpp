@@ -13,9 +13,22 @@ int64_t KeyBox::voxels() const {
   return n;
 }
 
+bool checked_key(const octomap::OcTree& tree, double coordinate, octomap::key_type& key) {
+  // The key range is [-2^(d-1), 2^(d-1)) resolutions; twice that is well inside int.
+  const double far = tree.getResolution() * double(1u << tree.getTreeDepth());
+  if (!(std::abs(coordinate) < far)) return false;  // NaN too
+  return tree.coordToKeyChecked(coordinate, key);
+}
+
+bool checked_key(const octomap::OcTree& tree, const octomap::point3d& p, octomap::OcTreeKey& key) {
+  for (unsigned i = 0; i < 3; ++i)
+    if (!checked_key(tree, double(p(i)), key[i])) return false;
+  return true;
+}
+
 octomap::key_type clamped_key(const octomap::OcTree& tree, double coordinate) {
   octomap::key_type k = 0;
-  if (tree.coordToKeyChecked(coordinate, k)) return k;
+  if (checked_key(tree, coordinate, k)) return k;
   // Outside the key range: one side or the other (finite coordinates only reach here).
   const int top = (1 << tree.getTreeDepth()) - 1;
   return coordinate < 0 ? octomap::key_type(0) : octomap::key_type(top);

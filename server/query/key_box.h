@@ -33,6 +33,13 @@ NodeCube node_cube(const octomap::OcTreeKey& key, unsigned depth, unsigned tree_
 int64_t overlap_voxels(const NodeCube& c, const KeyBox& b);
 bool cube_inside(const NodeCube& c, const KeyBox& b);
 
+// OctoMap's coordToKeyChecked without its undefined behaviour: 1.9.7 converts
+// floor(coordinate / resolution) to int before it checks the range, which is undefined for
+// coordinates far outside the map (found by fuzzing the query messages). Coordinates that
+// far out are outside the key range, so the answer is the same: false.
+bool checked_key(const octomap::OcTree& tree, double coordinate, octomap::key_type& key);
+bool checked_key(const octomap::OcTree& tree, const octomap::point3d& p, octomap::OcTreeKey& key);
+
 // coordToKey for one axis, clamped to [0, 2^tree_depth - 1] outside the key range.
 octomap::key_type clamped_key(const octomap::OcTree& tree, double coordinate);
 

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <string>
 
+#include "query/key_box.h"
+
 namespace ort::query {
 
 unsigned checked_depth(const octomap::OcTree& tree, int depth) {
@@ -19,7 +21,7 @@ PointAnswer query_point(const octomap::OcTree& tree, const octomap::point3d& p, 
   // search(point, depth) without its error print for points outside the key range: the
   // same key conversion, the same null answer.
   octomap::OcTreeKey key;
-  if (!tree.coordToKeyChecked(p, key)) return a;
+  if (!checked_key(tree, p, key)) return a;
   const octomap::OcTreeNode* node = tree.search(key, depth);
   if (!node) return a;
   a.state = tree.isNodeOccupied(node) ? VoxelState::kOccupied : VoxelState::kFree;

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "query/key_box.h"
+
 namespace ort::query {
 namespace {
 bool finite(const octomap::point3d& p) { return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()); }
@@ -16,12 +18,12 @@ RayAnswer cast_ray(const octomap::OcTree& tree, const octomap::point3d& origin, 
   if (!(direction.norm() >= 1e-12f)) throw QueryError("ray direction is zero");
   RayAnswer a;
   octomap::OcTreeKey key;
-  if (!tree.coordToKeyChecked(origin, key)) {
+  if (!checked_key(tree, origin, key)) {
     a.end = origin;
     return a;
   }
   a.hit = tree.castRay(origin, direction, a.end, opt.ignore_unknown, opt.max_range);
-  if (!tree.coordToKeyChecked(a.end, key)) return a;
+  if (!checked_key(tree, a.end, key)) return a;
   if (const octomap::OcTreeNode* n = tree.search(key))
     a.end_state = tree.isNodeOccupied(n) ? VoxelState::kOccupied : VoxelState::kFree;
   return a;

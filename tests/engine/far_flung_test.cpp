@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/errors.h"
 #include "core/ray_tiles.h"
 #include "engine/map_engine.h"
 #include "core/octomap_ray_walk.h"
@@ -104,6 +105,44 @@ TEST(FarFlung, FiftyPointsThreeKilometresAwayGiveOctoMapsMapAtBoundedCost) {
     EXPECT_TRUE(d.maps_equal()) << to_string(kind) << ": " << d.differing_voxels << " voxels, " << d.differing_logodds
                                 << " log-odds differ: " << d.first_difference;
   }
+}
+
+// The daemon hands sensor-frame scans to the vulkan back end, which prepares them on the
+// device (shoot_posed). A far-flung scan must not be planned there from its bounding box: the
+// device declines it and the engine tiles it on the CPU path; the map still equals OctoMap's
+// and no ray walk hits the shaders' step guard. Near scans stay on the device.
+TEST(FarFlung, SensorFrameScansOnTheVulkanBackEndAreTiledNotWedged) {
+  EngineOptions o;
+  o.resolution = 0.1;
+  o.backend.kind = BackendKind::kVulkan;
+  o.backend.grid_budget_bytes = 256ull << 20;
+  std::unique_ptr<MapEngine> engine;
+  try {
+    engine = std::make_unique<MapEngine>(o);
+  } catch (const Unsupported& e) {
+    GTEST_SKIP() << "no Vulkan device: " << e.what();
+  }
+  ASSERT_TRUE(engine->backend().prepares_on_device());
+  ScanSet set;
+  // 400 m at 0.1 m: a key box of ~8000^3 voxels, far above one window plan (2^30).
+  set.scans.push_back(far_flung_scan(octomap::point3d(1.0f, 2.0f, 0.5f), 400.0, 50, 5));
+  set.scans.push_back(far_flung_scan(octomap::point3d(-40.0f, 7.0f, 1.5f), 8.0, 200, 7));  // near: on the device
+  auto tree = engine->make_tree();
+  for (size_t i = 0; i < set.scans.size(); ++i) {
+    const PosedScan& s = set.scans[i];
+    ShotScan shot;
+    engine->insert_posed(s.pose, sensor_origin(s), std::span<const octomap::point3d>(&s.points[0], s.points.size()),
+                         *tree, shot);
+    ASSERT_EQ(shot.refusal, ShotRefusal::kNone) << shot.refusal_detail;
+    EXPECT_EQ(shot.shoot.walk_overruns, 0u) << "scan " << i;
+    EXPECT_EQ(shot.prepare.device_declined, i == 0) << "scan " << i;
+    if (i == 0) EXPECT_GT(shot.tiles, 0u);
+    if (i == 0) EXPECT_LT(shot.shoot.windows, 20'000u);
+  }
+  const auto ref = octomap_reference(set, 0.1, -1.0);
+  const TreeDiff d = compare_leaves(*tree, *ref);
+  EXPECT_TRUE(d.maps_equal()) << d.differing_voxels << " voxels, " << d.differing_logodds
+                              << " log-odds differ: " << d.first_difference;
 }
 
 TEST(FarFlung, WhatOctoMapCannotWalkOrTheBoundForbidsIsRefused) {

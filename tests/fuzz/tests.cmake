@@ -4,9 +4,9 @@
 # tests/fuzz/corpus/<target>/. tools/run-tests runs each for a bounded time; longer runs:
 #   build-fuzz/tests/fuzz_octree_file -max_total_time=1800 CORPUS_COPY tests/fuzz/corpus/fuzz_octree_file
 #
-# To add a target for another inbound message (map_request_t, occupancy_query_t): write
-# tests/fuzz/fuzz_<name>.cpp around its validator, add one octomap_rt_add_fuzz_target line
-# here and a seed directory tests/fuzz/corpus/fuzz_<name>/ (tools/run-tests finds it).
+# To add a target for another inbound message: write tests/fuzz/fuzz_<name>.cpp around its
+# validator, add one octomap_rt_add_fuzz_target line here and a seed directory
+# tests/fuzz/corpus/fuzz_<name>/ (tools/run-tests finds it).
 if(NOT OCTOMAP_RT_FUZZ)
   return()
 endif()
@@ -22,7 +22,8 @@ function(octomap_rt_add_fuzz_target name)
   add_executable(${name} ${FUZZ_DIR}/${name}.cpp ${ARG_SOURCES})
   target_compile_options(${name} PRIVATE ${FUZZ_FLAGS})
   target_link_options(${name} PRIVATE ${FUZZ_FLAGS})
-  target_include_directories(${name} PRIVATE ${CMAKE_SOURCE_DIR}/server ${CMAKE_SOURCE_DIR}/client)
+  target_include_directories(${name} PRIVATE ${CMAKE_SOURCE_DIR} ${CMAKE_SOURCE_DIR}/server ${CMAKE_SOURCE_DIR}/client
+                             ${CMAKE_SOURCE_DIR}/lcmtypes/include)
   target_link_libraries(${name} PRIVATE octomap_rt_octomap Threads::Threads ${ARG_LIBS})
   set(OCTOMAP_RT_FUZZ_TARGETS ${OCTOMAP_RT_FUZZ_TARGETS} ${name} PARENT_SCOPE)
 endfunction()
@@ -34,4 +35,13 @@ octomap_rt_add_fuzz_target(fuzz_scan_message
 octomap_rt_add_fuzz_target(fuzz_scan_graph
   SOURCES ${CMAKE_SOURCE_DIR}/server/core/scan_graph_check.cpp ${CMAKE_SOURCE_DIR}/client/scene/scan_set.cpp)
 octomap_rt_add_fuzz_target(fuzz_octree_file SOURCES ${CMAKE_SOURCE_DIR}/server/core/octree_file_check.cpp)
+file(GLOB FUZZ_QUERY_CORE ${CMAKE_SOURCE_DIR}/server/query/*.cpp)
+octomap_rt_add_fuzz_target(fuzz_query_message
+  SOURCES ${CMAKE_SOURCE_DIR}/server/daemon/query_wire.cpp ${CMAKE_SOURCE_DIR}/server/daemon/query_answers.cpp
+          ${FUZZ_QUERY_CORE}
+  LIBS octomap_rt_lcmtypes octomap_rt_lcm)
+octomap_rt_add_fuzz_target(fuzz_map_request
+  SOURCES ${CMAKE_SOURCE_DIR}/protocol/wire_checks.cpp ${CMAKE_SOURCE_DIR}/protocol/map_protocol.cpp
+          ${CMAKE_SOURCE_DIR}/server/daemon/map_request_rules.cpp
+  LIBS octomap_rt_lcmtypes octomap_rt_lcm)
 add_custom_target(octomap_rt_fuzz_targets DEPENDS ${OCTOMAP_RT_FUZZ_TARGETS})

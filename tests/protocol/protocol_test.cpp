@@ -1,6 +1,7 @@
 // The map protocol's pieces on their own: the fixed offsets the pre-decode checks rely on,
 // crafted messages refused with a reason, the delta codec (round trip, part size limit,
 // corrupt payloads refused) and the client's snapshot assembly.
+#include <climits>
 #include <map>
 #include <random>
 
@@ -81,6 +82,17 @@ TEST(Protocol, CraftedRequestsAreRefusedWithAReason) {
   b = good;
   b[b.size() - 28] = 0xff;  // the reply channel's string length
   EXPECT_NE(check_request(b.data(), b.size(), out), "");
+  // Found by fuzz_map_request: a string length of INT32_MIN made LCM's generated decode()
+  // compute len - 1 (signed overflow) and copy from past the buffer. Lengths are walked first.
+  const size_t client_len = kRequestNumIndicesOffset + 4 + 4 * 3;
+  b = good;
+  put_be32(b, client_len, INT32_MIN);
+  EXPECT_EQ(check_request(b.data(), b.size(), out), "bad string length");
+  put_be32(b, client_len, 0);
+  EXPECT_EQ(check_request(b.data(), b.size(), out), "bad string length");
+  b = good;
+  b[client_len + 4 + size_t(be32(good, client_len)) - 1] = 'x';
+  EXPECT_EQ(check_request(b.data(), b.size(), out), "string not terminated");
 }
 
 std::vector<VoxelChange> random_changes(size_t n, int8_t mode, unsigned seed) {

@@ -91,6 +91,12 @@ TEST(BoxQuery, MetricBoxUsesOctomapKeysAndClampsToTheKeyRange) {
   const KeyBox c = query::key_box(t, far_lo, far_hi);
   EXPECT_EQ(c.min[0], 0);
   EXPECT_EQ(c.max[0], 65535);
+  // Found by fuzz_query_message: OctoMap's coordToKeyChecked converts floor(c / res) to int
+  // before its range check, undefined for a corner like -5.3e304; such corners clamp too.
+  const double huge_lo[3] = {-5.3e304, -1, -1}, huge_hi[3] = {1e300, 1, 1};
+  const KeyBox h = query::key_box(t, huge_lo, huge_hi);
+  EXPECT_EQ(h.min[0], 0);
+  EXPECT_EQ(h.max[0], 65535);
   const double nan_lo[3] = {NAN, 0, 0}, inverted_hi[3] = {1e9, -2, 1};
   EXPECT_THROW(query::key_box(t, nan_lo, far_hi), query::QueryError);
   EXPECT_THROW(query::key_box(t, far_lo, inverted_hi), query::QueryError);

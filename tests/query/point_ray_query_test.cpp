@@ -55,6 +55,10 @@ TEST(PointQuery, BatchKeepsInputOrderAndRefusesBadDepth) {
   EXPECT_THROW(query::query_points(t, xyz, 17), query::QueryError);
   EXPECT_THROW(query::query_points(t, xyz, -1), query::QueryError);
   EXPECT_EQ(query::query_point(t, octomap::point3d(NAN, 0, 0)).state, VoxelState::kUnknown);
+  // Far outside the key range (where OctoMap's own conversion is undefined): unknown, as
+  // search() answers for any point outside the map.
+  EXPECT_EQ(query::query_point(t, octomap::point3d(-3e38f, 0, 0)).state, VoxelState::kUnknown);
+  EXPECT_EQ(query::query_point(t, octomap::point3d(0, 1e20f, 0)).state, VoxelState::kUnknown);
 }
 
 // Rays along the axes, in voxel faces (origins on voxel boundaries, axis or face-diagonal
