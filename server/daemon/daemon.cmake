@@ -12,4 +12,4 @@ octomap_rt_lcm_handler_sources(octomap_rt_daemon ${DAEMON_DIR}/lcm_loop.cpp)
 # The engine flags (-r, sensor model, back end, ...) come from engine/engine_flags, shared so
 # that `octomap-rt build` and the server take the same names and defaults.
 add_executable(octomap-rt-server ${DAEMON_DIR}/server_main.cpp ${DAEMON_DIR}/server_cli.cpp)
-target_link_libraries(octomap-rt-server PRIVATE octomap_rt_daemon)
+target_link_libraries(octomap-rt-server PRIVATE octomap_rt_daemon octomap_rt_allocator)
