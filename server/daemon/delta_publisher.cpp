@@ -66,11 +66,14 @@ void DeltaPublisher::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
-void DeltaPublisher::applied(const VoxelList& voxels, const octomap::OcTree& tree, uint64_t version) {
+// The changes among voxels [begin, end) of one scan's list (see the header: class or exact mode).
+std::vector<VoxelChange> DeltaPublisher::changes_in(const VoxelList& voxels, size_t begin, size_t end,
+                                                    const octomap::OcTree& tree) const {
   const float hit = tree.getProbHitLog(), miss = tree.getProbMissLog(), thr = tree.getOccupancyThresLog();
   std::vector<VoxelChange> changed;
-  changed.reserve(cfg_.exact ? voxels.size() : voxels.size() / 8);
-  for (const VoxelUpdate& v : voxels) {
+  changed.reserve(cfg_.exact ? end - begin : (end - begin) / 8);
+  for (size_t i = begin; i < end; ++i) {
+    const VoxelUpdate& v = voxels[i];
     const octomap::OcTreeKey key = v.key();
     const octomap::OcTreeNode* node = tree.search(key);
     if (!node) continue;  // cannot happen after an update; nothing to report
@@ -82,8 +85,29 @@ void DeltaPublisher::applied(const VoxelList& voxels, const octomap::OcTree& tre
       changed.push_back({protocol::pack_key(key), static_cast<float>(now_class)});
     }
   }
+  return changed;
+}
+
+// Called by stage 2 under the map lock, so its time is the pipeline's: done on one thread
+// with a hash-map insert per change, it took two thirds of stage 2 on RGB-D scans (H200,
+// docs/BENCHMARKS.md "Performance (issue 12)"). The tree is only read here, so the look-ups
+// are split over threads (chunks of at least kMinChunk voxels, appended in the list's order,
+// so the result is the one-thread result), and the changes are only appended: flush() sorts
+// them and keeps each key's newest value, on the publisher's thread.
+void DeltaPublisher::applied(const VoxelList& voxels, const octomap::OcTree& tree, uint64_t version) {
+  constexpr size_t kMinChunk = 16384;
+  const size_t n = voxels.size();
+  const size_t chunks = std::clamp<size_t>(n / kMinChunk, 1, std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<std::vector<VoxelChange>> parts(chunks);
+  {
+    std::vector<std::jthread> helpers;
+    helpers.reserve(chunks - 1);
+    for (size_t c = 1; c < chunks; ++c)
+      helpers.emplace_back([&, c] { parts[c] = changes_in(voxels, n * c / chunks, n * (c + 1) / chunks, tree); });
+    parts[0] = changes_in(voxels, 0, n / chunks, tree);
+  }  // helpers joined
   std::lock_guard lock(mutex_);
-  for (const VoxelChange& c : changed) pending_[c.key] = c.value;
+  for (const std::vector<VoxelChange>& part : parts) pending_.insert(pending_.end(), part.begin(), part.end());
   to_version_ = version;
   pending_scans_++;
 }
@@ -125,9 +149,7 @@ void DeltaPublisher::flush() {
   {
     std::lock_guard lock(mutex_);
     if (pending_.empty() && skip_seqs_ == 0) return;  // versions keep accumulating into the next set
-    set.reserve(pending_.size());
-    for (const auto& [k, v] : pending_) set.push_back({k, v});
-    pending_.clear();
+    set.swap(pending_);
     from = from_version_;
     to = to_version_;
     from_version_ = to;
@@ -136,7 +158,13 @@ void DeltaPublisher::flush() {
     next_seq_ += skip_seqs_;
     skip_seqs_ = 0;
   }
-  std::sort(set.begin(), set.end(), [](const VoxelChange& a, const VoxelChange& b) { return a.key < b.key; });
+  // In the order the scans were applied: after a stable sort by key, the last of each key's
+  // run is its newest value.
+  std::stable_sort(set.begin(), set.end(), [](const VoxelChange& a, const VoxelChange& b) { return a.key < b.key; });
+  size_t kept = 0;
+  for (size_t i = 0; i < set.size(); ++i)
+    if (i + 1 == set.size() || set[i + 1].key != set[i].key) set[kept++] = set[i];
+  set.resize(kept);
   const int8_t mode = cfg_.exact ? Delta::MODE_LOG_ODDS : Delta::MODE_CLASS;
   auto parts = protocol::encode_delta_parts(set, mode, std::max(cfg_.zstd_level, 1), protocol::kDeltaDataBytes);
   if (parts.empty())  // after replaced(): one empty set carries the gap to the mirrors

@@ -4,9 +4,10 @@
 // list are looked up once in the updated tree: in class mode a key is kept when its class
 // may have changed (unknown -> free/occupied, free <-> occupied; the class before is the
 // value after minus the scan's update, OctoMap's clamping taken into account), in exact
-// mode every updated key is kept with its new log-odds. Keys collect in one pending set
-// (the newest value wins) which a thread of its own sends at most max_rate_hz times a
-// second: sorted, delta-coded, compressed, cut into self-contained parts <= 60 KB, paced.
+// mode every updated key is kept with its new log-odds (the look-ups are split over threads).
+// Keys collect in one pending list which a thread of its own sends at most max_rate_hz times
+// a second: sorted, each key's newest value kept, delta-coded, compressed, cut into
+// self-contained parts <= 60 KB, paced.
 #pragma once
 
 #include <atomic>
@@ -17,10 +18,11 @@
 #include <ostream>
 #include <string>
 #include <thread>
-#include <unordered_map>
+#include <vector>
 
 #include "daemon/lcm_loop.h"
 #include "daemon/map_state.h"
+#include "protocol/delta_codec.h"
 
 namespace ort::daemon {
 
@@ -60,6 +62,8 @@ class DeltaPublisher : public MapChangeObserver {
  private:
   void run();
   void flush();
+  std::vector<protocol::VoxelChange> changes_in(const VoxelList& voxels, size_t begin, size_t end,
+                                                const octomap::OcTree& tree) const;
 
   LcmLoop& loop_;
   DeltaConfig cfg_;
@@ -68,7 +72,9 @@ class DeltaPublisher : public MapChangeObserver {
 
   mutable std::mutex mutex_;  // pending_, versions, stop_, stats_
   std::condition_variable cv_;
-  std::unordered_map<uint64_t, float> pending_;
+  // Changes in the order the scans were applied, a key possibly more than once: stage 2 only
+  // appends (it runs under the map lock); flush() keeps each key's newest value.
+  std::vector<protocol::VoxelChange> pending_;
   uint64_t from_version_ = 0, to_version_ = 0;
   int64_t pending_scans_ = 0;
   int64_t skip_seqs_ = 0;
