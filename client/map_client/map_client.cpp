@@ -82,6 +82,7 @@ void MapClient::on_info_bytes(const lcm::ReceiveBuffer* rb, const std::string&) 
   }
   inbound_.infos++;
   info_ = std::move(m);
+  if (info_handler_) info_handler_(*info_);
 }
 
 void MapClient::on_delta_bytes(const lcm::ReceiveBuffer* rb, const std::string&) {
@@ -102,6 +103,10 @@ void MapClient::on_delta(std::function<void(const octomap_rt::map_delta_t&)> han
     delta_sub_ = lcm_.subscribe(opts_.delta_channel, &MapClient::on_delta_bytes, this);
     delta_sub_->setQueueCapacity(0);
   }
+}
+
+void MapClient::on_info(std::function<void(const octomap_rt::map_info_t&)> handler) {
+  info_handler_ = std::move(handler);
 }
 
 void MapClient::handle_for(double seconds) {

@@ -80,6 +80,8 @@ class MapClient {
   std::optional<octomap_rt::map_info_t> wait_info(double timeout_s);
   // Deltas go to `handler` from now on (subscribes the delta channel).
   void on_delta(std::function<void(const octomap_rt::map_delta_t&)> handler);
+  // Every map_info_t received from now on also goes to `handler`.
+  void on_info(std::function<void(const octomap_rt::map_info_t&)> handler);
   // Handles inbound messages for up to `timeout_s` (deltas reach their handler).
   void spin(double timeout_s);
 
@@ -102,6 +104,7 @@ class MapClient {
   std::vector<octomap_rt::map_chunk_t> chunks_;  // received since the last look
   std::optional<octomap_rt::map_info_t> info_;
   std::function<void(const octomap_rt::map_delta_t&)> delta_handler_;
+  std::function<void(const octomap_rt::map_info_t&)> info_handler_;
   lcm::Subscription* delta_sub_ = nullptr;
 };
 

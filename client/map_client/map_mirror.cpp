@@ -12,9 +12,11 @@ using Delta = octomap_rt::map_delta_t;
 
 MapMirror::MapMirror(MapClient& client, MirrorOptions opts) : client_(client), opts_(std::move(opts)) {
   client_.on_delta([this](const Delta& d) { on_delta(d); });
+  client_.on_info([this](const octomap_rt::map_info_t& info) { on_info(info); });
 }
 
 void MapMirror::on_delta(const Delta& d) {
+  highest_seq_ = std::max(highest_seq_, d.delta_seq);
   if (syncing_ || !tree_) {
     buffered_.push_back(d);
     return;
@@ -22,7 +24,23 @@ void MapMirror::on_delta(const Delta& d) {
   process(d);
 }
 
+// The server publishes a delta before any map_info_t naming its delta_seq, from one socket,
+// so they arrive in that order: an info naming a delta_seq never received means that delta
+// was lost. Without this a lost last delta (the end of a stream) would go unseen for good.
+void MapMirror::on_info(const octomap_rt::map_info_t& info) {
+  const bool baseline = !info_seen_;  // synced before any info: its deltas' seqs were unknown
+  info_seen_ = true;
+  latest_info_seq_ = info.delta_seq;
+  if (info.delta_seq < highest_seq_ || baseline) highest_seq_ = info.delta_seq;  // or the server started again
+  if (syncing_ || !tree_ || need_sync_ || info.delta_seq <= highest_seq_) return;
+  highest_seq_ = info.delta_seq;  // counted once
+  gap();
+}
+
 void MapMirror::sync() {
+  // Deltas sent before the latest info are in the fresh snapshot asked for now.
+  if (!info_seen_) client_.wait_info(1.5);  // 1 Hz; a server without map info: no check
+  const int64_t sent_before = latest_info_seq_;
   syncing_ = true;
   buffered_.clear();
   FetchedSnapshot s;
@@ -33,6 +51,7 @@ void MapMirror::sync() {
     throw;
   }
   tree_ = s.tree();
+  highest_seq_ = std::max(highest_seq_, sent_before);
   version_ = s.snapshot_id;
   started_ = false;
   last_seq_ = -1;

@@ -1,7 +1,9 @@
 // A local OcTree kept equal to the server's map: one snapshot, then every delta applied in
 // order (docs/PROTOCOL.md "Mirror"). A missed delta (a gap in delta_seq, or a change set
 // whose start was not seen) makes it fetch a fresh snapshot and continue from there, with
-// the deltas that arrived meanwhile; `on_delta` is called after each applied delta.
+// the deltas that arrived meanwhile; `on_delta` is called after each applied delta. A lost
+// last delta (no later one shows the gap) is found by map_info_t (1 Hz), which names the last
+// delta_seq sent: one never received is a gap too.
 //
 // In class mode (the server's default) the mirror's voxels have the right class (free /
 // occupied / unknown), with the clamping bound as log-odds; in exact mode (server flag
@@ -52,6 +54,7 @@ class MapMirror {
 
  private:
   void on_delta(const octomap_rt::map_delta_t& d);
+  void on_info(const octomap_rt::map_info_t& info);
   void process(const octomap_rt::map_delta_t& d);
   void apply(const octomap_rt::map_delta_t& d);
   void gap();
@@ -61,6 +64,9 @@ class MapMirror {
   std::unique_ptr<octomap::OcTree> tree_;
   int64_t version_ = -1;
   int64_t last_seq_ = -1;   // last delta applied or skipped as contained
+  int64_t highest_seq_ = -1;       // highest delta_seq received, or known to be in the snapshot
+  int64_t latest_info_seq_ = -1;   // delta_seq of the latest map_info_t
+  bool info_seen_ = false;
   bool started_ = false;    // a change set was applied from its first part since the snapshot
   bool syncing_ = false, need_sync_ = false;
   std::vector<octomap_rt::map_delta_t> buffered_;

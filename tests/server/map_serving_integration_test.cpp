@@ -4,7 +4,8 @@
 //  - under streaming from several robots, mirrors (client library, in this process) end
 //    equal to the final snapshot: in class, and in log-odds with --delta-exact; chunks and
 //    deltas dropped on purpose in the client's receive path are recovered by re-sends and
-//    resyncs, and the same loss without resync leaves the mirror wrong;
+//    resyncs (a lost last delta through the next map_info_t), and the same loss without
+//    resync leaves the mirror wrong;
 //  - bad requests are refused or ignored, counted in the status, and mapping goes on.
 #include <gtest/gtest.h>
 
@@ -16,6 +17,7 @@
 #include <sstream>
 
 #include "daemon/applied_order.h"
+#include "daemon/kernel_udp_stats.h"
 #include "integration_harness.h"
 #include "map_client/map_mirror.h"
 #include "octomap_rt/map_request_t.hpp"
@@ -132,10 +134,17 @@ TEST(MapServingIntegration, SnapshotEqualsTheSavedMapAndOctomapsOwn) {
   if (!::testing::Test::HasFailure()) std::filesystem::remove_all(f.dir);
 }
 
+// Datagrams the kernel dropped on this process's sockets (its LCM clients' receive buffers
+// full): udpm loses them, and a mirror then sees a gap. 0 when unknown.
+int64_t own_drops() { return std::max<int64_t>(0, daemon::read_own_udp_drops()); }
+
 // Runs `mirrors` while 3 robots stream the synthetic scene (`scans_each` each), then
-// returns the final snapshot (fetched without loss once everything is applied).
+// returns the final snapshot (fetched without loss once everything is applied) once the
+// mirrors in `converging` are at its version (a lost last delta is found by the next
+// map_info_t, then resynced; at most 15 s).
 std::unique_ptr<octomap::OcTree> stream_and_mirror(Fixture& f, ChildProcess& server, int scans_each,
                                                    std::vector<client::MapMirror*> mirrors,
+                                                   std::vector<client::MapMirror*> converging,
                                                    const std::function<void()>& while_streaming) {
   for (auto* m : mirrors) m->sync();
   std::vector<std::unique_ptr<ChildProcess>> producers;
@@ -158,10 +167,17 @@ std::unique_ptr<octomap::OcTree> stream_and_mirror(Fixture& f, ChildProcess& ser
   }
   for (auto& p : producers) EXPECT_EQ(p->wait(10), 0) << p->log();
   EXPECT_TRUE(f.wait_applied(server.pid(), 3 * scans_each, 300)) << server.log();
-  for (int k = 0; k < 40; ++k)
-    for (auto* m : mirrors) m->spin(0.05);  // the last change sets (10 Hz) arrive
   client::MapClient c(f.client_url);
-  return c.fetch_snapshot(Chunk::FORMAT_OCTOMAP_FULL, 60).tree();
+  const client::FetchedSnapshot final_map = c.fetch_snapshot(Chunk::FORMAT_OCTOMAP_FULL, 60);
+  auto behind = [&] {
+    for (auto* m : converging)
+      if (m->version() < final_map.snapshot_id) return true;
+    return false;
+  };
+  for (int k = 0; k < 300 && behind(); ++k)
+    for (auto* m : mirrors) m->spin(0.05);  // the last change sets (10 Hz) and map infos (1 Hz) arrive
+  for (auto* m : converging) EXPECT_EQ(m->version(), final_map.snapshot_id);
+  return final_map.tree();
 }
 
 TEST(MapServingIntegration, MirrorsFollowStreamingAndRecoverFromLoss) {
@@ -193,7 +209,7 @@ TEST(MapServingIntegration, MirrorsFollowStreamingAndRecoverFromLoss) {
     client::MapClient c(f.client_url, o);
     lossy_fetch = c.fetch_snapshot(Chunk::FORMAT_OCTOMAP_FULL, 60);
   };
-  const auto final_map = stream_and_mirror(f, *server, 40, {&clean, &lossy, &no_resync}, fetch_with_loss);
+  const auto final_map = stream_and_mirror(f, *server, 40, {&clean, &lossy, &no_resync}, {&clean, &lossy}, fetch_with_loss);
   auto show = [](const char* name, const client::MapMirror& m, const ClassDiff& d) {
     const client::MirrorStats& s = m.stats();
     std::cout << name << ": version " << m.version() << ", " << s.deltas_applied << " deltas applied ("
@@ -210,7 +226,9 @@ TEST(MapServingIntegration, MirrorsFollowStreamingAndRecoverFromLoss) {
 
   const ClassDiff d_clean = compare_classes(clean.tree(), *final_map);
   EXPECT_EQ(d_clean.differing, 0u) << "of " << d_clean.voxels;
-  EXPECT_EQ(clean.stats().gaps, 0);
+  if (own_drops() == 0) {
+    EXPECT_EQ(clean.stats().gaps, 0) << "gaps without a datagram dropped by the kernel";
+  }
   EXPECT_GT(clean.stats().deltas_applied, 10);
   const ClassDiff d_lossy = compare_classes(lossy.tree(), *final_map);
   EXPECT_EQ(d_lossy.differing, 0u) << "of " << d_lossy.voxels;
@@ -231,11 +249,18 @@ TEST(MapServingIntegration, ExactMirrorEqualsTheFinalSnapshotInLogOdds) {
   ASSERT_TRUE(f.status->wait_for([&](const auto& s) { return s.pid == server->pid(); }, 60)) << server->log();
   client::MapClient c(f.client_url);
   client::MapMirror mirror(c);
-  const auto final_map = stream_and_mirror(f, *server, 36, {&mirror}, {});
+  const auto final_map = stream_and_mirror(f, *server, 36, {&mirror}, {&mirror}, {});
   const TreeDiff d = compare_leaves(mirror.tree(), *final_map);
   EXPECT_EQ(d.differing_voxels, 0u) << d.first_difference;
   EXPECT_EQ(d.differing_logodds, 0u) << d.first_difference;
-  EXPECT_EQ(mirror.stats().gaps, 0);
+  // The deltas carried the log-odds (no resync snapshot did), unless the kernel dropped some.
+  const int64_t drops = own_drops();
+  if (drops == 0) {
+    EXPECT_EQ(mirror.stats().gaps, 0) << "gaps without a datagram dropped by the kernel";
+  }
+  std::cout << "exact mirror: " << mirror.stats().deltas_applied << " deltas applied, " << mirror.stats().gaps
+            << " gaps, " << drops << " datagrams dropped by the kernel on this process's sockets\n";
+  EXPECT_GT(mirror.stats().deltas_applied, 10);
   server->signal(SIGTERM);
   EXPECT_EQ(server->wait(120), 0) << server->log();
   if (!::testing::Test::HasFailure()) std::filesystem::remove_all(f.dir);
