@@ -26,17 +26,34 @@ def test_url(port):
     return f"udpm://239.255.76.67:{port}?ttl=0&recv_buf_size={min(4194304, rmem_max())}"
 
 
-class Logger:
-    """Debian's lcm-logger on a URL, stopped with SIGINT (it then flushes the log)."""
+PROBE_CHANNEL = "LOGGER_READY_PROBE"
 
-    def __init__(self, url, path):
+
+class Logger:
+    """Debian's lcm-logger on a URL, stopped with SIGINT (it then flushes the log). Ready once
+    it has logged a probe message: a message sent before its socket joined the group would be
+    missing from the log, and the machine's load decides how long joining takes."""
+
+    def __init__(self, url, path, timeout_s=30.0):
+        self.path = path
         # 1.3.1's short option -l is broken (missing from its optstring): use --lcm-url=.
-        self.proc = subprocess.Popen(["lcm-logger", "--quiet", f"--lcm-url={url}", path],
+        self.proc = subprocess.Popen(["lcm-logger", "--quiet", "--flush-interval=50", f"--lcm-url={url}", path],
                                      stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-        time.sleep(1.0)  # its socket joins the group
+        deadline = time.monotonic() + timeout_s
+        with UdpmTransport(url) as probe:
+            while not (os.path.exists(path) and os.path.getsize(path) > 0):
+                if self.proc.poll() is not None or time.monotonic() > deadline:
+                    raise RuntimeError(f"lcm-logger logged nothing within {timeout_s} s: {self.stop()}")
+                probe.publish(PROBE_CHANNEL, b"")
+                time.sleep(0.1)
+
+    def events(self):
+        """What it logged, the probes left out."""
+        return [e for e in lcm_log.read_events(self.path) if e[0] != PROBE_CHANNEL]
 
     def stop(self):
-        self.proc.send_signal(signal.SIGINT)
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGINT)
         _, err = self.proc.communicate(timeout=20)
         return err.decode(errors="replace")
 
@@ -68,7 +85,7 @@ class AgainstLcmTest(unittest.TestCase):
                 time.sleep(0.05)  # paced, as scans are: one message's fragments at a time
         time.sleep(0.5)
         err = logger.stop()
-        logged = lcm_log.read_events(os.path.join(self.dir, "py.lcmlog"))
+        logged = logger.events()
         self.assertEqual([c for c, _ in logged], [c for c, _ in sent], err)
         for (channel, payload), (_, got) in zip(sent, logged):
             self.assertEqual(got, payload, f"{channel}: {len(got)} bytes logged, {len(payload)} sent")
@@ -89,7 +106,7 @@ class AgainstLcmTest(unittest.TestCase):
             _, replay_err = replay.communicate(timeout=10)
             self.assertEqual(replay.returncode, 0, replay_err.decode(errors="replace"))
         err = logger.stop()
-        logged = lcm_log.read_events(os.path.join(self.dir, "cpp.lcmlog"))
+        logged = logger.events()
         self.assertEqual(len(logged), 3, err)
         self.assertEqual(received, logged)  # same channels, same bytes, same order
         scan = octomap_rt.scan_t.decode(received[0][1])
