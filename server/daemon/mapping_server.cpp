@@ -130,7 +130,7 @@ void MappingServer::start() {
   limits.max_points = cfg_.max_points;
   limits.resolution = cfg_.engine.resolution;
   open_map_serving();  // the delta observer is in place before the first scan is applied
-  pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, cfg_.pipeline,
+  pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, log_, cfg_.pipeline,
                                              std::chrono::duration<double>(cfg_.latency_bound_s));
   pipeline_->start();
   intake_ = std::make_unique<ScanIntake>(*loop_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);

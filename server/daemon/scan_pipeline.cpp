@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
-#include <iostream>
+#include <ostream>
 
 #include "core/clock.h"
 #include "daemon/scan_to_map.h"
@@ -16,12 +16,14 @@ std::string lower_case(std::string s) {
 }  // namespace
 
 ScanPipeline::ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, ProducerRegistry& producers,
-                           PipelineMetrics& metrics, bool pipelined, std::chrono::duration<double> max_queue_age)
+                           PipelineMetrics& metrics, std::ostream& log, bool pipelined,
+                           std::chrono::duration<double> max_queue_age)
     : engine_(engine),
       map_(map),
       queue_(queue),
       producers_(producers),
       metrics_(metrics),
+      log_(log),
       pipelined_(pipelined),
       max_queue_age_(max_queue_age) {}
 
@@ -65,7 +67,7 @@ void ScanPipeline::join() {
 }
 
 void ScanPipeline::reject(size_t producer, Reject why, const char* what) {
-  if (why == Reject::kEngineError && engine_errors_++ < 10) std::cerr << "octomap-rt-server: engine error: " << what << "\n";
+  if (why == Reject::kEngineError && engine_errors_++ < 10) log_ << "octomap-rt-server: engine error: " << what << "\n";
   producers_.count_rejected_in_flight(producer, why);
 }
 
@@ -92,7 +94,7 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
       ok = false;
     } else if (job.shot.shoot.walk_overruns && overrun_warnings_++ < 10) {
       // The shaders' step guard stopped a ray: the scan is applied, but this must never happen.
-      std::cerr << "octomap-rt-server: " << job.shot.shoot.walk_overruns << " ray walks hit the GPU step guard\n";
+      log_ << "octomap-rt-server: " << job.shot.shoot.walk_overruns << " ray walks hit the GPU step guard\n";
     }
     if (ok && job.shot.refusal != ShotRefusal::kNone) {
       reject(item.producer, job.shot.refusal == ShotRefusal::kRayTooLong ? Reject::kRayTooLong : Reject::kTooMuchWork, "");

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <atomic>
+#include <iosfwd>
 #include <thread>
 
 #include "daemon/bounded_handoff.h"
@@ -32,8 +33,9 @@ class ScanPipeline {
   // `max_queue_age` > 0: overload shedding. A scan that waited longer than this in the
   // queue is dropped when it comes out (counted: "over latency bound"), so end-to-end
   // latency stays near the bound instead of growing without limit.
+  // `log` is the daemon's log stream (engine errors, step-guard warnings).
   ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, ProducerRegistry& producers,
-               PipelineMetrics& metrics, bool pipelined,
+               PipelineMetrics& metrics, std::ostream& log, bool pipelined,
                std::chrono::duration<double> max_queue_age = std::chrono::duration<double>::zero());
   ~ScanPipeline();
   void start();
@@ -64,6 +66,7 @@ class ScanPipeline {
   ScanQueue& queue_;
   ProducerRegistry& producers_;
   PipelineMetrics& metrics_;
+  std::ostream& log_;
   bool pipelined_;
   BoundedHandoff<ShotJob> handoff_{1};
   std::thread stage1_, stage2_;
