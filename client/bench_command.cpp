@@ -15,6 +15,7 @@
 #include "bench_results.h"
 #include "commands.h"
 #include "core/clock.h"
+#include "engine/engine_pipeline.h"
 #include "engine/map_engine.h"
 #include "map_summary.h"
 #include "process_memory.h"
@@ -42,6 +43,7 @@ struct BenchArgs {
   std::string device;
   int warmup = 1, repeat = 1;
   bool no_octomap_breakdown = false;
+  bool no_pipeline = false;
   std::vector<std::string> prepares = {"device"};
   std::string csv, png_dir, markdown;
   std::vector<std::string> replot;
@@ -149,13 +151,14 @@ void run_engine(const ScanSet& set, const EngineOptions& opts, const BenchArgs& 
   MapEngine engine(opts);  // the device is in the row; the creation notes are not wanted here
   r.device = engine.backend().device_name();
   const size_t warm = std::min<size_t>(a.warmup, set.scans.size());
+  // Sensor-frame points: the engine transforms (on the CPU or the GPU).
+  const ScanInputSource scan_input = [&set](size_t i) {
+    const PosedScan& s = set.scans[i];
+    return PosedScanInput{s.pose, sensor_origin(s), as_span(s.points)};
+  };
   {  // warm-up: pipelines, first allocations, page faults of the grid
     auto scratch = engine.make_tree();
-    for (size_t i = 0; i < warm; ++i) {
-      ShotScan shot;
-      const PosedScan& s = set.scans[i];
-      engine.insert_posed(s.pose, sensor_origin(s), as_span(s.points), *scratch, shot);
-    }
+    insert_scans(engine, warm, scan_input, *scratch, {}, !a.no_pipeline);
   }
   std::vector<std::pair<double, BenchRow>> runs;
   std::unique_ptr<octomap::OcTree> tree;
@@ -164,14 +167,13 @@ void run_engine(const ScanSet& set, const EngineOptions& opts, const BenchArgs& 
     tree = engine.make_tree();
     StageTimes st;
     const auto t0 = Clock::now();
-    for (const PosedScan& s : set.scans) {
-      ShotScan shot;  // sensor-frame points: the engine transforms (on the CPU or the GPU)
-      engine.insert_posed(s.pose, sensor_origin(s), as_span(s.points), *tree, shot);
+    // Stage times are each stage's own sum; with the pipeline they overlap in the total.
+    insert_scans(engine, set.scans.size(), scan_input, *tree, [&](size_t, const ShotScan& shot) {
       st.add(shot.shoot.times);
       m.windows += shot.shoot.windows;
       m.voxel_updates += shot.voxels.size();
       m.gpu_grid_bytes = std::max<uint64_t>(m.gpu_grid_bytes, shot.shoot.grid_words * 4);
-    }
+    }, !a.no_pipeline);
     m.total_ms = ms_since(t0);
     m.prepare_ms = st.prepare_ms;  // transform included
     m.upload_ms = st.upload_ms;
@@ -371,6 +373,9 @@ void register_bench_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-octomap-breakdown", a->no_octomap_breakdown,
                 "skip the separate computeUpdate pass that splits OctoMap's time into shoot and octree");
+  cmd->add_flag("--no-pipeline", a->no_pipeline,
+                "run our mappers' two stages one scan after the other (default: scan k+1 is shot while scan k's "
+                "octree update runs)");
   cmd->add_option("--prepare", a->prepares,
                   "scan preparation: device (on the GPU where the back end can: vulkan) and/or cpu; "
                   "vulkan's cpu rows are named vulkan/cpu-prep")

@@ -10,6 +10,7 @@
 #include "commands.h"
 #include "core/clock.h"
 #include "engine/engine_flags.h"
+#include "engine/engine_pipeline.h"
 #include "map_summary.h"
 #include "scene/scan_set.h"
 #include "scene/synthetic_scene.h"
@@ -22,6 +23,7 @@ struct BuildArgs {
   std::string output;
   EngineFlags engine;
   bool quiet = false;
+  bool no_pipeline = false;
 };
 
 // Writes the map and checks the stream only after closing it: a full disk shows when the
@@ -63,16 +65,18 @@ int run_build(const BuildArgs& a) {
   uint64_t voxels = 0, windows = 0;
   size_t rejected = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  for (size_t i = 0; i < set.scans.size(); ++i) {
+  const auto scan_input = [&set](size_t i) {  // sensor-frame points: transformed on the GPU where it prepares
     const PosedScan& scan = set.scans[i];
     std::span<const octomap::point3d> pts(scan.points.size() ? &scan.points[0] : nullptr, scan.points.size());
-    ShotScan shot;  // sensor-frame points: transformed on the GPU where the back end prepares there
-    engine.insert_posed(scan.pose, sensor_origin(scan), pts, *tree, shot);
+    return PosedScanInput{scan.pose, sensor_origin(scan), pts};
+  };
+  // Called in scan order once the scan is in the map (on the octree stage's thread when pipelined).
+  const auto account = [&](size_t i, const ShotScan& shot) {
     if (!shot.prepare.origin_ok || shot.refusal != ShotRefusal::kNone) {
       ++rejected;
       std::cerr << "  scan " << i << " rejected: "
                 << (shot.prepare.origin_ok ? shot.refusal_detail : shot.prepare.error) << "\n";
-      continue;
+      return;
     }
     total.add(shot.shoot.times);
     prep_total.points_in += shot.prepare.points_in;
@@ -84,10 +88,11 @@ int run_build(const BuildArgs& a) {
     windows += shot.shoot.windows;
     if (!a.quiet) {
       std::fprintf(stderr, "  [%zu/%zu] %zu points, %zu voxels (%llu occupied), %.1f ms\n", i + 1, set.scans.size(),
-                   scan.points.size(), shot.voxels.size(), (unsigned long long)shot.occupied_voxels,
+                   set.scans[i].points.size(), shot.voxels.size(), (unsigned long long)shot.occupied_voxels,
                    shot.shoot.times.total_ms());
     }
-  }
+  };
+  insert_scans(engine, set.scans.size(), scan_input, *tree, account, !a.no_pipeline);
   const double wall_ms =
       ms_since(t0);
   write_map(*tree, a.output);
@@ -133,6 +138,9 @@ void register_build_command(CLI::App& app) {
       ->required();
   cmd->add_option("-o,--output", args->output, "map file: .bt (OctoMap binary) or .ot (with log-odds)")->required();
   cmd->add_flag("-q,--quiet", args->quiet, "no per-scan progress lines");
+  cmd->add_flag("--no-pipeline", args->no_pipeline,
+                "run the two stages one scan after the other (default: scan k+1 is shot while scan k's octree "
+                "update runs); the stage times are each stage's sum, the total is the wall clock either way");
   add_engine_flags(*cmd, args->engine, /*require_resolution=*/true);
   cmd->callback([args] {
     const int rc = run_build(*args);
