@@ -14,8 +14,11 @@ RayAnswer cast_ray(const octomap::OcTree& tree, const octomap::point3d& origin, 
   if (!finite(origin)) throw QueryError("ray origin is not finite");
   if (!finite(direction)) throw QueryError("ray direction is not finite");
   // castRay normalizes in float; a direction whose float norm is 0 (or subnormal) would
-  // become NaN there.
-  if (!(direction.norm() >= 1e-12f)) throw QueryError("ray direction is zero");
+  // become NaN there, one whose norm overflows (components ~1e19 and up) would become 0,
+  // which castRay refuses with an error print ("direction (0,0,0)", found by fuzzing).
+  const float norm = direction.norm();
+  if (!(norm >= 1e-12f)) throw QueryError("ray direction is zero");
+  if (!std::isfinite(norm)) throw QueryError("ray direction is too long to normalize in float; scale it down");
   RayAnswer a;
   octomap::OcTreeKey key;
   if (!checked_key(tree, origin, key)) {

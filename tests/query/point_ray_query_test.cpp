@@ -125,6 +125,8 @@ TEST(RayQuery, RefusesRaysCastRayCannotCast) {
   EXPECT_THROW(query::cast_ray(t, {0, 0, 0}, {0, 0, 0}, {}), query::QueryError);
   EXPECT_THROW(query::cast_ray(t, {NAN, 0, 0}, {1, 0, 0}, {}), query::QueryError);
   EXPECT_THROW(query::cast_ray(t, {0, 0, 0}, {1, INFINITY, 0}, {}), query::QueryError);
+  EXPECT_THROW(query::cast_ray(t, {0, 0, 0}, {1e30f, 1e30f, 0}, {}), query::QueryError);  // norm overflows
+  EXPECT_TRUE(query::cast_ray(t, {0, 0, 0}, {1e15f, 1e15f, 0}, {}).end.norm() >= 0.f);    // fine: castRay normalizes
   const query::RayAnswer far = query::cast_ray(t, {1e6f, 0, 0}, {1, 0, 0}, {});
   EXPECT_FALSE(far.hit);
   EXPECT_EQ(far.end, octomap::point3d(1e6f, 0, 0));
