@@ -15,6 +15,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "daemon/degraded_causes.h"
 #include "daemon/delta_publisher.h"
 #include "daemon/lcm_loop.h"
 #include "daemon/map_service.h"
@@ -78,7 +79,7 @@ class MappingServer {
   void set_state(int8_t state, std::string message);
   StatusInputs gather_status();
   void publish_status();
-  std::string degraded_causes(const StatusInputs& in);
+  DegradedSignals degraded_signals(const StatusInputs& in);
   void run_status_loop();
   void run_save_loop();
 
@@ -112,7 +113,7 @@ class MappingServer {
   std::atomic<size_t> cached_leaves_{0};
   std::atomic<int64_t> cached_nodes_{0}, cached_memory_{0}, cached_version_{0};
   std::chrono::steady_clock::time_point leaves_time_;
-  int64_t last_drops_ = 0, last_kernel_errors_ = -1, last_rejects_ = 0;
+  DegradedTracker degraded_;                  // used by the status thread only
   std::thread status_thread_, save_thread_;
 
   std::mutex save_mutex_;                     // one save at a time

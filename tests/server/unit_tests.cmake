@@ -13,6 +13,9 @@ octomap_rt_add_test(lcm_loop_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/lcm_loop_tes
 octomap_rt_lcm_handler_sources(lcm_loop_test ${CMAKE_CURRENT_LIST_DIR}/lcm_loop_test.cpp)
 octomap_rt_add_test(server_producer_registry_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/producer_registry_test.cpp
                     LIBS octomap_rt_daemon TIMEOUT 60)
+# The rule behind the status' DEGRADED state and its causes.
+octomap_rt_add_test(server_degraded_causes_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/degraded_causes_test.cpp
+                    LIBS octomap_rt_daemon TIMEOUT 60)
 octomap_rt_add_test(server_hardening_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_hardening_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 600)
 octomap_rt_add_test(server_shutdown_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_shutdown_test.cpp
