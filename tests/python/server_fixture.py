@@ -3,6 +3,7 @@ publishing OCTOMAP) on a test URL of their network namespace, a MapClient on it,
 helpers to publish a wall of points and to name voxels as OctoMap does."""
 
 import os
+import shutil
 import signal
 import subprocess
 import tempfile
@@ -65,8 +66,11 @@ class ServerTestCase(unittest.TestCase):
     def tearDownClass(cls):
         cls.client.close()
         cls.server.send_signal(signal.SIGTERM)
-        cls.server.wait(timeout=60)
+        code = cls.server.wait(timeout=60)
         cls.log.close()
+        # The folder holds the server's log and map: kept only where a run needs looking into.
+        if code == 0 and not os.environ.get("OCTOMAP_RT_KEEP_TEST_DIRS"):
+            shutil.rmtree(cls.dir, ignore_errors=True)
 
     def publish_wall(self, x: float, robot_id: str, origin=(0.0, 0.0, 0.5)):
         """A 2 m x 1 m wall of points at `x` from a sensor at `origin`, waited for until applied;
