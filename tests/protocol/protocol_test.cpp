@@ -95,6 +95,36 @@ TEST(Protocol, CraftedRequestsAreRefusedWithAReason) {
   EXPECT_EQ(check_request(b.data(), b.size(), out), "string not terminated");
 }
 
+// map_info_t carries one string per producer after the array of their seqs: each is walked.
+TEST(Protocol, CraftedInfosAreRefusedWithAReason) {
+  octomap_rt::map_info_t m{};
+  m.num_producers = 2;
+  m.producer_last_seq = {1, 2};
+  m.producer_id = {"robot_a", "robot_b"};
+  m.server_id = "s";
+  m.map_frame = "map";
+  const auto good = encode(m);
+  octomap_rt::map_info_t out{};
+  EXPECT_EQ(check_info(good.data(), good.size(), out), "");
+  EXPECT_EQ(out.producer_id.size(), 2u);
+  EXPECT_EQ(out.producer_id[1], "robot_b");
+  const size_t first_id = kInfoNumProducersOffset + 4 + 8 * 2;  // after the seqs
+  const size_t second_id = first_id + 4 + size_t(be32(good, first_id));
+  auto b = good;
+  put_be32(b, second_id, INT32_MIN);
+  EXPECT_EQ(check_info(b.data(), b.size(), out), "bad string length");
+  put_be32(b, second_id, 1000);  // within the bound, beyond the bytes
+  EXPECT_EQ(check_info(b.data(), b.size(), out), "truncated");
+  b = good;
+  b[second_id + 4 + size_t(be32(good, second_id)) - 1] = 'x';
+  EXPECT_EQ(check_info(b.data(), b.size(), out), "string not terminated");
+  b = good;
+  put_be32(b, kInfoNumProducersOffset, 3);  // a third id the bytes do not hold
+  EXPECT_NE(check_info(b.data(), b.size(), out), "");
+  put_be32(b, kInfoNumProducersOffset, 5000);
+  EXPECT_EQ(check_info(b.data(), b.size(), out), "count too large");
+}
+
 std::vector<VoxelChange> random_changes(size_t n, int8_t mode, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_int_distribution<int> k(32000, 33500), c(1, 2);
