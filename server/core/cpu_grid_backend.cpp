@@ -1,10 +1,17 @@
 #include "core/cpu_grid_backend.h"
 
+#include <sys/mman.h>
+
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
 #include <thread>
 #include <vector>
 
+#include "core/brick_layout.h"
 #include "core/clock.h"
 #include "core/exact_traversal.h"
 #include "core/octomap_ray_walk.h"
@@ -16,7 +23,84 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr uint32_t kVoxelsPerWord = 16;
+constexpr uint32_t kVoxelsPerWord = BrickLayout::kVoxelsPerWord;
+constexpr uint32_t kNoIndex = std::numeric_limits<uint32_t>::max();
+
+// The persistent grid: 2 MiB-aligned so that the kernel can back it with huge pages (a
+// window of tens of MiB walked at random would otherwise miss the TLB on most line misses).
+struct GridMemory {
+  static constexpr size_t kHugePage = 2u << 20;
+  explicit GridMemory(uint64_t words) : bytes((words * 4 + kHugePage - 1) / kHugePage * kHugePage) {
+    words_ = static_cast<uint32_t*>(std::aligned_alloc(kHugePage, bytes));
+    if (!words_) throw std::bad_alloc();
+    madvise(words_, bytes, MADV_HUGEPAGE);  // a hint: without it the grid still works
+    std::memset(words_, 0, bytes);
+  }
+  ~GridMemory() { std::free(words_); }
+  GridMemory(const GridMemory&) = delete;
+  GridMemory& operator=(const GridMemory&) = delete;
+  uint32_t* data() const { return words_; }
+  size_t bytes;
+
+ private:
+  uint32_t* words_;
+};
+
+// Sets 2-bit states in the grid and lists each word the first time it becomes non-zero.
+// `shared`: other threads mark the same grid (atomic OR); otherwise plain loads and stores.
+struct GridMarker {
+  uint32_t* grid;
+  std::vector<uint32_t>& touched;
+  bool shared;
+
+  [[gnu::always_inline]] void mark(uint32_t idx, uint32_t bits) {
+    const uint32_t word = idx / kVoxelsPerWord;
+    const uint32_t mask = bits << (2 * (idx % kVoxelsPerWord));
+    uint32_t& cell = grid[word];
+    // Most visits near the sensor find their bit set already: read before the atomic.
+    const uint32_t old = std::atomic_ref<uint32_t>(cell).load(std::memory_order_relaxed);
+    if ((old & mask) == mask) return;
+    if (shared) {
+      if (std::atomic_ref<uint32_t>(cell).fetch_or(mask, std::memory_order_relaxed) == 0) touched.push_back(word);
+    } else {
+      std::atomic_ref<uint32_t>(cell).store(old | mask, std::memory_order_relaxed);
+      if (old == 0) touched.push_back(word);
+    }
+  }
+};
+
+// walk_octomap_ray_steps' stepper for a ray whose origin lies in the window: keeps the voxel
+// index as the sum of per-axis offsets, and stops the walk where the ray leaves the window
+// (each axis moves one way only, so a ray that left never comes back).
+struct WindowStepper {
+  WindowStepper(const BrickLayout& layout, const octomap::OcTreeKey& origin, const octomap::OcTreeKey& end,
+                GridMarker& m)
+      : marker(m), ox(layout.x_offsets()), oy(layout.y_offsets()), oz(layout.z_offsets()),
+        x(origin[0] - layout.window().lo[0]), y(origin[1] - layout.window().lo[1]), z(origin[2] - layout.window().lo[2]),
+        nx(layout.extent(0)), ny(layout.extent(1)), nz(layout.extent(2)),
+        ix(ox[x]), iy(oy[y]), iz(oz[z]),
+        end_index(layout.contains(end) ? layout.index(end) : kNoIndex) {}
+
+  void start(int a, int b, int c) {
+    sx = a, sy = b, sz = c;
+    x_out = a > 0 ? nx : -1, y_out = b > 0 ? ny : -1, z_out = c > 0 ? nz : -1;
+  }
+  bool step_x() { x += sx; if (x == x_out) return false; ix = ox[x]; return true; }
+  bool step_y() { y += sy; if (y == y_out) return false; iy = oy[y]; return true; }
+  bool step_z() { z += sz; if (z == z_out) return false; iz = oz[z]; return true; }
+  bool at_end() const { return index() == end_index; }
+  void visit() { marker.mark(index(), kStateFree); }
+  uint32_t index() const { return ix + iy + iz; }
+
+  GridMarker& marker;
+  const uint32_t *ox, *oy, *oz;
+  int x, y, z;  // key - window.lo
+  int nx, ny, nz;
+  uint32_t ix, iy, iz;
+  uint32_t end_index;  // kNoIndex when the end voxel lies outside the window
+  int sx = 0, sy = 0, sz = 0;
+  int x_out = 0, y_out = 0, z_out = 0;  // the first coordinate outside the window along each step
+};
 
 class CpuGridBackend final : public RayBackend {
  public:
@@ -24,9 +108,7 @@ class CpuGridBackend final : public RayBackend {
       : res_(o.resolution),
         threads_(o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency())),
         words_((o.grid_budget_bytes ? o.grid_budget_bytes : (256ull << 20)) / 4),
-        grid_(new std::atomic<uint32_t>[words_]) {
-    for (uint64_t i = 0; i < words_; ++i) grid_[i].store(0, std::memory_order_relaxed);
-  }
+        grid_(words_) {}
 
   BackendKind kind() const override { return BackendKind::kCpuGrid; }
   std::string device_name() const override {
@@ -37,23 +119,25 @@ class CpuGridBackend final : public RayBackend {
     out.clear();
     stats.grid_words = words_;
     stats.grid_allocations = 1;
-    const std::vector<KeyBox> windows = plan_windows(batch.keys, words_ * kVoxelsPerWord);
+    const std::vector<KeyBox> windows = plan_bricked_windows(batch.keys);
     stats.windows += windows.size();
     const unsigned n_threads = unsigned(std::min<size_t>(threads_, std::max<size_t>(1, batch.ends.size() / 256)));
     std::vector<std::vector<uint32_t>> touched(n_threads);
     std::vector<VoxelList> partial(n_threads);
     for (const KeyBox& w : windows) {
       const auto t_shoot = Clock::now();
+      const BrickLayout layout(w);
       run_parallel(n_threads, [&](unsigned t) {
         const size_t begin = batch.ends.size() * t / n_threads, end = batch.ends.size() * (t + 1) / n_threads;
         touched[t].clear();
-        for (size_t i = begin; i < end; ++i) shoot_ray(batch, batch.ends[i], mode, w, touched[t]);
+        GridMarker marker{grid_.data(), touched[t], n_threads > 1};
+        for (size_t i = begin; i < end; ++i) shoot_ray(batch, batch.ends[i], mode, layout, marker);
       });
       stats.times.shoot_ms += ms_since(t_shoot);
       const auto t_compact = Clock::now();
       run_parallel(n_threads, [&](unsigned t) {
         partial[t].clear();
-        compact(w, touched[t], partial[t]);
+        compact(layout, touched[t], partial[t]);
       });
       for (unsigned t = 0; t < n_threads; ++t) {
         stats.words_touched += touched[t].size();
@@ -74,51 +158,59 @@ class CpuGridBackend final : public RayBackend {
     f(0u);
   }
 
-  // Sets `bits` of voxel k if it lies in the window; lists the word when it was empty.
-  [[gnu::always_inline]] void mark(const KeyBox& w, const octomap::OcTreeKey& k, uint32_t bits,
-                                   std::vector<uint32_t>& touched) {
-    const int64_t idx = window_index(w, k[0], k[1], k[2]);
-    if (idx < 0) return;
-    const uint64_t word = uint64_t(idx) / kVoxelsPerWord;
-    const uint32_t mask = bits << (2 * (idx % kVoxelsPerWord));
-    std::atomic<uint32_t>& cell = grid_[word];
-    // Most visits near the sensor find their bit set already: read before the atomic.
-    if ((cell.load(std::memory_order_relaxed) & mask) == mask) return;
-    if (cell.fetch_or(mask, std::memory_order_relaxed) == 0) touched.push_back(uint32_t(word));
+  // plan_windows with room for the bricks' padding (and indices that fit 32 bits).
+  std::vector<KeyBox> plan_bricked_windows(const KeyBox& keys) const {
+    const uint64_t voxels = std::min<uint64_t>(words_ * kVoxelsPerWord, 1ull << 31);
+    for (uint64_t capacity = voxels;; capacity -= std::max<uint64_t>(capacity / 8, 1)) {
+      std::vector<KeyBox> windows = plan_windows(keys, capacity);
+      if (std::all_of(windows.begin(), windows.end(),
+                      [&](const KeyBox& w) { return BrickLayout::padded_voxels(w) <= voxels; }))
+        return windows;
+    }
   }
 
-  void shoot_ray(const RayBatch& b, const RayEnd& e, Traversal mode, const KeyBox& w, std::vector<uint32_t>& touched) {
+  void mark_checked(const BrickLayout& layout, const octomap::OcTreeKey& k, uint32_t bits, GridMarker& marker) {
+    if (layout.contains(k)) marker.mark(layout.index(k), bits);
+  }
+
+  void shoot_ray(const RayBatch& b, const RayEnd& e, Traversal mode, const BrickLayout& layout, GridMarker& marker) {
     const octomap::point3d end(e.x, e.y, e.z);
     octomap::OcTreeKey end_key;
     coord_to_key_checked(end, res_, end_key);  // prepare_scan kept only in-range ends
-    if (mode == Traversal::kOctomap) {
-      walk_octomap_ray(b.origin, end, b.origin_key, end_key, res_,
-                       [&](const octomap::OcTreeKey& k) { mark(w, k, kStateFree, touched); });
-    } else {
+    if (mode == Traversal::kExact) {
       thread_local std::vector<octomap::OcTreeKey> keys;
       keys.clear();
       exact_ray_keys(b.origin, end, res_, keys);
-      for (const auto& k : keys) mark(w, k, kStateFree, touched);
+      for (const auto& k : keys) mark_checked(layout, k, kStateFree, marker);
+    } else if (b.origin_key != end_key) {
+      if (layout.contains(b.origin_key)) {
+        walk_in_window(b, end, end_key, layout, marker);
+      } else {  // a later window of a split ray space: the ray may enter it anywhere
+        walk_octomap_ray(b.origin, end, b.origin_key, end_key, res_,
+                         [&](const octomap::OcTreeKey& k) { mark_checked(layout, k, kStateFree, marker); });
+      }
     }
-    if (e.flags & kRayEndOccupied) mark(w, end_key, kStateOccupied, touched);
+    if (e.flags & kRayEndOccupied) mark_checked(layout, end_key, kStateOccupied, marker);
+  }
+
+  void walk_in_window(const RayBatch& b, const octomap::point3d& end, const octomap::OcTreeKey& end_key,
+                      const BrickLayout& layout, GridMarker& marker) {
+    WindowStepper s(layout, b.origin_key, end_key, marker);
+    marker.mark(s.index(), kStateFree);
+    walk_octomap_ray_steps(b.origin, end, b.origin_key, res_, s);
   }
 
   // Turns touched words into voxel updates (occupied wins) and clears them: the grid is
   // cleared through the touched list only, never by a pass over the window.
-  void compact(const KeyBox& w, const std::vector<uint32_t>& touched, VoxelList& out) {
-    const int64_t nx = w.hi[0] - w.lo[0] + 1, ny = w.hi[1] - w.lo[1] + 1;
+  void compact(const BrickLayout& layout, const std::vector<uint32_t>& touched, VoxelList& out) {
     for (uint32_t word : touched) {
-      uint32_t bits = grid_[word].exchange(0, std::memory_order_relaxed);
+      uint32_t bits = std::atomic_ref<uint32_t>(grid_.data()[word]).exchange(0, std::memory_order_relaxed);
       while (bits) {
         const int slot = __builtin_ctz(bits) / 2;
         const uint32_t state = (bits >> (2 * slot)) & 3u;
         bits &= ~(3u << (2 * slot));
-        const int64_t idx = int64_t(word) * kVoxelsPerWord + slot;
-        const int x = int(idx % nx) + w.lo[0];
-        const int y = int((idx / nx) % ny) + w.lo[1];
-        const int z = int(idx / (nx * ny)) + w.lo[2];
-        out.push_back(VoxelUpdate{uint16_t(x), uint16_t(y), uint16_t(z),
-                                  uint16_t((state & kStateOccupied) ? kStateOccupied : kStateFree)});
+        const octomap::OcTreeKey k = layout.key_of(word, uint32_t(slot));
+        out.push_back(VoxelUpdate{k[0], k[1], k[2], uint16_t((state & kStateOccupied) ? kStateOccupied : kStateFree)});
       }
     }
   }
@@ -126,7 +218,7 @@ class CpuGridBackend final : public RayBackend {
   double res_;
   unsigned threads_;
   uint64_t words_;
-  std::unique_ptr<std::atomic<uint32_t>[]> grid_;
+  GridMemory grid_;
 };
 
 }  // namespace

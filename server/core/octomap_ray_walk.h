@@ -14,17 +14,18 @@
 
 namespace ort {
 
-// Walks origin -> end. Keys must already be known to be inside the key range (as
-// computeRayKeys checks). Calls free_voxel(key) for the origin voxel and every voxel up to,
-// but excluding, the end voxel; nothing when both lie in the same voxel.
-template <class FreeVoxel>
-inline void walk_octomap_ray(const octomap::point3d& origin, const octomap::point3d& end,
-                             const octomap::OcTreeKey& key_origin, const octomap::OcTreeKey& key_end,
-                             double resolution, FreeVoxel&& free_voxel) {
+// The DDA itself, over a "stepper" that owns the current voxel. It calls
+//   s.start(sx, sy, sz)        once, with the step sign of each axis (-1, 0, 1);
+//   s.step_x() / step_y() / step_z() after each step along that axis; false stops the walk
+//                              (the cpu-grid stepper stops where the ray leaves its window);
+//   s.at_end()                 true when the current voxel is the end key's (the walk stops);
+//   s.visit()                  for every voxel after the origin's, up to, excluding, the end voxel.
+// The origin voxel is the caller's (walk_octomap_ray visits it first). Keys must already be
+// known to be inside the key range (as computeRayKeys checks); key_origin != key_end.
+template <class Stepper>
+inline void walk_octomap_ray_steps(const octomap::point3d& origin, const octomap::point3d& end,
+                                   const octomap::OcTreeKey& key_origin, double resolution, Stepper& s) {
   constexpr int kTreeMaxVal = 32768;
-  if (key_origin == key_end) return;
-  free_voxel(key_origin);
-
   octomap::point3d direction = end - origin;
   const float length = (float)direction.norm();
   direction /= length;
@@ -32,13 +33,12 @@ inline void walk_octomap_ray(const octomap::point3d& origin, const octomap::poin
   int step[3];
   double t_max[3];
   double t_delta[3];
-  octomap::OcTreeKey current = key_origin;
   for (unsigned i = 0; i < 3; ++i) {
     if (direction(i) > 0.0) step[i] = 1;
     else if (direction(i) < 0.0) step[i] = -1;
     else step[i] = 0;
     if (step[i] != 0) {
-      double voxel_border = (double((int)current[i] - kTreeMaxVal) + 0.5) * resolution;  // keyToCoord
+      double voxel_border = (double((int)key_origin[i] - kTreeMaxVal) + 0.5) * resolution;  // keyToCoord
       voxel_border += (float)(step[i] * resolution * 0.5);
       t_max[i] = (voxel_border - origin(i)) / direction(i);
       t_delta[i] = resolution / std::fabs(direction(i));
@@ -47,32 +47,57 @@ inline void walk_octomap_ray(const octomap::point3d& origin, const octomap::poin
       t_delta[i] = std::numeric_limits<double>::max();
     }
   }
+  s.start(step[0], step[1], step[2]);
   // The loop keeps its state in registers (OctoMap indexes arrays by the stepping axis, a
   // chain through memory on every step); the comparisons and operations are the same.
   double tx = t_max[0], ty = t_max[1], tz = t_max[2];
   const double dx = t_delta[0], dy = t_delta[1], dz = t_delta[2];
-  const auto sx = octomap::key_type(step[0]), sy = octomap::key_type(step[1]), sz = octomap::key_type(step[2]);
   while (true) {
     if (tx < ty) {
       if (tx < tz) {
-        current[0] = octomap::key_type(current[0] + sx);
+        if (!s.step_x()) return;
         tx += dx;
       } else {
-        current[2] = octomap::key_type(current[2] + sz);
+        if (!s.step_z()) return;
         tz += dz;
       }
     } else if (ty < tz) {
-      current[1] = octomap::key_type(current[1] + sy);
+      if (!s.step_y()) return;
       ty += dy;
     } else {
-      current[2] = octomap::key_type(current[2] + sz);
+      if (!s.step_z()) return;
       tz += dz;
     }
-    if (current == key_end) return;
+    if (s.at_end()) return;
     const double dist_from_origin = std::min(std::min(tx, ty), tz);
     if (dist_from_origin > length) return;
-    free_voxel(current);
+    s.visit();
   }
+}
+
+// Walks origin -> end. Keys must already be known to be inside the key range (as
+// computeRayKeys checks). Calls free_voxel(key) for the origin voxel and every voxel up to,
+// but excluding, the end voxel; nothing when both lie in the same voxel.
+template <class FreeVoxel>
+inline void walk_octomap_ray(const octomap::point3d& origin, const octomap::point3d& end,
+                             const octomap::OcTreeKey& key_origin, const octomap::OcTreeKey& key_end,
+                             double resolution, FreeVoxel&& free_voxel) {
+  if (key_origin == key_end) return;
+  free_voxel(key_origin);
+  struct KeyStepper {
+    octomap::OcTreeKey current, end;
+    FreeVoxel& f;
+    octomap::key_type sx = 0, sy = 0, sz = 0;
+    void start(int x, int y, int z) {
+      sx = octomap::key_type(x), sy = octomap::key_type(y), sz = octomap::key_type(z);
+    }
+    bool step_x() { current[0] = octomap::key_type(current[0] + sx); return true; }
+    bool step_y() { current[1] = octomap::key_type(current[1] + sy); return true; }
+    bool step_z() { current[2] = octomap::key_type(current[2] + sz); return true; }
+    bool at_end() const { return current == end; }
+    void visit() { f(current); }
+  } s{key_origin, key_end, free_voxel};
+  walk_octomap_ray_steps(origin, end, key_origin, resolution, s);
 }
 
 }  // namespace ort

@@ -1,0 +1,78 @@
+// The cpu-grid's voxel layout inside one window: bricks of 8 x 8 x 4 voxels, one 64-byte
+// cache line of 2-bit states, each brick 16 words of 4 x 4 x 1 voxels.
+//
+// Why: laid out x fastest, every y or z step of a ray's walk lands in another cache line
+// (and, over a window of tens of MiB, often another page); in a brick a walk stays in one line
+// for several steps. The index is a sum of one offset per axis (tables built once per window),
+// so a walk keeps it incrementally: a step along x replaces only the x offset.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <octomap/OcTreeKey.h>
+
+#include "core/ray_batch.h"
+
+namespace ort {
+
+class BrickLayout {
+ public:
+  static constexpr int kBrickX = 8, kBrickY = 8, kBrickZ = 4;
+  static constexpr uint32_t kVoxelsPerBrick = kBrickX * kBrickY * kBrickZ;  // 256
+  static constexpr uint32_t kVoxelsPerWord = 16;
+
+  // Voxels the layout of window w spans (w rounded up to whole bricks).
+  static uint64_t padded_voxels(const KeyBox& w) {
+    return uint64_t(bricks(w, 0)) * bricks(w, 1) * bricks(w, 2) * kVoxelsPerBrick;
+  }
+
+  explicit BrickLayout(const KeyBox& w) : w_(w), nbx_(bricks(w, 0)), nby_(bricks(w, 1)) {
+    const uint32_t brick_row = kVoxelsPerBrick * nbx_, brick_layer = brick_row * nby_;
+    ox_.resize(size_t(w.hi[0] - w.lo[0] + 1));
+    oy_.resize(size_t(w.hi[1] - w.lo[1] + 1));
+    oz_.resize(size_t(w.hi[2] - w.lo[2] + 1));
+    // Inside a brick: bits 0-1 x&3, 2-3 y&3 (slot in the word), 4 x>>2&1, 5 y>>2&1, 6-7 z&3.
+    for (uint32_t x = 0; x < ox_.size(); ++x) ox_[x] = (x & 3u) | ((x >> 2) & 1u) << 4 | (x >> 3) * kVoxelsPerBrick;
+    for (uint32_t y = 0; y < oy_.size(); ++y) oy_[y] = (y & 3u) << 2 | ((y >> 2) & 1u) << 5 | (y >> 3) * brick_row;
+    for (uint32_t z = 0; z < oz_.size(); ++z) oz_[z] = (z & 3u) << 6 | (z >> 2) * brick_layer;
+  }
+
+  const KeyBox& window() const { return w_; }
+  // Per-axis offsets, indexed by key - window.lo.
+  const uint32_t* x_offsets() const { return ox_.data(); }
+  const uint32_t* y_offsets() const { return oy_.data(); }
+  const uint32_t* z_offsets() const { return oz_.data(); }
+  int extent(int axis) const { return w_.hi[axis] - w_.lo[axis] + 1; }
+
+  bool contains(const octomap::OcTreeKey& k) const {
+    return k[0] >= w_.lo[0] && k[0] <= w_.hi[0] && k[1] >= w_.lo[1] && k[1] <= w_.hi[1] && k[2] >= w_.lo[2] &&
+           k[2] <= w_.hi[2];
+  }
+  // Voxel index of a key inside the window (contains(k) must hold).
+  uint32_t index(const octomap::OcTreeKey& k) const {
+    return ox_[k[0] - w_.lo[0]] + oy_[k[1] - w_.lo[1]] + oz_[k[2] - w_.lo[2]];
+  }
+  // The key of slot `slot` (0-15) of word `word`.
+  octomap::OcTreeKey key_of(uint32_t word, uint32_t slot) const {
+    const uint32_t brick = word >> 4, in_brick = word & 15u;
+    const uint32_t bx = brick % nbx_, by = (brick / nbx_) % nby_, bz = brick / (nbx_ * nby_);
+    const uint32_t x = bx * kBrickX + ((in_brick & 1u) << 2 | (slot & 3u));
+    const uint32_t y = by * kBrickY + (((in_brick >> 1) & 1u) << 2 | slot >> 2);
+    const uint32_t z = bz * kBrickZ + (in_brick >> 2);
+    return octomap::OcTreeKey(octomap::key_type(x + w_.lo[0]), octomap::key_type(y + w_.lo[1]),
+                              octomap::key_type(z + w_.lo[2]));
+  }
+
+ private:
+  static uint32_t bricks(const KeyBox& w, int axis) {
+    const int brick = axis == 0 ? kBrickX : axis == 1 ? kBrickY : kBrickZ;
+    return uint32_t((w.hi[axis] - w.lo[axis] + brick) / brick);
+  }
+
+  KeyBox w_;
+  uint32_t nbx_, nby_;
+  std::vector<uint32_t> ox_, oy_, oz_;
+};
+
+}  // namespace ort

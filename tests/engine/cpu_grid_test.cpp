@@ -1,0 +1,108 @@
+// The cpu-grid back end's bricked layout (core/brick_layout.h) and its window walk (the voxel
+// index kept per axis, the window's bounds tested only on the stepping axis) against the cpu
+// back end (OctoMap's computeRayKeys + a hash set), on whole scans: rays along each axis, in
+// the axis planes, across brick and window borders, at the key range's edges, one thread
+// (plain stores) and two (atomic OR).
+#include <random>
+#include <set>
+#include <tuple>
+
+#include <gtest/gtest.h>
+
+#include "core/brick_layout.h"
+#include "core/cpu_backend.h"
+#include "core/cpu_grid_backend.h"
+#include "core/prepare_scan.h"
+
+namespace ort {
+namespace {
+
+TEST(BrickLayout, IndexIsABijectionAndKeyOfInvertsIt) {
+  KeyBox w;
+  w.lo[0] = 5, w.lo[1] = 1000, w.lo[2] = 65520;
+  w.hi[0] = 5 + 12, w.hi[1] = 1000 + 8, w.hi[2] = 65535;  // 13 x 9 x 16: partial bricks in x and y
+  const BrickLayout layout(w);
+  const uint64_t padded = BrickLayout::padded_voxels(w);
+  EXPECT_EQ(padded, 2u * 2u * 4u * 256u);
+  std::set<uint32_t> seen;
+  for (int z = w.lo[2]; z <= w.hi[2]; ++z)
+    for (int y = w.lo[1]; y <= w.hi[1]; ++y)
+      for (int x = w.lo[0]; x <= w.hi[0]; ++x) {
+        const octomap::OcTreeKey k(x, y, z);
+        ASSERT_TRUE(layout.contains(k));
+        const uint32_t i = layout.index(k);
+        ASSERT_LT(i, padded);
+        ASSERT_TRUE(seen.insert(i).second) << "two keys share index " << i;
+        ASSERT_TRUE(layout.key_of(i / 16, i % 16) == k) << x << " " << y << " " << z;
+      }
+  EXPECT_FALSE(layout.contains(octomap::OcTreeKey(4, 1000, 65535)));
+  EXPECT_FALSE(layout.contains(octomap::OcTreeKey(5, 1009, 65535)));
+}
+
+std::set<std::tuple<int, int, int, int>> as_set(const VoxelList& l) {
+  std::set<std::tuple<int, int, int, int>> s;
+  for (const auto& v : l) s.insert({v.x, v.y, v.z, v.state});
+  return s;
+}
+
+// One scan from `origin`: rays along the axes and axis planes both ways, diagonals, and
+// random directions, of lengths from sub-voxel to `reach` metres; ends on voxel borders too.
+std::vector<octomap::point3d> scan_points(const octomap::point3d& origin, float reach, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), len(0.01f, 1.0f);
+  std::vector<octomap::point3d> pts;
+  for (int i = 0; i < 6000; ++i) {
+    octomap::point3d d(u(rng), u(rng), u(rng));
+    switch (i % 6) {
+      case 0: d = octomap::point3d(0, 0, 0), d(i / 6 % 3) = (i / 18) % 2 ? 1.0f : -1.0f; break;  // along an axis
+      case 1: d(i / 6 % 3) = 0.0f; break;                                                        // in an axis plane
+      case 2: d = octomap::point3d(u(rng) < 0 ? -1.0f : 1.0f, u(rng) < 0 ? -1.0f : 1.0f, u(rng) < 0 ? -1.0f : 1.0f); break;
+      default: break;
+    }
+    if (d.norm() == 0.0f) continue;
+    octomap::point3d e = origin + d.normalized() * (reach * len(rng));
+    if (i % 7 == 0) e = octomap::point3d(std::round(e.x() * 10) / 10, std::round(e.y() * 10) / 10, e.z());  // on borders
+    pts.push_back(e);
+  }
+  return pts;
+}
+
+void expect_grid_equals_cpu(const octomap::point3d& origin, float reach, uint64_t grid_bytes, unsigned threads,
+                            bool expect_split) {
+  const double res = 0.1;
+  auto reference = make_cpu_backend(res);
+  auto grid = make_cpu_grid_backend({res, grid_bytes, threads});
+  for (uint32_t seed = 1; seed <= 3; ++seed) {
+    PrepareReport rep;
+    const RayBatch b = prepare_scan(origin, scan_points(origin, reach, seed), seed == 2 ? reach * 0.5 : -1.0, res, rep);
+    ASSERT_TRUE(rep.origin_ok);
+    ASSERT_GT(b.ends.size(), 1000u);
+    VoxelList a, g;
+    ShootStats sa, sg;
+    reference->shoot(b, Traversal::kOctomap, a, sa);
+    grid->shoot(b, Traversal::kOctomap, g, sg);
+    EXPECT_EQ(sg.windows > 1, expect_split) << "windows " << sg.windows << " seed " << seed << " origin " << origin << " box " << b.keys.voxel_count();
+    ASSERT_EQ(as_set(g), as_set(a)) << "seed " << seed << " threads " << threads;
+    ASSERT_EQ(g.size(), a.size()) << "a key listed twice";
+  }
+}
+
+TEST(CpuGridBackend, BrickedWalkEqualsCpuBackendInOneWindow) {
+  for (unsigned threads : {1u, 2u}) {
+    expect_grid_equals_cpu({0.05f, 0.05f, 0.05f}, 12.0f, 0, threads, false);   // origin at a voxel centre
+    expect_grid_equals_cpu({0.8f, -1.6f, 0.4f}, 9.0f, 0, threads, false);     // origin on brick borders
+    expect_grid_equals_cpu({3276.0f, -3276.0f, 3270.0f}, 6.0f, 0, threads, false);  // at the key range's edge
+  }
+}
+
+TEST(CpuGridBackend, BrickedWalkEqualsCpuBackendAcrossWindows) {
+  for (unsigned threads : {1u, 2u}) {
+    // 128 KiB: 512 K voxels, so a ray space of ~240^3 voxels is cut into many windows, most of
+    // them without the origin (walked with a bounds test per voxel), one with it.
+    expect_grid_equals_cpu({0.05f, 0.05f, 0.05f}, 12.0f, 128u << 10, threads, true);
+    expect_grid_equals_cpu({3276.0f, -3276.0f, 3270.0f}, 6.0f, 16u << 10, threads, true);
+  }
+}
+
+}  // namespace
+}  // namespace ort
