@@ -7,24 +7,10 @@
 
 namespace ort {
 namespace {
-constexpr int kTreeMaxVal = 32768;  // OctoMap depth 16
-
 bool finite(const octomap::point3d& p) {
   return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z());
 }
 }  // namespace
-
-bool coord_to_key_checked(const octomap::point3d& p, double resolution, octomap::OcTreeKey& key) {
-  // Same expression as OcTreeBaseImpl::coordToKeyChecked: floor(resolution_factor * coord)
-  // in double, resolution_factor = 1.0 / resolution.
-  const double factor = 1.0 / resolution;
-  for (int i = 0; i < 3; ++i) {
-    const double scaled = std::floor(factor * double(p(i)));
-    if (!(scaled >= -kTreeMaxVal && scaled < kTreeMaxVal)) return false;  // also rejects NaN
-    key[i] = static_cast<octomap::key_type>(int(scaled) + kTreeMaxVal);
-  }
-  return true;
-}
 
 namespace {
 

@@ -74,6 +74,30 @@ TEST(CoordToKey, MatchesOctomap) {
   }
 }
 
+// The inline floor (truncation, one down when above): voxel borders on both sides of zero,
+// -0.0, the key range's edges, non-finite values, several resolutions.
+TEST(CoordToKey, MatchesOctomapOnBordersAndRangeEdges) {
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  for (double res : {0.1, 0.05, 0.2, 0.3, 1.0}) {
+    octomap::OcTree tree(res);
+    const float edge = float(32768 * res);
+    std::vector<float> values = {0.0f, -0.0f, inf, -inf, nan, edge, -edge, std::nextafter(edge, 0.0f),
+                                 std::nextafter(-edge, 0.0f), std::nextafter(-edge, -2 * edge), 1e-30f, -1e-30f};
+    for (int k = -300; k <= 300; ++k) {
+      const float border = float(k * res);
+      for (float v : {border, std::nextafter(border, inf), std::nextafter(border, -inf)}) values.push_back(v);
+    }
+    for (float v : values) {
+      const octomap::point3d p(v, -v, 0.5f * v);
+      octomap::OcTreeKey a, b;
+      const bool ok_a = tree.coordToKeyChecked(p, a);
+      const bool ok_b = coord_to_key_checked(p, res, b);
+      ASSERT_EQ(ok_a, ok_b) << p << " res " << res;
+      if (ok_a) ASSERT_TRUE(a == b) << p << " res " << res;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ort
 
