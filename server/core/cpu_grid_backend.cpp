@@ -12,11 +12,13 @@
 #include <vector>
 
 #include "core/brick_layout.h"
+#include "core/grid_marker.h"
 #include "core/clock.h"
 #include "core/exact_traversal.h"
 #include "core/octomap_ray_walk.h"
 #include "core/prepare_scan.h"
 #include "core/ray_space.h"
+#include "core/window_walk_avx2.h"
 
 namespace ort {
 namespace {
@@ -44,29 +46,6 @@ struct GridMemory {
 
  private:
   uint32_t* words_;
-};
-
-// Sets 2-bit states in the grid and lists each word the first time it becomes non-zero.
-// `shared`: other threads mark the same grid (atomic OR); otherwise plain loads and stores.
-struct GridMarker {
-  uint32_t* grid;
-  std::vector<uint32_t>& touched;
-  bool shared;
-
-  [[gnu::always_inline]] void mark(uint32_t idx, uint32_t bits) {
-    const uint32_t word = idx / kVoxelsPerWord;
-    const uint32_t mask = bits << (2 * (idx % kVoxelsPerWord));
-    uint32_t& cell = grid[word];
-    // Most visits near the sensor find their bit set already: read before the atomic.
-    const uint32_t old = std::atomic_ref<uint32_t>(cell).load(std::memory_order_relaxed);
-    if ((old & mask) == mask) return;
-    if (shared) {
-      if (std::atomic_ref<uint32_t>(cell).fetch_or(mask, std::memory_order_relaxed) == 0) touched.push_back(word);
-    } else {
-      std::atomic_ref<uint32_t>(cell).store(old | mask, std::memory_order_relaxed);
-      if (old == 0) touched.push_back(word);
-    }
-  }
 };
 
 // walk_octomap_ray_steps' stepper for a ray whose origin lies in the window: keeps the voxel
@@ -108,11 +87,13 @@ class CpuGridBackend final : public RayBackend {
       : res_(o.resolution),
         threads_(o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency())),
         words_((o.grid_budget_bytes ? o.grid_budget_bytes : (256ull << 20)) / 4),
+        simd_(o.simd && cpu_has_avx2()),
         grid_(words_) {}
 
   BackendKind kind() const override { return BackendKind::kCpuGrid; }
   std::string device_name() const override {
-    return "CPU, " + std::to_string(threads_) + " threads (2-bit grid, " + std::to_string(words_ * 4 >> 20) + " MiB)";
+    return "CPU, " + std::to_string(threads_) + " threads (2-bit grid, " + std::to_string(words_ * 4 >> 20) + " MiB" +
+           (simd_ ? ", AVX2 walk)" : ")");
   }
 
   void shoot(const RayBatch& batch, Traversal mode, VoxelList& out, ShootStats& stats) override {
@@ -131,7 +112,11 @@ class CpuGridBackend final : public RayBackend {
         const size_t begin = batch.ends.size() * t / n_threads, end = batch.ends.size() * (t + 1) / n_threads;
         touched[t].clear();
         GridMarker marker{grid_.data(), touched[t], n_threads > 1};
-        for (size_t i = begin; i < end; ++i) shoot_ray(batch, batch.ends[i], mode, layout, marker);
+        if (mode == Traversal::kOctomap && simd_ && layout.contains(batch.origin_key)) {
+          walk_rays_avx2(batch, begin, end, layout, res_, marker);
+        } else {
+          for (size_t i = begin; i < end; ++i) shoot_ray(batch, batch.ends[i], mode, layout, marker);
+        }
       });
       stats.times.shoot_ms += ms_since(t_shoot);
       const auto t_compact = Clock::now();
@@ -218,6 +203,7 @@ class CpuGridBackend final : public RayBackend {
   double res_;
   unsigned threads_;
   uint64_t words_;
+  bool simd_;  // OctoMap walks in AVX2 lanes (window_walk_avx2.h) where the CPU has AVX2
   GridMemory grid_;
 };
 

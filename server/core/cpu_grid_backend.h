@@ -15,6 +15,7 @@ struct CpuGridOptions {
   double resolution = 0.1;
   uint64_t grid_budget_bytes = 256ull << 20;  // the persistent grid; 0 = 256 MiB
   unsigned threads = 0;                       // 0 = hardware threads
+  bool simd = true;                           // AVX2 ray walk where the CPU has it (false: scalar only)
 };
 
 std::unique_ptr<RayBackend> make_cpu_grid_backend(const CpuGridOptions& opts);

@@ -14,6 +14,40 @@
 
 namespace ort {
 
+// The DDA's start, as computeRayKeys sets it up: the step sign of each axis, the ray
+// parameter of the first voxel border along each axis (t_max), the parameter between borders
+// (t_delta), and the segment's float length (the walk stops past it).
+struct OctomapRayStart {
+  int step[3];
+  double t_max[3];
+  double t_delta[3];
+  float length;
+};
+
+inline OctomapRayStart octomap_ray_start(const octomap::point3d& origin, const octomap::point3d& end,
+                                         const octomap::OcTreeKey& key_origin, double resolution) {
+  constexpr int kTreeMaxVal = 32768;
+  OctomapRayStart r;
+  octomap::point3d direction = end - origin;
+  r.length = (float)direction.norm();
+  direction /= r.length;
+  for (unsigned i = 0; i < 3; ++i) {
+    if (direction(i) > 0.0) r.step[i] = 1;
+    else if (direction(i) < 0.0) r.step[i] = -1;
+    else r.step[i] = 0;
+    if (r.step[i] != 0) {
+      double voxel_border = (double((int)key_origin[i] - kTreeMaxVal) + 0.5) * resolution;  // keyToCoord
+      voxel_border += (float)(r.step[i] * resolution * 0.5);
+      r.t_max[i] = (voxel_border - origin(i)) / direction(i);
+      r.t_delta[i] = resolution / std::fabs(direction(i));
+    } else {
+      r.t_max[i] = std::numeric_limits<double>::max();
+      r.t_delta[i] = std::numeric_limits<double>::max();
+    }
+  }
+  return r;
+}
+
 // The DDA itself, over a "stepper" that owns the current voxel. It calls
 //   s.start(sx, sy, sz)        once, with the step sign of each axis (-1, 0, 1);
 //   s.step_x() / step_y() / step_z() after each step along that axis; false stops the walk
@@ -25,33 +59,13 @@ namespace ort {
 template <class Stepper>
 inline void walk_octomap_ray_steps(const octomap::point3d& origin, const octomap::point3d& end,
                                    const octomap::OcTreeKey& key_origin, double resolution, Stepper& s) {
-  constexpr int kTreeMaxVal = 32768;
-  octomap::point3d direction = end - origin;
-  const float length = (float)direction.norm();
-  direction /= length;
-
-  int step[3];
-  double t_max[3];
-  double t_delta[3];
-  for (unsigned i = 0; i < 3; ++i) {
-    if (direction(i) > 0.0) step[i] = 1;
-    else if (direction(i) < 0.0) step[i] = -1;
-    else step[i] = 0;
-    if (step[i] != 0) {
-      double voxel_border = (double((int)key_origin[i] - kTreeMaxVal) + 0.5) * resolution;  // keyToCoord
-      voxel_border += (float)(step[i] * resolution * 0.5);
-      t_max[i] = (voxel_border - origin(i)) / direction(i);
-      t_delta[i] = resolution / std::fabs(direction(i));
-    } else {
-      t_max[i] = std::numeric_limits<double>::max();
-      t_delta[i] = std::numeric_limits<double>::max();
-    }
-  }
-  s.start(step[0], step[1], step[2]);
+  const OctomapRayStart r = octomap_ray_start(origin, end, key_origin, resolution);
+  const float length = r.length;
+  s.start(r.step[0], r.step[1], r.step[2]);
   // The loop keeps its state in registers (OctoMap indexes arrays by the stepping axis, a
   // chain through memory on every step); the comparisons and operations are the same.
-  double tx = t_max[0], ty = t_max[1], tz = t_max[2];
-  const double dx = t_delta[0], dy = t_delta[1], dz = t_delta[2];
+  double tx = r.t_max[0], ty = r.t_max[1], tz = r.t_max[2];
+  const double dx = r.t_delta[0], dy = r.t_delta[1], dz = r.t_delta[2];
   while (true) {
     if (tx < ty) {
       if (tx < tz) {

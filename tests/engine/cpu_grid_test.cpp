@@ -2,7 +2,7 @@
 // index kept per axis, the window's bounds tested only on the stepping axis) against the cpu
 // back end (OctoMap's computeRayKeys + a hash set), on whole scans: rays along each axis, in
 // the axis planes, across brick and window borders, at the key range's edges, one thread
-// (plain stores) and two (atomic OR).
+// (plain stores) and two (atomic OR), scalar and AVX2.
 #include <random>
 #include <set>
 #include <tuple>
@@ -13,6 +13,7 @@
 #include "core/cpu_backend.h"
 #include "core/cpu_grid_backend.h"
 #include "core/prepare_scan.h"
+#include "core/window_walk_avx2.h"
 
 namespace ort {
 namespace {
@@ -68,10 +69,10 @@ std::vector<octomap::point3d> scan_points(const octomap::point3d& origin, float 
 }
 
 void expect_grid_equals_cpu(const octomap::point3d& origin, float reach, uint64_t grid_bytes, unsigned threads,
-                            bool expect_split) {
+                            bool expect_split, bool simd) {
   const double res = 0.1;
   auto reference = make_cpu_backend(res);
-  auto grid = make_cpu_grid_backend({res, grid_bytes, threads});
+  auto grid = make_cpu_grid_backend({res, grid_bytes, threads, simd});
   for (uint32_t seed = 1; seed <= 3; ++seed) {
     PrepareReport rep;
     const RayBatch b = prepare_scan(origin, scan_points(origin, reach, seed), seed == 2 ? reach * 0.5 : -1.0, res, rep);
@@ -82,26 +83,38 @@ void expect_grid_equals_cpu(const octomap::point3d& origin, float reach, uint64_
     reference->shoot(b, Traversal::kOctomap, a, sa);
     grid->shoot(b, Traversal::kOctomap, g, sg);
     EXPECT_EQ(sg.windows > 1, expect_split) << "windows " << sg.windows << " seed " << seed << " origin " << origin << " box " << b.keys.voxel_count();
-    ASSERT_EQ(as_set(g), as_set(a)) << "seed " << seed << " threads " << threads;
+    ASSERT_EQ(as_set(g), as_set(a)) << "seed " << seed << " threads " << threads << " simd " << simd;
     ASSERT_EQ(g.size(), a.size()) << "a key listed twice";
   }
 }
 
+// simd = true takes the AVX2 walk where this CPU has it (window_walk_avx2.h), false the scalar one.
 TEST(CpuGridBackend, BrickedWalkEqualsCpuBackendInOneWindow) {
-  for (unsigned threads : {1u, 2u}) {
-    expect_grid_equals_cpu({0.05f, 0.05f, 0.05f}, 12.0f, 0, threads, false);   // origin at a voxel centre
-    expect_grid_equals_cpu({0.8f, -1.6f, 0.4f}, 9.0f, 0, threads, false);     // origin on brick borders
-    expect_grid_equals_cpu({3276.0f, -3276.0f, 3270.0f}, 6.0f, 0, threads, false);  // at the key range's edge
+  for (bool simd : {false, true}) {
+    for (unsigned threads : {1u, 2u}) {
+      expect_grid_equals_cpu({0.05f, 0.05f, 0.05f}, 12.0f, 0, threads, false, simd);  // origin at a voxel centre
+      expect_grid_equals_cpu({0.8f, -1.6f, 0.4f}, 9.0f, 0, threads, false, simd);    // origin on brick borders
+      expect_grid_equals_cpu({3276.0f, -3276.0f, 3270.0f}, 6.0f, 0, threads, false, simd);  // at the key range's edge
+    }
   }
 }
 
 TEST(CpuGridBackend, BrickedWalkEqualsCpuBackendAcrossWindows) {
-  for (unsigned threads : {1u, 2u}) {
-    // 128 KiB: 512 K voxels, so a ray space of ~240^3 voxels is cut into many windows, most of
-    // them without the origin (walked with a bounds test per voxel), one with it.
-    expect_grid_equals_cpu({0.05f, 0.05f, 0.05f}, 12.0f, 128u << 10, threads, true);
-    expect_grid_equals_cpu({3276.0f, -3276.0f, 3270.0f}, 6.0f, 16u << 10, threads, true);
+  for (bool simd : {false, true}) {
+    for (unsigned threads : {1u, 2u}) {
+      // 128 KiB: 512 K voxels, so a ray space of ~240^3 voxels is cut into many windows, most of
+      // them without the origin (walked with a bounds test per voxel), one with it.
+      expect_grid_equals_cpu({0.05f, 0.05f, 0.05f}, 12.0f, 128u << 10, threads, true, simd);
+      expect_grid_equals_cpu({3276.0f, -3276.0f, 3270.0f}, 6.0f, 16u << 10, threads, true, simd);
+    }
   }
+}
+
+TEST(CpuGridBackend, SaysWhetherItWalksInAvx2) {
+  auto simd = make_cpu_grid_backend({0.1, 1u << 20, 1, true});
+  auto scalar = make_cpu_grid_backend({0.1, 1u << 20, 1, false});
+  EXPECT_EQ(simd->device_name().find("AVX2") != std::string::npos, cpu_has_avx2());
+  EXPECT_EQ(scalar->device_name().find("AVX2"), std::string::npos);
 }
 
 }  // namespace

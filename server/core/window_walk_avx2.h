@@ -1,0 +1,28 @@
+// OctoMap's DDA on four rays at once (AVX2, 64-bit lanes), for the cpu-grid back end.
+//
+// Why: the scalar walk's axis choice is a data-dependent branch that mispredicts often, and
+// after the bricked grid the DDA itself was ~75 % of the walk. Here each lane takes the same
+// double comparisons and additions as octomap_ray_walk.h (the axis choice as masks, the same
+// three stop tests), so each ray visits the same keys; only the order of the marks differs,
+// which the 2-bit OR does not see. Used only where the CPU says it has AVX2 (checked at run
+// time; the build assumes nothing beyond x86-64).
+#pragma once
+
+#include <cstddef>
+
+#include "core/brick_layout.h"
+#include "core/grid_marker.h"
+#include "core/ray_batch.h"
+
+namespace ort {
+
+// True when this CPU runs AVX2 (and the build targets x86-64).
+bool cpu_has_avx2();
+
+// Walks rays [begin, end) of `b`, whose origin key must lie in the layout's window: marks the
+// origin voxel and every free voxel of each ray inside the window, and each measured end
+// inside the window as occupied, as the scalar walk does ray by ray.
+void walk_rays_avx2(const RayBatch& b, size_t begin, size_t end, const BrickLayout& layout, double resolution,
+                    GridMarker& marker);
+
+}  // namespace ort
