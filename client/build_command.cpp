@@ -46,7 +46,8 @@ void write_map(const octomap::OcTree& tree, const std::string& path) {
 }
 
 int run_build(const BuildArgs& a) {
-  const EngineOptions opts = to_engine_options(a.engine);
+  EngineOptions opts = to_engine_options(a.engine);
+  opts.shoots_beside_apply = !a.no_pipeline;
   const auto t_load = std::chrono::steady_clock::now();
   const ScanSet set = a.input == "synthetic" ? make_synthetic_rooms() : load_scan_graph(a.input);
   const double load_ms =
@@ -57,7 +58,7 @@ int run_build(const BuildArgs& a) {
             << set.name << " (" << load_ms << " ms)\n"
             << "  back end " << to_string(engine.backend().kind()) << " on " << engine.backend().device_name()
             << ", traversal " << to_string(opts.traversal) << ", resolution " << opts.resolution
-            << " m, max range " << opts.max_range << "\n";
+            << " m, max range " << opts.max_range << ", octree threads " << engine.octree_threads() << "\n";
 
   auto tree = engine.make_tree();
   StageTimes total;
@@ -119,6 +120,9 @@ int run_build(const BuildArgs& a) {
                  (unsigned long long)prep_total.out_of_range, 32768 * opts.resolution);
   std::printf("  stage times:     prepare %.1f ms, upload %.1f ms, shoot %.1f ms, compact+readback %.1f ms, octree %.1f ms\n",
               total.prepare_ms, total.upload_ms, total.shoot_ms, total.compact_ms, total.octree_ms);
+  if (total.compact_gpu_ms + total.readback_copy_ms + total.unpack_ms > 0)
+    std::printf("  compact+readback: GPU compaction %.1f ms, copy to host memory %.1f ms, into the voxel list %.1f ms\n",
+                total.compact_gpu_ms, total.readback_copy_ms, total.unpack_ms);
   std::printf("  total:           %.1f ms, %.0f points/s, %llu voxel updates, %llu windows\n", wall_ms,
               wall_ms > 0 ? prep_total.points_in / (wall_ms / 1000.0) : 0.0, (unsigned long long)voxels,
               (unsigned long long)windows);

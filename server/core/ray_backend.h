@@ -25,9 +25,16 @@ struct StageTimes {
   double shoot_ms = 0;     // ray shooting + 2-bit consistent states
   double compact_ms = 0;   // compaction of touched words + readback of the voxel list
   double octree_ms = 0;    // CPU octree update
+  // Parts of compact_ms on the GPU back ends (not added again by total_ms): the compaction
+  // pass on the device's clock, the copy of the voxel list into host memory (a submission of
+  // its own on discrete GPUs), and the host's copy of it into the scan's VoxelList.
+  double compact_gpu_ms = 0;
+  double readback_copy_ms = 0;
+  double unpack_ms = 0;
   void add(const StageTimes& o) {
     prepare_ms += o.prepare_ms; upload_ms += o.upload_ms; shoot_ms += o.shoot_ms;
     compact_ms += o.compact_ms; octree_ms += o.octree_ms;
+    compact_gpu_ms += o.compact_gpu_ms; readback_copy_ms += o.readback_copy_ms; unpack_ms += o.unpack_ms;
   }
   double total_ms() const { return prepare_ms + upload_ms + shoot_ms + compact_ms + octree_ms; }
 };

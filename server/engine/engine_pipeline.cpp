@@ -10,17 +10,18 @@ namespace {
 
 void insert_sequentially(MapEngine& engine, size_t count, const ScanInputSource& source, octomap::OcTree& tree,
                          const AppliedScanSink& sink) {
+  ShotScan shot;  // one for all scans: its voxel list's storage is reused
   for (size_t i = 0; i < count; ++i) {
     const PosedScanInput in = source(i);
-    ShotScan shot;
     engine.insert_posed(in.pose, in.origin, in.sensor_points, tree, shot);
     if (sink) sink(i, shot);
   }
 }
 
-// Two ShotScan buffers: stage 1 fills slot i % 2 while stage 2 applies the other. Stage 1
-// may shoot scan i once scan i-2 was applied (its buffer is free again), which bounds the
-// scans shot but not yet applied to one beyond the one being applied.
+// Two ShotScan buffers: stage 1 fills slot i % 2 (shoot_posed resets it, keeping its voxel
+// list's storage) while stage 2 applies the other. Stage 1 may shoot scan i once scan i-2
+// was applied (its buffer is free again), which bounds the scans shot but not yet applied to
+// one beyond the one being applied.
 class TwoStageRun {
  public:
   TwoStageRun(MapEngine& engine, octomap::OcTree& tree, const AppliedScanSink& sink)
@@ -33,7 +34,6 @@ class TwoStageRun {
       for (size_t i = 0; i < count; ++i) {
         if (!wait_for_free_slot(i)) break;  // stage 2 failed: its error is rethrown below
         const PosedScanInput in = source(i);
-        slots_[i % 2] = ShotScan{};
         engine_.shoot_posed(in.pose, in.origin, in.sensor_points, engine_.options().max_range, slots_[i % 2]);
         publish(i);
       }

@@ -6,15 +6,30 @@
 #include "core/map_frame.h"
 
 #include "core/ray_tiles.h"
+#include "octree/worker_pool.h"
 
 namespace ort {
+
+namespace {
+
+bool on_device(BackendKind k) { return k == BackendKind::kVulkan || k == BackendKind::kRt; }
+
+}  // namespace
 
 MapEngine::MapEngine(const EngineOptions& opts, const Log& log) : opts_(opts), octree_stage_(opts.octree) {
   opts_.backend.resolution = opts.resolution;
   opts_.backend.max_range = opts.max_range;
   opts_.backend.traversal = opts.traversal;
   backend_ = make_backend(opts_.backend, log);
+  const unsigned hardware = resolve_thread_count(0);
+  if (opts_.shoots_beside_apply && opts_.octree.threads == 0 && on_device(backend_->kind()) &&
+      hardware >= kSpareCoreAbove) {
+    opts_.octree.threads = hardware - 1;
+    octree_stage_ = OctreeStage(opts_.octree);  // its threads start on first use
+  }
 }
+
+unsigned MapEngine::octree_threads() const { return resolve_thread_count(opts_.octree.threads); }
 
 std::unique_ptr<octomap::OcTree> MapEngine::make_tree() const {
   auto tree = std::make_unique<octomap::OcTree>(opts_.resolution);
@@ -46,7 +61,7 @@ void refuse(ShotScan& out, ShotRefusal why, std::string detail) {
 
 void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range,
                       ShotScan& out) {
-  out = ShotScan{};
+  out.reset();
   const auto t0 = SteadyClock::now();
   const RayBatch batch = prepare_scan(origin, points, max_range, opts_.resolution, out.prepare, opts_.octree.threads);
   out.shoot.times.prepare_ms = ms_since(t0);
@@ -80,7 +95,7 @@ void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::p
 void MapEngine::shoot_posed(const octomap::pose6d& pose, const octomap::point3d& origin,
                             std::span<const octomap::point3d> sensor_points, double max_range, ShotScan& out) {
   if (backend_->prepares_on_device()) {
-    out = ShotScan{};
+    out.reset();
     // The device shoots what fits one window plan; a far-flung scan comes back declined and
     // takes the CPU path below (tiles along the rays, the per-scan limits), as shoot() does.
     backend_->shoot_posed({&pose, origin, sensor_points, max_range, kTiledAbove, opts_.max_scan_walk_keys},

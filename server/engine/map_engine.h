@@ -33,7 +33,17 @@ struct EngineOptions {
   // a scan above it is refused before any ray is shot. 0: no limit. The default is 2.5x a
   // 4M-point scan of 1000-voxel rays; far-flung but small scans stay far below it.
   uint64_t max_scan_walk_keys = 10'000'000'000ull;
+  // Set by callers that shoot the next scan on another thread while apply() runs
+  // (engine/engine_pipeline.h). With a device back end (vulkan, rt), octree.threads = 0 and
+  // at least kSpareCoreAbove hardware threads, the octree stage then keeps one hardware
+  // thread free for that stage-1 thread: with a worker on every core, stage 1 preempts one
+  // and the others wait for it at each of the stage's joins (docs/BENCHMARKS.md, issue 12).
+  bool shoots_beside_apply = false;
 };
+
+// Fewer hardware threads than this: every one goes to the octree stage (on a few cores one
+// worker less costs the stage more than the preemption does).
+inline constexpr unsigned kSpareCoreAbove = 8;
 
 // Why shoot() refused a scan whose origin was fine (the scan is then not shot at all).
 enum class ShotRefusal {
@@ -52,6 +62,16 @@ struct ShotScan {
   uint64_t tiles = 0;              // path-following tiles (0: the scan's box was shot whole)
   ShotRefusal refusal = ShotRefusal::kNone;
   std::string refusal_detail;      // says why, with the numbers
+
+  // Ready for the next scan, as a fresh ShotScan but keeping the voxel list's storage: a
+  // large scan's list (campus: 60 MB) allocated anew each scan costs a page fault every 4 KiB
+  // (the allocator returns such blocks to the system when they are freed).
+  void reset() {
+    VoxelList keep = std::move(voxels);
+    keep.clear();
+    *this = ShotScan{};
+    voxels = std::move(keep);
+  }
 };
 
 class MapEngine {
@@ -90,6 +110,8 @@ class MapEngine {
   }
 
   const EngineOptions& options() const { return opts_; }
+  // The batched octree stage's threads (0 in opts_.octree: all hardware threads).
+  unsigned octree_threads() const;
   const RayBackend& backend() const { return *backend_; }
 
   // A scan whose widened key box holds more voxels than this is shot tile by tile

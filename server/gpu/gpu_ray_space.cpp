@@ -192,13 +192,14 @@ void GpuRaySpace::shoot_window(const RayBatch& batch, uint32_t ray_count, const 
   const double gpu_compact = stamps_.elapsed_ms(kStampShot, kStampCompacted);
   stats.times.upload_ms += gpu_upload;
   stats.times.compact_ms += gpu_compact;
+  stats.times.compact_gpu_ms += gpu_compact;
   stats.times.shoot_ms += std::max(0.0, wall_ms - gpu_upload - gpu_compact);
 
   const auto t_read = Clock::now();
   const Counters first = read_counters();
   stats.walk_overruns += first.walk_overruns;  // reported by the engine's callers; must stay 0
-  read_voxels(first.emitted_count, out);
-  const uint64_t compacted = compact_rest(cp, first, out);
+  read_voxels(first.emitted_count, out, stats.times);
+  const uint64_t compacted = compact_rest(cp, first, out, stats.times);
   stats.times.compact_ms += ms_since(t_read);
   stats.words_touched += first.touched_count;
   stats.words_read_back += compacted;
@@ -230,7 +231,7 @@ void GpuRaySpace::record_first_pass(VkCommandBuffer cmd, const ShootPush& push, 
 
 // Rare: more touched words than one compaction can emit into the output. Returns the words
 // compacted in this window, as the counters count them.
-uint64_t GpuRaySpace::compact_rest(CompactPush cp, const Counters& first, VoxelList& out) {
+uint64_t GpuRaySpace::compact_rest(CompactPush cp, const Counters& first, VoxelList& out, StageTimes& times) {
   const uint32_t touched = first.touched_count;
   uint64_t compacted = first.words_compacted;
   for (uint64_t begin = cp.chunk_words; begin < touched; begin += cp.chunk_words) {
@@ -244,7 +245,7 @@ uint64_t GpuRaySpace::compact_rest(CompactPush cp, const Counters& first, VoxelL
     runner_.submit_and_wait();
     const Counters& c = read_counters();
     compacted = c.words_compacted;
-    read_voxels(c.emitted_count, out);
+    read_voxels(c.emitted_count, out, times);
   }
   return compacted;
 }
@@ -269,10 +270,11 @@ const Counters& GpuRaySpace::read_counters() const {
 }
 
 // Appends the first `count` voxels of the output to `out`.
-void GpuRaySpace::read_voxels(uint32_t count, VoxelList& out) {
+void GpuRaySpace::read_voxels(uint32_t count, VoxelList& out, StageTimes& times) {
   if (count == 0) return;
   if (count > opts_.sizing.output_voxels) throw std::logic_error("GPU ray space: the voxel output overflowed");
   const size_t bytes = size_t(count) * sizeof(VoxelUpdate);
+  const auto t_copy = Clock::now();
   if (voxels_readback_) {
     VkCommandBuffer cmd = runner_.begin();
     const VkBufferCopy region{0, 0, bytes};
@@ -281,11 +283,19 @@ void GpuRaySpace::read_voxels(uint32_t count, VoxelList& out) {
                        VK_ACCESS_HOST_READ_BIT);
     runner_.submit_and_wait();
   }
+  const auto t_unpack = Clock::now();
+  times.readback_copy_ms += ms_between(t_copy, t_unpack);
   const vk::Buffer& src = voxels_readback_ ? voxels_readback_ : voxels_;
   src.invalidate();
-  const size_t old = out.size();
-  out.resize(old + count);
-  std::memcpy(out.data() + old, src.mapped(), bytes);
+  // Room for this list and a quarter more: the caller keeps the list's storage from scan to
+  // scan (ShotScan::reset), and a scan only a little longer than the last would otherwise
+  // move to fresh memory, where every 4 KiB page of a large list faults on first touch.
+  const size_t need = out.size() + count;
+  if (need > out.capacity()) out.reserve(need + need / 4);
+  // Appended without value-initialising first (resize would write every byte twice).
+  const VoxelUpdate* voxels = src.as<VoxelUpdate>();
+  out.insert(out.end(), voxels, voxels + count);
+  times.unpack_ms += ms_since(t_unpack);
 }
 
 }  // namespace ort::gpu

@@ -93,10 +93,10 @@ class GpuRaySpace {
                     ShootStats& stats);
   void record_first_pass(VkCommandBuffer cmd, const ShootPush& push, const RecordShoot& record_shoot,
                          const CompactPush& cp);
-  uint64_t compact_rest(CompactPush cp, const Counters& first, VoxelList& out);
+  uint64_t compact_rest(CompactPush cp, const Counters& first, VoxelList& out, StageTimes& times);
   void record_counters_readback(VkCommandBuffer cmd);
   const Counters& read_counters() const;
-  void read_voxels(uint32_t count, VoxelList& out);
+  void read_voxels(uint32_t count, VoxelList& out, StageTimes& times);
   ShootBuffers shoot_buffers() const;
 
   // Declared first: destroyed last, after every buffer and pipeline made from it.

@@ -4,12 +4,16 @@
 // inserted pipelined and one after the other, on the native grid walk and on Vulkan (with
 // its device preparation), with the batched octree stage; and errors in either stage stop
 // the run and reach the caller.
+#include <algorithm>
+#include <cstring>
 #include <stdexcept>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "engine/engine_pipeline.h"
+#include "octree/worker_pool.h"
 #include "scene/scan_set.h"
 #include "support/octomap_reference.h"
 #include "support/test_data.h"
@@ -38,6 +42,7 @@ EngineOptions engine_options(BackendKind kind) {
   o.resolution = 0.1;
   o.backend.kind = kind;
   o.octree.mode = OctreeUpdateMode::kBatched;
+  o.shoots_beside_apply = true;  // as bench and build set it when they pipeline
   return o;
 }
 
@@ -73,6 +78,59 @@ TEST_P(PipelinedInsertion, GivesTheSequentialTreeAndOctoMapsOnRealScans) {
 
 INSTANTIATE_TEST_SUITE_P(Backends, PipelinedInsertion, ::testing::Values(BackendKind::kCpuGrid, BackendKind::kVulkan),
                          [](const auto& info) { return info.param == BackendKind::kVulkan ? "vulkan" : "cpu_grid"; });
+
+// Stage 1 reuses a scan's ShotScan for a later scan (ShotScan::reset keeps the voxel list's
+// storage): each scan must come out as from a fresh ShotScan, whatever the one before left
+// there (a larger list, a refusal, counts), and its voxels must be those of OctoMap's own
+// walk (the cpu back end).
+TEST_P(PipelinedInsertion, AReusedShotScanGivesEachScanTheVoxelsOfAFreshOne) {
+  const std::string path = data_file("3dtk_dat/3dtk_3scans.graph");
+  ASSERT_FALSE(path.empty());
+  const ScanSet set = load_scan_graph(path);
+  ASSERT_EQ(set.scans.size(), 3u);
+  MapEngine engine(engine_options(GetParam()));
+  MapEngine reference(engine_options(BackendKind::kCpu));
+  const auto sorted = [](VoxelList v) {
+    std::sort(v.begin(), v.end(), [](const VoxelUpdate& a, const VoxelUpdate& b) {
+      return std::tie(a.z, a.y, a.x, a.state) < std::tie(b.z, b.y, b.x, b.state);
+    });
+    return v;
+  };
+  const auto same = [](const VoxelList& a, const VoxelList& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(VoxelUpdate)) == 0;
+  };
+  ShotScan reused;
+  for (size_t i : {0, 1, 2, 1, 0, 2}) {
+    const PosedScanInput in = inputs_of(set)(i);
+    reused.refusal = ShotRefusal::kTooMuchWork;  // left from an earlier scan
+    reused.occupied_voxels = 12345;
+    engine.shoot_posed(in.pose, in.origin, in.sensor_points, -1.0, reused);
+    ShotScan fresh, walked;
+    engine.shoot_posed(in.pose, in.origin, in.sensor_points, -1.0, fresh);
+    reference.shoot_posed(in.pose, in.origin, in.sensor_points, -1.0, walked);
+    EXPECT_EQ(reused.refusal, ShotRefusal::kNone) << "scan " << i;
+    EXPECT_EQ(reused.occupied_voxels, fresh.occupied_voxels) << "scan " << i;
+    EXPECT_EQ(reused.free_voxels, fresh.free_voxels) << "scan " << i;
+    EXPECT_GT(reused.voxels.size(), 10'000u) << "scan " << i;
+    EXPECT_TRUE(same(sorted(reused.voxels), sorted(fresh.voxels))) << "scan " << i;
+    EXPECT_TRUE(same(sorted(reused.voxels), sorted(walked.voxels))) << "scan " << i << ": not OctoMap's walk";
+  }
+}
+
+// Beside a device's stage 1 the octree stage leaves one hardware thread to it, on hosts with
+// enough of them; asked-for thread counts and the CPU back ends keep every thread.
+TEST(PipelinedInsertion, TheOctreeStageLeavesAThreadToADeviceStageOne) {
+  const unsigned hardware = resolve_thread_count(0);
+  const unsigned spared = hardware >= kSpareCoreAbove ? hardware - 1 : hardware;
+  EXPECT_EQ(MapEngine(engine_options(BackendKind::kVulkan)).octree_threads(), spared);
+  EXPECT_EQ(MapEngine(engine_options(BackendKind::kCpuGrid)).octree_threads(), hardware);
+  EngineOptions alone = engine_options(BackendKind::kVulkan);
+  alone.shoots_beside_apply = false;
+  EXPECT_EQ(MapEngine(alone).octree_threads(), hardware);
+  EngineOptions asked = engine_options(BackendKind::kVulkan);
+  asked.octree.threads = 3;
+  EXPECT_EQ(MapEngine(asked).octree_threads(), 3u);
+}
 
 // A small scene: a wall of points in front of the sensor.
 ScanSet small_scans(size_t n) {
