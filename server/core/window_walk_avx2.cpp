@@ -1,8 +1,8 @@
 #include "core/window_walk_avx2.h"
 
+#include <limits>
 #include <stdexcept>
 
-#include "core/octomap_ray_walk.h"
 #include "core/prepare_scan.h"
 
 #if defined(__x86_64__)
@@ -23,53 +23,118 @@ struct alignas(32) Lanes {
   int64_t x[4], y[4], z[4], sx[4], sy[4], sz[4], x_out[4], y_out[4], z_out[4], ex[4], ey[4], ez[4], active[4];
 };
 
+// The DDA's start (octomap_ray_start) of up to four rays, computed in AVX2 lanes with the
+// same IEEE operations in the same order (float difference, float squared norm, double sqrt
+// cast to float, float division, double border/difference/division), so bit for bit the
+// scalar start: the start's seven divisions a ray were a quarter of the walk's time.
+struct alignas(32) StartBlock {
+  double t_max[3][4], t_delta[3][4], length[4];
+  int64_t step[3][4], end_key[3][4];
+  int count = 0, next = 0;
+};
+
 // Feeds the lanes ray after ray; marks what a ray needs beyond its walk (its measured end,
-// its origin voxel) as it is loaded. Rays inside one voxel only mark their end.
+// its origin voxel) as it is taken. Rays inside one voxel only mark their end.
 class RayFeed {
  public:
   RayFeed(const RayBatch& b, size_t begin, size_t end, const BrickLayout& layout, double res, GridMarker& m)
       : b_(b), next_(begin), end_(end), layout_(layout), res_(res), marker_(m) {
+    constexpr int kTreeMaxVal = 32768;
     const KeyBox& w = layout.window();
-    for (int i = 0; i < 3; ++i) origin_[i] = b.origin_key[i] - w.lo[i], extent_[i] = layout.extent(i);
+    for (int i = 0; i < 3; ++i) {
+      origin_[i] = b.origin_key[i] - w.lo[i], extent_[i] = layout.extent(i);
+      // octomap_ray_start's voxel border for a positive and a negative step (the origin key is
+      // the same for every ray of the batch).
+      const double centre = (double((int)b.origin_key[i] - kTreeMaxVal) + 0.5) * res;
+      border_up_[i] = centre + (float)(1 * res * 0.5);
+      border_down_[i] = centre + (float)(-1 * res * 0.5);
+    }
     origin_index_ = layout.x_offsets()[origin_[0]] + layout.y_offsets()[origin_[1]] + layout.z_offsets()[origin_[2]];
   }
 
   // Loads the next ray that walks at least one step into lane l; false (lane idle) when none is left.
-  bool load(Lanes& L, int l) {
-    while (next_ < end_) {
-      const RayEnd& e = b_.ends[next_++];
-      const octomap::point3d end(e.x, e.y, e.z);
-      octomap::OcTreeKey end_key;
-      coord_to_key_checked(end, res_, end_key);  // prepare_scan kept only in-range ends
-      if ((e.flags & kRayEndOccupied) && layout_.contains(end_key)) marker_.mark(layout_.index(end_key), kStateOccupied);
-      if (end_key == b_.origin_key) continue;
-      marker_.mark(origin_index_, kStateFree);
-      const OctomapRayStart r = octomap_ray_start(b_.origin, end, b_.origin_key, res_);
-      L.tx[l] = r.t_max[0], L.ty[l] = r.t_max[1], L.tz[l] = r.t_max[2];
-      L.dx[l] = r.t_delta[0], L.dy[l] = r.t_delta[1], L.dz[l] = r.t_delta[2];
-      L.length[l] = double(r.length);
-      L.x[l] = origin_[0], L.y[l] = origin_[1], L.z[l] = origin_[2];
-      L.sx[l] = r.step[0], L.sy[l] = r.step[1], L.sz[l] = r.step[2];
-      L.x_out[l] = r.step[0] > 0 ? extent_[0] : -1;
-      L.y_out[l] = r.step[1] > 0 ? extent_[1] : -1;
-      L.z_out[l] = r.step[2] > 0 ? extent_[2] : -1;
-      const KeyBox& w = layout_.window();
-      L.ex[l] = end_key[0] - w.lo[0], L.ey[l] = end_key[1] - w.lo[1], L.ez[l] = end_key[2] - w.lo[2];
-      L.active[l] = -1;
-      return true;
+  __attribute__((target("avx2"))) bool load(Lanes& L, int l) {
+    if (block_.next == block_.count && !fill_block()) {
+      L.active[l] = 0;
+      return false;
     }
-    L.active[l] = 0;
-    return false;
+    const int r = block_.next++;
+    L.tx[l] = block_.t_max[0][r], L.ty[l] = block_.t_max[1][r], L.tz[l] = block_.t_max[2][r];
+    L.dx[l] = block_.t_delta[0][r], L.dy[l] = block_.t_delta[1][r], L.dz[l] = block_.t_delta[2][r];
+    L.length[l] = block_.length[r];
+    L.x[l] = origin_[0], L.y[l] = origin_[1], L.z[l] = origin_[2];
+    L.sx[l] = block_.step[0][r], L.sy[l] = block_.step[1][r], L.sz[l] = block_.step[2][r];
+    L.x_out[l] = block_.step[0][r] > 0 ? extent_[0] : -1;
+    L.y_out[l] = block_.step[1][r] > 0 ? extent_[1] : -1;
+    L.z_out[l] = block_.step[2][r] > 0 ? extent_[2] : -1;
+    L.ex[l] = block_.end_key[0][r], L.ey[l] = block_.end_key[1][r], L.ez[l] = block_.end_key[2][r];
+    L.active[l] = -1;
+    return true;
   }
 
  private:
+  // Takes up to four rays that leave the origin voxel and computes their starts.
+  __attribute__((target("avx2"))) bool fill_block() {
+    alignas(16) float ends[3][4];
+    int n = 0;
+    const KeyBox& w = layout_.window();
+    while (n < 4 && next_ < end_) {
+      const RayEnd& e = b_.ends[next_++];
+      octomap::OcTreeKey end_key;
+      coord_to_key_checked(octomap::point3d(e.x, e.y, e.z), res_, end_key);  // prepare_scan kept only in-range ends
+      if ((e.flags & kRayEndOccupied) && layout_.contains(end_key)) marker_.mark(layout_.index(end_key), kStateOccupied);
+      if (end_key == b_.origin_key) continue;
+      marker_.mark(origin_index_, kStateFree);
+      ends[0][n] = e.x, ends[1][n] = e.y, ends[2][n] = e.z;
+      for (int i = 0; i < 3; ++i) block_.end_key[i][n] = end_key[i] - w.lo[i];
+      ++n;
+    }
+    for (int k = n; k < 4; ++k)  // unused lanes repeat a real ray (no division by zero)
+      for (int i = 0; i < 3; ++i) ends[i][k] = n ? ends[i][0] : b_.origin(i) + 1.0f;
+    block_.count = n, block_.next = 0;
+    if (n == 0) return false;
+    compute_starts(ends);
+    return true;
+  }
+
+  __attribute__((target("avx2"))) void compute_starts(const float (&ends)[3][4]) {
+    __m128 d[3];
+    for (int i = 0; i < 3; ++i) d[i] = _mm_sub_ps(_mm_load_ps(ends[i]), _mm_set1_ps(b_.origin(i)));
+    // norm_sq in float as (x*x + y*y) + z*z, sqrt in double, cast to float.
+    const __m128 norm_sq = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d[0], d[0]), _mm_mul_ps(d[1], d[1])), _mm_mul_ps(d[2], d[2]));
+    const __m128 length = _mm256_cvtpd_ps(_mm256_sqrt_pd(_mm256_cvtps_pd(norm_sq)));
+    _mm256_store_pd(block_.length, _mm256_cvtps_pd(length));
+    const __m256d max = _mm256_set1_pd(std::numeric_limits<double>::max());
+    const __m256d res = _mm256_set1_pd(res_);
+    const __m128 sign = _mm_set1_ps(-0.0f);
+    for (int i = 0; i < 3; ++i) {
+      const __m128 dir = _mm_div_ps(d[i], length);  // direction /= length
+      const __m128 up = _mm_cmpgt_ps(dir, _mm_setzero_ps()), down = _mm_cmplt_ps(dir, _mm_setzero_ps());
+      const __m256i up64 = _mm256_cvtepi32_epi64(_mm_castps_si128(up));
+      const __m256i down64 = _mm256_cvtepi32_epi64(_mm_castps_si128(down));
+      // step: 1, -1 or 0 (the masks are all ones: -1 & 1 = 1, -1 = -1).
+      const __m256i step = _mm256_or_si256(_mm256_and_si256(up64, _mm256_set1_epi64x(1)), down64);
+      _mm256_store_si256((__m256i*)block_.step[i], step);
+      const __m256d moving = _mm256_castsi256_pd(_mm256_or_si256(up64, down64));
+      const __m256d border = _mm256_blendv_pd(_mm256_set1_pd(border_down_[i]), _mm256_set1_pd(border_up_[i]),
+                                              _mm256_castsi256_pd(up64));
+      const __m256d dir64 = _mm256_cvtps_pd(dir);
+      const __m256d t_max = _mm256_div_pd(_mm256_sub_pd(border, _mm256_set1_pd(double(b_.origin(i)))), dir64);
+      const __m256d t_delta = _mm256_div_pd(res, _mm256_cvtps_pd(_mm_andnot_ps(sign, dir)));  // fabs in float
+      _mm256_store_pd(block_.t_max[i], _mm256_blendv_pd(max, t_max, moving));
+      _mm256_store_pd(block_.t_delta[i], _mm256_blendv_pd(max, t_delta, moving));
+    }
+  }
+
   const RayBatch& b_;
   size_t next_, end_;
   const BrickLayout& layout_;
   double res_;
   GridMarker& marker_;
   int64_t origin_[3], extent_[3];
+  double border_up_[3], border_down_[3];
   uint32_t origin_index_;
+  StartBlock block_;
 };
 
 }  // namespace
