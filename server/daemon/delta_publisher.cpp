@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "daemon/delta_changes.h"
 #include "octomap_rt/map_chunk_t.hpp"
 #include "octomap_rt/map_delta_t.hpp"
 #include "protocol/delta_codec.h"
@@ -20,23 +21,6 @@ using protocol::VoxelChange;
 int64_t utime_now() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
-}
-
-// The class a voxel had before this scan's update `u` made it `after`: 0 = unknown (no
-// node), else CLASS_*. -1 when it cannot be told apart safely (then the voxel is sent).
-int class_before(const octomap::OcTree& t, float after, float u) {
-  const float lo = t.getClampingThresMinLog(), hi = t.getClampingThresMaxLog(), thr = t.getOccupancyThresLog();
-  const bool clamped = (u > 0 && after >= hi) || (u < 0 && after <= lo);
-  if (clamped) {
-    // Was within |u| of the bound on its side: the bound's class, if |u| cannot cross the threshold.
-    const float bound = u > 0 ? hi : lo;
-    if (std::fabs(bound - thr) <= std::fabs(u) + 1e-4f) return -1;
-    return bound >= thr ? Delta::CLASS_OCCUPIED : Delta::CLASS_FREE;
-  }
-  const float before = after - u;
-  if (before == 0.0f) return 0;  // a new node starts at 0 (or an old one at exactly 0: sent anyway)
-  if (std::fabs(before) < 1e-4f || std::fabs(before - thr) < 1e-4f) return -1;
-  return before >= thr ? Delta::CLASS_OCCUPIED : Delta::CLASS_FREE;
 }
 
 }  // namespace
@@ -66,50 +50,34 @@ void DeltaPublisher::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
-// The changes among voxels [begin, end) of one scan's list (see the header: class or exact mode).
-std::vector<VoxelChange> DeltaPublisher::changes_in(const VoxelList& voxels, size_t begin, size_t end,
-                                                    const octomap::OcTree& tree) const {
-  const float hit = tree.getProbHitLog(), miss = tree.getProbMissLog(), thr = tree.getOccupancyThresLog();
-  std::vector<VoxelChange> changed;
-  changed.reserve(cfg_.exact ? end - begin : (end - begin) / 8);
-  for (size_t i = begin; i < end; ++i) {
-    const VoxelUpdate& v = voxels[i];
-    const octomap::OcTreeKey key = v.key();
-    const octomap::OcTreeNode* node = tree.search(key);
-    if (!node) continue;  // cannot happen after an update; nothing to report
-    const float after = node->getLogOdds();
-    const int8_t now_class = after >= thr ? Delta::CLASS_OCCUPIED : Delta::CLASS_FREE;
-    if (cfg_.exact) {
-      changed.push_back({protocol::pack_key(key), after});
-    } else if (class_before(tree, after, v.occupied() ? hit : miss) != now_class) {
-      changed.push_back({protocol::pack_key(key), static_cast<float>(now_class)});
-    }
-  }
-  return changed;
-}
-
-// Called by stage 2 under the map lock, so its time is the pipeline's: done on one thread
-// with a hash-map insert per change, it took two thirds of stage 2 on RGB-D scans (H200,
-// docs/BENCHMARKS.md "Performance (issue 12)"). The tree is only read here, so the look-ups
-// are split over threads (chunks of at least kMinChunk voxels, appended in the list's order,
-// so the result is the one-thread result), and the changes are only appended: flush() sorts
-// them and keeps each key's newest value, on the publisher's thread.
-void DeltaPublisher::applied(const VoxelList& voxels, const octomap::OcTree& tree, uint64_t version) {
-  constexpr size_t kMinChunk = 16384;
-  const size_t n = voxels.size();
-  const size_t chunks = std::clamp<size_t>(n / kMinChunk, 1, std::max(1u, std::thread::hardware_concurrency()));
-  std::vector<std::vector<VoxelChange>> parts(chunks);
-  {
-    std::vector<std::jthread> helpers;
-    helpers.reserve(chunks - 1);
-    for (size_t c = 1; c < chunks; ++c)
-      helpers.emplace_back([&, c] { parts[c] = changes_in(voxels, n * c / chunks, n * (c + 1) / chunks, tree); });
-    parts[0] = changes_in(voxels, 0, n / chunks, tree);
-  }  // helpers joined
+// Called by stage 2 under the map lock, so its time is the pipeline's: looking each voxel up
+// in the tree again took 1.9 ms a scan on RGB-D scans mapping new space (H200,
+// docs/BENCHMARKS.md "Performance (issue 12)"). The octree stage's own log is swapped in
+// instead, and classified on the publisher's thread.
+void DeltaPublisher::applied(LeafChanges& changes, const octomap::OcTree& tree, uint64_t version) {
   std::lock_guard lock(mutex_);
-  for (const std::vector<VoxelChange>& part : parts) pending_.insert(pending_.end(), part.begin(), part.end());
+  pending_.push_back(std::move(changes));
+  if (!spare_.empty()) {
+    changes = std::move(spare_.back());
+    spare_.pop_back();
+  } else {
+    changes = LeafChanges{};
+  }
+  occupancy_thres_log_ = tree.getOccupancyThresLog();
   to_version_ = version;
   pending_scans_++;
+}
+
+void DeltaPublisher::give_back(std::vector<LeafChanges>& logs) {
+  // About the scans of one set (300 scans/s at 10 sets/s): most scans then find a log whose
+  // lanes need not grow (growing them would be stage 2's time, under the map lock). Holds no
+  // more memory than the logs of one set held anyway.
+  constexpr size_t kMaxSpare = 48;
+  std::lock_guard lock(mutex_);
+  while (!logs.empty() && spare_.size() < kMaxSpare) {
+    spare_.push_back(std::move(logs.back()));
+    logs.pop_back();
+  }
 }
 
 void DeltaPublisher::replaced(const octomap::OcTree&, uint64_t version) {
@@ -143,13 +111,15 @@ void DeltaPublisher::run() {
 }
 
 void DeltaPublisher::flush() {
-  std::vector<VoxelChange> set;
+  std::vector<LeafChanges> logs;
   uint64_t from, to;
   int64_t scans;
+  float thr;
   {
     std::lock_guard lock(mutex_);
     if (pending_.empty() && skip_seqs_ == 0) return;  // versions keep accumulating into the next set
-    set.swap(pending_);
+    logs.swap(pending_);
+    thr = occupancy_thres_log_;
     from = from_version_;
     to = to_version_;
     from_version_ = to;
@@ -158,13 +128,10 @@ void DeltaPublisher::flush() {
     next_seq_ += skip_seqs_;
     skip_seqs_ = 0;
   }
-  // In the order the scans were applied: after a stable sort by key, the last of each key's
-  // run is its newest value.
-  std::stable_sort(set.begin(), set.end(), [](const VoxelChange& a, const VoxelChange& b) { return a.key < b.key; });
-  size_t kept = 0;
-  for (size_t i = 0; i < set.size(); ++i)
-    if (i + 1 == set.size() || set[i + 1].key != set[i].key) set[kept++] = set[i];
-  set.resize(kept);
+  std::vector<VoxelChange> set;
+  for (const LeafChanges& log : logs) append_delta_changes(log, cfg_.exact, thr, set);
+  keep_newest_per_key(set);
+  give_back(logs);
   const int8_t mode = cfg_.exact ? Delta::MODE_LOG_ODDS : Delta::MODE_CLASS;
   auto parts = protocol::encode_delta_parts(set, mode, std::max(cfg_.zstd_level, 1), protocol::kDeltaDataBytes);
   if (parts.empty())  // after replaced(): one empty set carries the gap to the mirrors

@@ -1,13 +1,13 @@
 // Live map deltas on OCTOMAP_RT_MAP_DELTA (map_delta_t, docs/PROTOCOL.md).
 //
-// As each scan is applied (under the map lock, MapChangeObserver), the keys of its voxel
-// list are looked up once in the updated tree: in class mode a key is kept when its class
-// may have changed (unknown -> free/occupied, free <-> occupied; the class before is the
-// value after minus the scan's update, OctoMap's clamping taken into account), in exact
-// mode every updated key is kept with its new log-odds (the look-ups are split over threads).
-// Keys collect in one pending list which a thread of its own sends at most max_rate_hz times
-// a second: sorted, each key's newest value kept, delta-coded, compressed, cut into
-// self-contained parts <= 60 KB, paced.
+// As each scan is applied (under the map lock, MapChangeObserver), the octree stage has
+// logged every finest leaf it changed with its value before and after
+// (octree/leaf_changes.h). The publisher only takes that log over (a swap: nothing is
+// looked up, classified or copied under the lock) and queues it. A thread of its own sends at
+// most max_rate_hz change sets a second: the queued logs classified (class mode: unknown ->
+// free/occupied, free <-> occupied; exact mode: every changed leaf with its log-odds;
+// daemon/delta_changes.h), sorted, each key's newest value kept, delta-coded, compressed,
+// cut into self-contained parts <= 60 KB, paced.
 #pragma once
 
 #include <atomic>
@@ -22,6 +22,7 @@
 
 #include "daemon/lcm_loop.h"
 #include "daemon/map_state.h"
+#include "octree/leaf_changes.h"
 #include "protocol/delta_codec.h"
 
 namespace ort::daemon {
@@ -52,7 +53,8 @@ class DeltaPublisher : public MapChangeObserver {
   void start(uint64_t version);
   // Sends what is pending, then ends the thread. Idempotent.
   void stop();
-  void applied(const VoxelList& voxels, const octomap::OcTree& tree, uint64_t version) override;
+  // Takes `changes` over and leaves it empty with some capacity (a used log given back).
+  void applied(LeafChanges& changes, const octomap::OcTree& tree, uint64_t version) override;
   // Drops what is pending and skips one delta_seq on purpose: every mirror sees a gap and
   // resyncs from a snapshot at `version` or newer.
   void replaced(const octomap::OcTree& tree, uint64_t version) override;
@@ -62,19 +64,21 @@ class DeltaPublisher : public MapChangeObserver {
  private:
   void run();
   void flush();
-  std::vector<protocol::VoxelChange> changes_in(const VoxelList& voxels, size_t begin, size_t end,
-                                                const octomap::OcTree& tree) const;
+  // Keeps a few of the sent logs for applied() to hand back to stage 2.
+  void give_back(std::vector<LeafChanges>& logs);
 
   LcmLoop& loop_;
   DeltaConfig cfg_;
   std::function<int64_t()> latest_snapshot_id_;
   std::ostream& log_;
 
-  mutable std::mutex mutex_;  // pending_, versions, stop_, stats_
+  mutable std::mutex mutex_;  // pending_, spare_, versions, stop_, stats_
   std::condition_variable cv_;
-  // Changes in the order the scans were applied, a key possibly more than once: stage 2 only
-  // appends (it runs under the map lock); flush() keeps each key's newest value.
-  std::vector<protocol::VoxelChange> pending_;
+  // The change logs of the scans applied since the last set, in the order applied: stage 2
+  // only moves them in (it runs under the map lock); flush() classifies them.
+  std::vector<LeafChanges> pending_;
+  std::vector<LeafChanges> spare_;  // emptied logs, handed back to stage 2 to keep their capacity
+  float occupancy_thres_log_ = 0;   // the map's, as of the newest pending scan
   uint64_t from_version_ = 0, to_version_ = 0;
   int64_t pending_scans_ = 0;
   int64_t skip_seqs_ = 0;

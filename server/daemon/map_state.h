@@ -14,16 +14,19 @@
 
 #include "daemon/applied_order.h"
 #include "core/voxel_update.h"
+#include "octree/leaf_changes.h"
 
 namespace ort::daemon {
 
-// Told of every applied scan, under the map lock, right after the tree changed: `voxels`
-// are the keys the scan updated, `version` the map state id it made. Keep it short: the
-// pipeline's stage 2 waits.
+// Told of every applied scan, under the map lock, right after the tree changed: `changes`
+// are the finest leaves the scan changed, with their values before and after (the octree
+// stage's log, octree/leaf_changes.h; the observer may take it over, e.g. by a swap: the
+// next update resets it), `version` the map state id it made. Keep it short: the pipeline's
+// stage 2 waits.
 class MapChangeObserver {
  public:
   virtual ~MapChangeObserver() = default;
-  virtual void applied(const VoxelList& voxels, const octomap::OcTree& tree, uint64_t version) = 0;
+  virtual void applied(LeafChanges& changes, const octomap::OcTree& tree, uint64_t version) = 0;
   // The map changed in a way not described by a voxel list (an edit, a reload): deltas
   // cannot carry it, so the observer makes clients resync. Also under the map lock.
   virtual void replaced(const octomap::OcTree& tree, uint64_t version) = 0;

@@ -136,11 +136,11 @@ void ScanPipeline::apply(ShotJob& job) {
   set_busy(1, true);
   try {
     std::lock_guard lock(map_.mutex);
-    engine_.apply(job.shot, *map_.tree);
+    engine_.apply(job.shot, *map_.tree, map_.observer ? &changes_ : nullptr);
     map_.order.append(AppliedEntry{job.robot_id, job.seq, job.utime});
     map_.version++;
     map_.last_scan_utime = std::max(map_.last_scan_utime, job.utime);
-    if (map_.observer) map_.observer->applied(job.shot.voxels, *map_.tree, map_.version);
+    if (map_.observer) map_.observer->applied(changes_, *map_.tree, map_.version);
     map_.applied_seq[lower_case(job.robot_id)] = job.seq;
   } catch (const std::exception& e) {
     set_busy(1, false);

@@ -69,6 +69,7 @@ class ScanPipeline {
   std::ostream& log_;
   bool pipelined_;
   BoundedHandoff<ShotJob> handoff_{1};
+  LeafChanges changes_;  // stage 2's: what the scan being applied changed, for map_.observer
   std::thread stage1_, stage2_;
   std::atomic<int64_t> engine_errors_{0}, shed_{0};
   int64_t overrun_warnings_ = 0;  // stage 1 only

@@ -145,9 +145,9 @@ void MapEngine::shoot_tiled(const RayBatch& batch, ShotScan& out) {
   }
 }
 
-void MapEngine::apply(ShotScan& scan, octomap::OcTree& tree) const {
+void MapEngine::apply(ShotScan& scan, octomap::OcTree& tree, LeafChanges* changes) const {
   const auto t0 = SteadyClock::now();
-  octree_stage_.apply(tree, scan.voxels);
+  octree_stage_.apply(tree, scan.voxels, changes);
   scan.shoot.times.octree_ms += ms_since(t0);
 }
 

@@ -93,8 +93,9 @@ class MapEngine {
   // out.shoot.times.prepare_ms includes the transform.
   void shoot_posed(const octomap::pose6d& pose, const octomap::point3d& origin,
                    std::span<const octomap::point3d> sensor_points, double max_range, ShotScan& out);
-  // Stage 2. Adds its time to out.shoot.times.octree_ms.
-  void apply(ShotScan& scan, octomap::OcTree& tree) const;
+  // Stage 2. Adds its time to out.shoot.times.octree_ms. With `changes`: reset, then every
+  // finest leaf the update changed, its value before and after (octree/leaf_changes.h).
+  void apply(ShotScan& scan, octomap::OcTree& tree, LeafChanges* changes = nullptr) const;
   // Both stages.
   void insert(const octomap::point3d& origin, std::span<const octomap::point3d> points, octomap::OcTree& tree,
               ShotScan& out) {

@@ -6,6 +6,7 @@
 
 #include "core/clock.h"
 #include "octree/node_count.h"
+#include "octree/octree_update.h"
 #include "octree/split_top.h"
 #include "octree/subtree_update.h"
 
@@ -41,21 +42,26 @@ BatchedOctreeUpdater::BatchedOctreeUpdater(const BatchedUpdateOptions& opts)
 BatchedOctreeUpdater::~BatchedOctreeUpdater() = default;
 
 void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
-                                 BatchedUpdateStats* stats) {
+                                 BatchedUpdateStats* stats, LeafChanges* changes) {
   BatchedUpdateStats local;
   BatchedUpdateStats& st = stats ? *stats : local;
   st = BatchedUpdateStats{};
-  if (updates.empty()) return;
-  if (tree.isChangeDetectionEnabled()) {
+  if (tree.isChangeDetectionEnabled() || updates.empty()) {
     // Only updateNodeRecurs maintains the changed-keys set.
-    for (const VoxelUpdate& u : updates) tree.updateNode(u.key(), u.occupied(), /*lazy_eval=*/false);
+    apply_updates_sequential(tree, updates, changes);
     return;
   }
+  if (changes) changes->reset(pool_.size());
   if (!tree.getRoot()) {
     // The root can only be made through updateNode; any voxel may go first (see header).
-    tree.updateNode(updates.front().key(), updates.front().occupied(), /*lazy_eval=*/false);
+    // Its change is read back first (order 0; the subtrees follow from 1).
+    update_node_logged(tree, updates.front(), changes ? &changes->lane(0) : nullptr);
+    if (changes) changes->close_segment(0, 0);
     updates = updates.subspan(1);
-    if (updates.empty()) return;
+    if (updates.empty()) {
+      if (changes) changes->finish();
+      return;
+    }
   }
   const bool parallel = pool_.size() > 1 && updates.size() >= opts_.min_parallel_voxels;
 
@@ -86,7 +92,9 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
       } else {
         sort_bucket(voxels, sort_tmp_[worker]);
       }
-      const bool changed = update_subtree(tree, node_ops, s.root, voxels);
+      const bool changed =
+          update_subtree(tree, node_ops, s.root, voxels, changes ? &changes->lane(worker) : nullptr);
+      if (changes) changes->close_segment(worker, order[k] + 1);
       top.child_done(s.parent, changed, node_ops);
     }
   };
@@ -97,6 +105,7 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
   const auto t3 = Clock::now();
   st.subtrees_ms = ms_between(t2, t3);
   for (double ms : sort_ms) st.sort_cpu_ms += ms;
+  if (changes) changes->finish();
 
   int64_t change = 0;
   for (auto& counting : counting_trees_) change += take_node_count(*counting);

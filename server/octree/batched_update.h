@@ -22,6 +22,9 @@
 //
 // Trees with change detection on (enableChangeDetection) go through the plain updateNode
 // loop, which also records the changed keys.
+//
+// The optional change log (leaf_changes.h) is written in step 3 by the thread that updates a
+// leaf, and ordered by subtree afterwards.
 #pragma once
 
 #include <cstddef>
@@ -32,6 +35,7 @@
 #include <octomap/OcTree.h>
 
 #include "core/voxel_update.h"
+#include "octree/leaf_changes.h"
 #include "octree/voxel_buckets.h"
 #include "octree/worker_pool.h"
 
@@ -61,7 +65,10 @@ class BatchedOctreeUpdater {
   explicit BatchedOctreeUpdater(const BatchedUpdateOptions& opts = {});
   ~BatchedOctreeUpdater();
 
-  void apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates, BatchedUpdateStats* stats = nullptr);
+  // With `changes`: reset, then filled with every finest leaf the update changed, each
+  // worker writing its own lane while it updates its subtrees (leaf_changes.h).
+  void apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates, BatchedUpdateStats* stats = nullptr,
+             LeafChanges* changes = nullptr);
 
   unsigned threads() const { return pool_.size(); }
 

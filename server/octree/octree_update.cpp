@@ -21,9 +21,9 @@ OctreeStage::~OctreeStage() = default;
 OctreeStage::OctreeStage(OctreeStage&&) noexcept = default;
 OctreeStage& OctreeStage::operator=(OctreeStage&&) noexcept = default;
 
-void OctreeStage::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates) {
+void OctreeStage::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates, LeafChanges* changes) {
   if (opts_.mode == OctreeUpdateMode::kSequential) {
-    apply_updates_sequential(tree, updates);
+    apply_updates_sequential(tree, updates, changes);
     return;
   }
   if (!batched_) {
@@ -31,7 +31,7 @@ void OctreeStage::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> upda
     o.threads = opts_.threads;
     batched_ = std::make_unique<BatchedOctreeUpdater>(o);
   }
-  batched_->apply(tree, updates);
+  batched_->apply(tree, updates, nullptr, changes);
 }
 
 }  // namespace ort

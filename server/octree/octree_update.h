@@ -9,6 +9,7 @@
 #include <octomap/OcTree.h>
 
 #include "core/voxel_update.h"
+#include "octree/leaf_changes.h"
 
 namespace ort {
 
@@ -22,8 +23,14 @@ struct OctreeUpdateOptions {
   unsigned threads = 0;  // batched mode: 0 = hardware threads
 };
 
-// Plain updateNode loop: each voxel updated once, occupied or free.
-void apply_updates_sequential(octomap::OcTree& tree, std::span<const VoxelUpdate> updates);
+// Plain updateNode loop: each voxel updated once, occupied or free. With `changes`: reset,
+// then every update that changed its leaf, found by a search before and after it (one lane,
+// one segment; leaf_changes.h).
+void apply_updates_sequential(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
+                              LeafChanges* changes = nullptr);
+
+// One updateNode; with `lane`, its change (if any) appended to it.
+void update_node_logged(octomap::OcTree& tree, const VoxelUpdate& u, std::vector<LeafChange>* lane);
 
 // One-off: the batched mode starts its threads for this call only (see OctreeStage).
 void apply_updates(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
@@ -40,7 +47,8 @@ class OctreeStage {
   OctreeStage(OctreeStage&&) noexcept;
   OctreeStage& operator=(OctreeStage&&) noexcept;
 
-  void apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates);
+  // With `changes`: reset and filled with what the update changed (leaf_changes.h).
+  void apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates, LeafChanges* changes = nullptr);
 
  private:
   OctreeUpdateOptions opts_;

@@ -16,7 +16,7 @@ struct PathNode {
 }  // namespace
 
 bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, const SubtreeRoot& root,
-                    std::span<const SortedVoxel> voxels) {
+                    std::span<const SortedVoxel> voxels, std::vector<LeafChange>* changes) {
   const float hit = tree.getProbHitLog();
   const float miss = tree.getProbMissLog();
 
@@ -47,7 +47,9 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
       if (depth == kTreeDepth) {
         // An existing leaf is what updateNode's search finds: at the bound, nothing happens.
         if (p.just_created || !at_clamping_bound(tree, *p.node, update)) {
+          const float before = p.node->getLogOdds();  // a created leaf's 0, or an expanded node's value
           tree.updateNodeLogOdds(p.node, update);
+          if (changes) log_leaf_change(*changes, sorted_voxel_code(v), p.just_created, before, p.node->getLogOdds());
           p.changed = true;
           p.just_created = false;  // a repeated key finds this leaf as it is now
         }

@@ -12,6 +12,7 @@
 
 #include <octomap/OcTree.h>
 
+#include "octree/leaf_changes.h"
 #include "octree/morton_order.h"
 
 namespace ort {
@@ -33,8 +34,11 @@ struct SubtreeRoot {
 // created, expanded and pruned through `node_ops`, which is `tree` itself or, when several
 // threads update one tree, the thread's own OcTree that only counts the nodes (OctoMap's node
 // counter is a plain size_t; see node_count.h).
+//
+// With `changes`, every finest leaf whose value the pass changed is appended to it, in the
+// voxels' order (leaf_changes.h).
 bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, const SubtreeRoot& root,
-                    std::span<const SortedVoxel> voxels);
+                    std::span<const SortedVoxel> voxels, std::vector<LeafChange>* changes = nullptr);
 
 // Whether OctoMap's updateNode would return early for an update of `log_odds_update` that
 // finds `node` as the deepest existing node on its path: already at the clamping bound in

@@ -27,3 +27,7 @@ octomap_rt_lcm_handler_sources(server_query_service_test ${CMAKE_CURRENT_LIST_DI
 # ... its counters in the status and the grid it publishes at a rate (issue 11).
 octomap_rt_add_test(server_query_status_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/query_status_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 120)
+# Map deltas from the octree stage's change log against OctoMap's search() and the old
+# look-up path, on the real data sets (issue 12).
+octomap_rt_add_test(server_delta_changes_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/delta_changes_test.cpp
+                    LIBS octomap_rt_daemon TIMEOUT 600)
