@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <new>
 #include <thread>
 #include <vector>
 
@@ -28,23 +29,30 @@ using Clock = std::chrono::steady_clock;
 constexpr uint32_t kVoxelsPerWord = BrickLayout::kVoxelsPerWord;
 constexpr uint32_t kNoIndex = std::numeric_limits<uint32_t>::max();
 
-// The persistent grid: 2 MiB-aligned so that the kernel can back it with huge pages (a
-// window of tens of MiB walked at random would otherwise miss the TLB on most line misses).
-struct GridMemory {
+// The persistent grid, in its own mapping: 2 MiB-aligned and marked for huge pages (a window
+// of tens of MiB walked at random would otherwise miss the TLB on most line misses). Not from
+// malloc: freed, a huge-page region would be handed to the process's small allocations
+// (OctoMap's nodes), whose partial purges split and re-zero huge pages.
+class GridMemory {
+ public:
   static constexpr size_t kHugePage = 2u << 20;
-  explicit GridMemory(uint64_t words) : bytes((words * 4 + kHugePage - 1) / kHugePage * kHugePage) {
-    words_ = static_cast<uint32_t*>(std::aligned_alloc(kHugePage, bytes));
-    if (!words_) throw std::bad_alloc();
-    madvise(words_, bytes, MADV_HUGEPAGE);  // a hint: without it the grid still works
-    std::memset(words_, 0, bytes);
+  explicit GridMemory(uint64_t words) : bytes_((words * 4 + kHugePage - 1) / kHugePage * kHugePage) {
+    mapped_bytes_ = bytes_ + kHugePage;
+    mapped_ = mmap(nullptr, mapped_bytes_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (mapped_ == MAP_FAILED) throw std::bad_alloc();
+    const uintptr_t base = (reinterpret_cast<uintptr_t>(mapped_) + kHugePage - 1) / kHugePage * kHugePage;
+    words_ = reinterpret_cast<uint32_t*>(base);
+    madvise(words_, bytes_, MADV_HUGEPAGE);  // a hint: without it the grid still works
+    std::memset(words_, 0, bytes_);          // fault it in now, not during the first scans
   }
-  ~GridMemory() { std::free(words_); }
+  ~GridMemory() { munmap(mapped_, mapped_bytes_); }
   GridMemory(const GridMemory&) = delete;
   GridMemory& operator=(const GridMemory&) = delete;
   uint32_t* data() const { return words_; }
-  size_t bytes;
 
  private:
+  size_t bytes_, mapped_bytes_;
+  void* mapped_;
   uint32_t* words_;
 };
 
