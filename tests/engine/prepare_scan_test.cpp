@@ -1,6 +1,7 @@
 // Bad input at the engine's door: NaN/inf points are skipped and counted, points outside the
 // key range are counted, an empty scan is fine, a bad origin rejects the scan.
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 
@@ -120,6 +121,32 @@ TEST(MapFrame, ParallelTransformEqualsPointcloudTransformBitForBit) {
     ASSERT_EQ(ours[i].x(), reference[i].x());
     ASSERT_EQ(ours[i].y(), reference[i].y());
     ASSERT_EQ(ours[i].z(), reference[i].z());
+  }
+}
+
+// The inlined transform (MapFrameTransform) against Pose6D::transform, bit for bit (memcmp, so
+// that -0.0 and NaN payloads count): random poses and identity / half turns, points from
+// sub-millimetre to kilometres, zeros, and non-finite coordinates.
+TEST(MapFrame, InlinedTransformEqualsPose6dTransformBitForBit) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> angle(-3.2, 3.2), shift(-500.0, 500.0);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), mag(-3.0f, 3.5f);
+  std::vector<octomap::pose6d> poses = {octomap::pose6d(0, 0, 0, 0, 0, 0), octomap::pose6d(1, 2, 3, 3.14159265, 0, 0),
+                                        octomap::pose6d(-1, 0, 0.5, 0, 0, -3.14159265)};
+  for (int i = 0; i < 40; ++i) poses.emplace_back(shift(rng), shift(rng), shift(rng), angle(rng), angle(rng), angle(rng));
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<octomap::point3d> points = {{0, 0, 0}, {-0.0f, 0, -0.0f}, {inf, 1, 2}, {1, nan, 3}, {-inf, -inf, 0}};
+  for (int i = 0; i < 20000; ++i) {
+    const float scale = std::pow(10.0f, mag(rng));
+    points.emplace_back(u(rng) * scale, u(rng) * scale, u(rng) * scale);
+  }
+  for (const auto& pose : poses) {
+    const MapFrameTransform transform(pose);
+    for (const auto& p : points) {
+      const octomap::point3d a = pose.transform(p), b = transform(p);
+      const float fa[3] = {a.x(), a.y(), a.z()}, fb[3] = {b.x(), b.y(), b.z()};
+      ASSERT_EQ(std::memcmp(fa, fb, sizeof fa), 0) << p << " under " << pose << ": " << a << " vs " << b;
+    }
   }
 }
 
