@@ -38,10 +38,11 @@ octomap_rt_add_fuzz_target(fuzz_octree_file SOURCES ${CMAKE_SOURCE_DIR}/server/c
 file(GLOB FUZZ_QUERY_CORE ${CMAKE_SOURCE_DIR}/server/query/*.cpp)
 octomap_rt_add_fuzz_target(fuzz_query_message
   SOURCES ${CMAKE_SOURCE_DIR}/server/daemon/query_wire.cpp ${CMAKE_SOURCE_DIR}/server/daemon/query_answers.cpp
-          ${FUZZ_QUERY_CORE}
+          ${CMAKE_SOURCE_DIR}/protocol/wire_layout.cpp ${FUZZ_QUERY_CORE}
   LIBS octomap_rt_lcmtypes octomap_rt_lcm)
 octomap_rt_add_fuzz_target(fuzz_map_request
-  SOURCES ${CMAKE_SOURCE_DIR}/protocol/wire_checks.cpp ${CMAKE_SOURCE_DIR}/protocol/map_protocol.cpp
+  SOURCES ${CMAKE_SOURCE_DIR}/protocol/wire_checks.cpp ${CMAKE_SOURCE_DIR}/protocol/wire_layout.cpp
+          ${CMAKE_SOURCE_DIR}/protocol/map_protocol.cpp
           ${CMAKE_SOURCE_DIR}/server/daemon/map_request_rules.cpp
   LIBS octomap_rt_lcmtypes octomap_rt_lcm)
 add_custom_target(octomap_rt_fuzz_targets DEPENDS ${OCTOMAP_RT_FUZZ_TARGETS})
