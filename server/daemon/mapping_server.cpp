@@ -2,11 +2,8 @@
 
 #include <unistd.h>
 
-#include <cstdio>
 #include <filesystem>
-#include <iomanip>
 #include <optional>
-#include <sstream>
 
 #include "core/clock.h"
 #include "daemon/map_snapshot.h"
