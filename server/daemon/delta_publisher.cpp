@@ -113,7 +113,7 @@ void DeltaPublisher::run() {
 void DeltaPublisher::flush() {
   std::vector<LeafChanges> logs;
   uint64_t from, to;
-  int64_t scans, skipped;
+  int64_t scans;
   float thr;
   {
     std::lock_guard lock(mutex_);
@@ -125,7 +125,6 @@ void DeltaPublisher::flush() {
     from_version_ = to;
     scans = pending_scans_;
     pending_scans_ = 0;
-    skipped = skip_seqs_;
     next_seq_ += skip_seqs_;
     skip_seqs_ = 0;
   }
@@ -133,20 +132,14 @@ void DeltaPublisher::flush() {
   for (const LeafChanges& log : logs) append_delta_changes(log, cfg_.exact, thr, set);
   keep_newest_per_key(set);
   give_back(logs);
-  if (set.empty() && skipped == 0) {
-    // The scans changed nothing a mirror sees: no set; their versions and count carry over
-    // into the next one (unless replaced() has moved the versions on meanwhile).
-    std::lock_guard lock(mutex_);
-    if (from_version_ == to) {
-      from_version_ = from;
-      pending_scans_ += scans;
-    }
-    return;
-  }
   const int8_t mode = cfg_.exact ? Delta::MODE_LOG_ODDS : Delta::MODE_CLASS;
   auto parts = protocol::encode_delta_parts(set, mode, std::max(cfg_.zstd_level, 1), protocol::kDeltaDataBytes);
-  if (parts.empty())  // after replaced(): one empty set carries the gap to the mirrors
-    parts.push_back(protocol::DeltaPart{0, 0, protocol::zstd_compress("", 1)});
+  // An empty set still goes out: after replaced() it carries the gap to the mirrors, and when
+  // the period's scans changed nothing a mirror sees it moves the mirrors to `to`. Without it
+  // a mirror stayed at an older version for as long as such scans came (a robot standing in a
+  // mapped room) and waiting for its own scan's version never ended. At most max_rate_hz sets
+  // a second, ~100 bytes each.
+  if (parts.empty()) parts.push_back(protocol::DeltaPart{0, 0, protocol::zstd_compress("", 1)});
   Delta d{};
   d.from_version = static_cast<int64_t>(from);
   d.to_version = static_cast<int64_t>(to);
