@@ -5,30 +5,22 @@
 #include <exception>
 
 #include "core/prepare_scan.h"
+#include "protocol/wire_layout.h"
 
 namespace ort::daemon {
 namespace {
 
-// LCM encodes integers big-endian.
-uint64_t read_be64(const uint8_t* p) {
-  uint64_t v = 0;
-  for (int i = 0; i < 8; ++i) v = (v << 8) | p[i];
-  return v;
-}
-int32_t read_be32(const uint8_t* p) {
-  const uint32_t v = (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | uint32_t(p[3]);
-  return static_cast<int32_t>(v);
-}
-
-// Checks the string whose 4-byte length sits at `pos`; advances pos past it.
-Reject check_string(const uint8_t* data, size_t size, size_t& pos, size_t max_chars) {
-  if (pos + 4 > size) return Reject::kTruncated;
-  const int32_t len = read_be32(data + pos);  // includes the terminating NUL
-  pos += 4;
-  if (len < 1 || static_cast<size_t>(len) > max_chars + 1) return Reject::kBadStringLength;
-  if (pos + static_cast<size_t>(len) > size) return Reject::kCountExceedsData;
-  pos += static_cast<size_t>(len);
-  return Reject::kNone;
+// protocol::check_wire's reason as the daemon's typed one (a string without its NUL has a
+// length that does not match it: a bad string length).
+Reject reject_of(const std::string& why) {
+  if (why.empty()) return Reject::kNone;
+  if (why == "wrong fingerprint") return Reject::kWrongFingerprint;
+  if (why == "negative count") return Reject::kNegativeCount;
+  if (why.rfind("count too large", 0) == 0) return Reject::kCountTooLarge;
+  if (why == "count exceeds data") return Reject::kCountExceedsData;
+  if (why == "bad string length" || why == "string not terminated") return Reject::kBadStringLength;
+  if (why == "trailing bytes") return Reject::kTrailingBytes;
+  return Reject::kTruncated;
 }
 
 }  // namespace
@@ -53,18 +45,12 @@ Reject check_scan_wire(const uint8_t* data, size_t size, const ScanLimits& limit
   // Largest legal message: header, max points, two strings of the longest allowed length.
   const uint64_t max_size = kScanXyzOffset + 12 * limits.max_points + 8 + kMaxRobotIdLength + kMaxMapFrameLength + 2;
   if (size > max_size) return Reject::kTooLarge;
-  if (size < 8) return Reject::kTruncated;
-  if (read_be64(data) != static_cast<uint64_t>(octomap_rt::scan_t::getHash())) return Reject::kWrongFingerprint;
-  if (size < kScanXyzOffset) return Reject::kTruncated;
-  const int32_t num_xyz = read_be32(data + kScanNumXyzOffset);
-  if (num_xyz < 0) return Reject::kNegativeCount;
-  if (static_cast<uint64_t>(num_xyz) > 3 * limits.max_points) return Reject::kCountTooLarge;
-  size_t pos = kScanXyzOffset + 4 * static_cast<size_t>(num_xyz);
-  if (pos > size) return Reject::kCountExceedsData;
-  if (Reject r = check_string(data, size, pos, kMaxRobotIdLength); r != Reject::kNone) return r;
-  if (Reject r = check_string(data, size, pos, kMaxMapFrameLength); r != Reject::kNone) return r;
-  if (pos != size) return Reject::kTrailingBytes;
-  return Reject::kNone;
+  // scan_t's layout (lcmtypes/octomap_rt_scan_t.lcm): the fixed fields, num_xyz, xyz[], robot_id, map_frame.
+  namespace p = protocol;
+  return reject_of(p::check_wire(
+      data, size, octomap_rt::scan_t::getHash(),
+      {p::wire_fixed(kScanNumXyzOffset - 8), p::wire_count(3 * static_cast<int64_t>(limits.max_points)),
+       p::wire_array(4), p::wire_string(kMaxRobotIdLength), p::wire_string(kMaxMapFrameLength)}));
 }
 
 Reject check_scan_content(const octomap_rt::scan_t& m, const std::string& expected_robot_id,

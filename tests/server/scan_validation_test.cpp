@@ -79,6 +79,9 @@ TEST(ScanValidation, CorruptCounts) {
   auto zero_len = encode(small_scan("alpha", 0, 0));  // robot_id length 0 (decode would throw)
   put_be32(zero_len, daemon::kScanXyzOffset, 0);
   EXPECT_EQ(check(zero_len), Reject::kBadStringLength);
+  auto no_nul = encode(small_scan("alpha", 0, 0));  // robot_id "alpha" whose NUL became 'x'
+  no_nul[daemon::kScanXyzOffset + 4 + 5] = 'x';
+  EXPECT_EQ(check(no_nul), Reject::kBadStringLength);
   auto not3 = small_scan("alpha", 0, 10);
   not3.xyz.pop_back();
   not3.num_xyz = static_cast<int32_t>(not3.xyz.size());
