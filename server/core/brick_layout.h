@@ -28,7 +28,7 @@ class BrickLayout {
   }
 
   explicit BrickLayout(const KeyBox& w) : w_(w), nbx_(bricks(w, 0)), nby_(bricks(w, 1)) {
-    const uint32_t brick_row = kVoxelsPerBrick * nbx_, brick_layer = brick_row * nby_;
+    const uint32_t brick_row = this->brick_row(), brick_layer = this->brick_layer();
     ox_.resize(size_t(w.hi[0] - w.lo[0] + 1));
     oy_.resize(size_t(w.hi[1] - w.lo[1] + 1));
     oz_.resize(size_t(w.hi[2] - w.lo[2] + 1));
@@ -44,6 +44,10 @@ class BrickLayout {
   const uint32_t* y_offsets() const { return oy_.data(); }
   const uint32_t* z_offsets() const { return oz_.data(); }
   int extent(int axis) const { return w_.hi[axis] - w_.lo[axis] + 1; }
+  // Voxels from one row of bricks (along x) to the next along y, and from one layer to the next along z:
+  // the offsets above are these times y >> 3 and z >> 2, plus the voxel's place inside its brick.
+  uint32_t brick_row() const { return kVoxelsPerBrick * nbx_; }
+  uint32_t brick_layer() const { return brick_row() * nby_; }
 
   bool contains(const octomap::OcTreeKey& k) const {
     return k[0] >= w_.lo[0] && k[0] <= w_.hi[0] && k[1] >= w_.lo[1] && k[1] <= w_.hi[1] && k[2] >= w_.lo[2] &&

@@ -36,7 +36,8 @@ constexpr uint32_t kNoIndex = std::numeric_limits<uint32_t>::max();
 class GridMemory {
  public:
   static constexpr size_t kHugePage = 2u << 20;
-  explicit GridMemory(uint64_t words) : bytes_((words * 4 + kHugePage - 1) / kHugePage * kHugePage) {
+  // One word more than asked: the AVX2 walk gathers 8 bytes at a word (walk_rays_avx2).
+  explicit GridMemory(uint64_t words) : bytes_(((words + 1) * 4 + kHugePage - 1) / kHugePage * kHugePage) {
     mapped_bytes_ = bytes_ + kHugePage;
     mapped_ = mmap(nullptr, mapped_bytes_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (mapped_ == MAP_FAILED) throw std::bad_alloc();

@@ -30,6 +30,26 @@ struct GridMarker {
       if (old == 0) touched.push_back(word);
     }
   }
+
+  // mark() for each of n indices; without a branch on the grid's bits where only this thread
+  // writes the grid (the caller found most of them unset: a test would mispredict).
+  void mark_all(const uint32_t* idx, int n, uint32_t bits) {
+    if (shared) {
+      for (int i = 0; i < n; ++i) mark(idx[i], bits);
+      return;
+    }
+    size_t count = touched.size();
+    touched.resize(count + size_t(n));
+    uint32_t* listed = touched.data();
+    for (int i = 0; i < n; ++i) {
+      const uint32_t word = idx[i] / 16u;
+      const uint32_t old = grid[word];
+      grid[word] = old | bits << (2 * (idx[i] % 16u));
+      listed[count] = word;
+      count += old == 0;
+    }
+    touched.resize(count);
+  }
 };
 
 }  // namespace ort

@@ -137,18 +137,54 @@ class RayFeed {
   StartBlock block_;
 };
 
+// Free marks found unset wait in a buffer of this many indices.
+constexpr int kPending = 64;
+
+// For each mask of 4 lanes, the permutation that moves the low 32 bits of each set lane's
+// 64-bit value to the front, in lane order (_mm256_permutevar8x32_epi32's control).
+struct PackTable {
+  alignas(32) int32_t control[16][8];
+};
+constexpr PackTable kPackLanes = [] {
+  PackTable table{};
+  for (int mask = 0; mask < 16; ++mask)
+    for (int lane = 0, n = 0; lane < 4; ++lane)
+      if (mask >> lane & 1) table.control[mask][n++] = 2 * lane;
+  return table;
+}();
+
+// BrickLayout::index in lanes: (key - window.lo) per axis -> the voxel's index in the grid
+// (bits 0-1 x & 3, 2-3 y & 3, 4 x >> 2 & 1, 5 y >> 2 & 1, 6-7 z & 3, then whole bricks).
+__attribute__((target("avx2"))) inline __m256i brick_index(__m256i x, __m256i y, __m256i z, __m256i brick_row,
+                                                          __m256i brick_layer) {
+  const __m256i three = _mm256_set1_epi64x(3), one = _mm256_set1_epi64x(1);
+  const __m256i in_x = _mm256_or_si256(_mm256_and_si256(x, three),
+                                       _mm256_slli_epi64(_mm256_and_si256(_mm256_srli_epi64(x, 2), one), 4));
+  const __m256i in_y = _mm256_or_si256(_mm256_slli_epi64(_mm256_and_si256(y, three), 2),
+                                       _mm256_slli_epi64(_mm256_and_si256(_mm256_srli_epi64(y, 2), one), 5));
+  const __m256i in_z = _mm256_slli_epi64(_mm256_and_si256(z, three), 6);
+  const __m256i bricks = _mm256_add_epi64(
+      _mm256_add_epi64(_mm256_slli_epi64(_mm256_srli_epi64(x, 3), 8), _mm256_mul_epu32(_mm256_srli_epi64(y, 3), brick_row)),
+      _mm256_mul_epu32(_mm256_srli_epi64(z, 2), brick_layer));
+  return _mm256_add_epi64(_mm256_or_si256(_mm256_or_si256(in_x, in_y), in_z), bricks);
+}
+
 }  // namespace
 
 __attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t begin, size_t end,
                                                      const BrickLayout& layout, double resolution,
                                                      GridMarker& marker) {
   if (!layout.contains(b.origin_key)) throw std::logic_error("walk_rays_avx2: the origin lies outside the window");
-  const uint32_t *ox = layout.x_offsets(), *oy = layout.y_offsets(), *oz = layout.z_offsets();
+  const __m256i brick_row = _mm256_set1_epi64x(layout.brick_row()), brick_layer = _mm256_set1_epi64x(layout.brick_layer());
+  const __m256i free_bit = _mm256_set1_epi64x(kStateFree), fifteen = _mm256_set1_epi64x(15);
+  const long long* grid = reinterpret_cast<const long long*>(marker.grid);
   RayFeed feed(b, begin, end, layout, resolution, marker);
   Lanes L{};
   int live = 0;
   for (int l = 0; l < 4; ++l) live += feed.load(L, l);
   const __m256i ones = _mm256_set1_epi64x(-1);
+  alignas(32) uint32_t pending[kPending];
+  int n_pending = 0;
   while (live > 0) {
     __m256d tx = _mm256_load_pd(L.tx), ty = _mm256_load_pd(L.ty), tz = _mm256_load_pd(L.tz);
     const __m256d dx = _mm256_load_pd(L.dx), dy = _mm256_load_pd(L.dy), dz = _mm256_load_pd(L.dz);
@@ -184,14 +220,24 @@ __attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t be
       const __m256d dist = _mm256_min_pd(tz, _mm256_min_pd(ty, tx));
       const __m256i past = _mm256_castpd_si256(_mm256_cmp_pd(dist, length, _CMP_GT_OQ));
       const __m256i done = _mm256_and_si256(_mm256_or_si256(_mm256_or_si256(left, at_end), past), active);
-      const int visit = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_andnot_si256(done, active)));
-      if (visit) {
-        alignas(32) int64_t vx[4], vy[4], vz[4];
-        _mm256_store_si256((__m256i*)vx, x), _mm256_store_si256((__m256i*)vy, y), _mm256_store_si256((__m256i*)vz, z);
-        for (int bits = visit; bits; bits &= bits - 1) {
-          const int l = __builtin_ctz(unsigned(bits));
-          marker.mark(ox[vx[l]] + oy[vy[l]] + oz[vz[l]], kStateFree);
-        }
+      const __m256i visiting = _mm256_andnot_si256(done, active);
+      // The mark's test in lanes: the voxel index as BrickLayout's tables give it, the grid
+      // word of each visiting lane gathered (word 0 for the others), and only the lanes whose
+      // free bit is not set yet go on to the scalar mark (most visits near the sensor find it set).
+      const __m256i index = brick_index(x, y, z, brick_row, brick_layer);
+      const __m256i word = _mm256_and_si256(_mm256_srli_epi64(index, 4), visiting);
+      const __m256i bit = _mm256_sllv_epi64(free_bit, _mm256_slli_epi64(_mm256_and_si256(index, fifteen), 1));
+      const __m256i got = _mm256_i64gather_epi64(grid, word, 4);  // the word and the next: the low 32 bits count
+      const __m256i is_set = _mm256_cmpeq_epi64(_mm256_and_si256(got, bit), bit);
+      const int unmarked = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_andnot_si256(is_set, visiting)));
+      // Their indices go to `pending` without a branch (a branch on the gathered bits
+      // mispredicts on most visits away from the sensor); marked (tested again) when it fills.
+      const __m256i packed = _mm256_permutevar8x32_epi32(index, _mm256_load_si256(reinterpret_cast<const __m256i*>(kPackLanes.control[unmarked])));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(pending + n_pending), _mm256_castsi256_si128(packed));
+      n_pending += __builtin_popcount(unsigned(unmarked));
+      if (n_pending > kPending - 4) {
+        marker.mark_all(pending, n_pending, kStateFree);
+        n_pending = 0;
       }
       const int finished = _mm256_movemask_pd(_mm256_castsi256_pd(done));
       if (!finished) continue;
@@ -201,6 +247,7 @@ __attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t be
       break;  // reload the lanes
     }
   }
+  marker.mark_all(pending, n_pending, kStateFree);
 }
 
 #else
