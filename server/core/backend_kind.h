@@ -33,6 +33,10 @@ struct BackendOptions {
   Traversal traversal = Traversal::kOctomap;  // rt refuses octomap mode at creation, so auto moves on
   unsigned threads = 0;            // cpu-grid: ray threads, 0 = hardware threads
   bool gpu_prepare = true;         // vulkan: transform, max-range cut and keys in a shader (gpu/gpu_prepare.h)
+  // vulkan on a discrete GPU: compaction writes the voxel list straight into host memory,
+  // instead of device memory copied back in a submission of its own (one fence wait less a
+  // scan: the daemon's choice, whose scans' lists are small; gpu/gpu_ray_space.h).
+  bool compact_into_host_memory = false;
   bool verbose = false;
 };
 

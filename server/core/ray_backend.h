@@ -31,10 +31,14 @@ struct StageTimes {
   double compact_gpu_ms = 0;
   double readback_copy_ms = 0;
   double unpack_ms = 0;
+  // Part of shoot_ms on the GPU back ends: the shooting pass on the device's clock (the rest
+  // of shoot_ms is the submission and the wait for its fence).
+  double shoot_gpu_ms = 0;
   void add(const StageTimes& o) {
     prepare_ms += o.prepare_ms; upload_ms += o.upload_ms; shoot_ms += o.shoot_ms;
     compact_ms += o.compact_ms; octree_ms += o.octree_ms;
     compact_gpu_ms += o.compact_gpu_ms; readback_copy_ms += o.readback_copy_ms; unpack_ms += o.unpack_ms;
+    shoot_gpu_ms += o.shoot_gpu_ms;
   }
   double total_ms() const { return prepare_ms + upload_ms + shoot_ms + compact_ms + octree_ms; }
 };
@@ -55,7 +59,9 @@ struct ShootStats {
 struct PosedPoints {
   const octomap::pose6d* pose = nullptr;
   octomap::point3d origin;
-  std::span<const octomap::point3d> points;
+  // The points, x y z each (the layout of an octomap::point3d array and of a scan_t's xyz):
+  // a device back end copies them as they lie, the receiver's buffer needs no repacking.
+  std::span<const float> xyz;
   double max_range = -1.0;  // < 0: no limit
   // Bounds of what the device shoots in one go (0: none). When the scan's key box, widened by
   // the window margin, holds more voxels than max_box_voxels, or its walk bound (rays x the
@@ -64,7 +70,14 @@ struct PosedPoints {
   // scans are tiled along their rays and the per-scan limits apply (MapEngine::shoot).
   uint64_t max_box_voxels = 0;
   uint64_t max_walk_keys = 0;
+  size_t point_count() const { return xyz.size() / 3; }
 };
+
+// An octomap::point3d array as its x y z floats (three floats a point, nothing between).
+inline std::span<const float> as_xyz(std::span<const octomap::point3d> points) {
+  static_assert(sizeof(octomap::point3d) == 3 * sizeof(float), "a point3d is its three floats");
+  return {points.empty() ? nullptr : &points[0](0), points.size() * 3};
+}
 
 class RayBackend {
  public:

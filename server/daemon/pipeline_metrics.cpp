@@ -10,6 +10,10 @@ void PipelineMetrics::record(const AppliedTiming& t) {
   shoot_.add(t.shoot_ms);
   octree_.add(t.octree_ms);
   e2e_.add(t.end_to_end_ms);
+  decode_.add(t.waits.decode_ms);
+  queue_wait_.add(t.waits.queue_ms);
+  handoff_wait_.add(t.waits.handoff_ms);
+  stage1_total_.add(t.stage1);
   scans_++;
   points_ += t.points;
   overlapped_ += t.overlapped ? 1 : 0;
@@ -31,6 +35,11 @@ MetricsSnapshot PipelineMetrics::snapshot() {
   s.octree_p99 = octree_.percentile(0.99);
   s.e2e_p50 = e2e_.percentile(0.5);
   s.e2e_p99 = e2e_.percentile(0.99);
+  auto both = [](const LatencyWindow& w) { return Percentiles{w.percentile(0.5), w.percentile(0.99)}; };
+  s.decode = both(decode_);
+  s.queue_wait = both(queue_wait_);
+  s.handoff_wait = both(handoff_wait_);
+  s.stage1_total = stage1_total_;
   while (!recent_.empty() && std::chrono::duration<double>(now - recent_.front().first).count() > kRateWindowS)
     recent_.pop_front();
   const double window = std::min(kRateWindowS, std::chrono::duration<double>(now - start_).count());

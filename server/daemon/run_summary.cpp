@@ -37,6 +37,21 @@ void print_stages(std::ostream& out, const MetricsSnapshot& m) {
                 m.shoot_p50, m.shoot_p99, m.shoot_total_ms, m.octree_p50, m.octree_p99, m.octree_total_ms, m.e2e_p50,
                 m.e2e_p99);
   out << line;
+  const StageTimes& p = m.stage1_total;
+  const double n = m.scans_applied ? double(m.scans_applied) : 1.0;
+  std::snprintf(line, sizeof line,
+                "  stage 1 parts (ms a scan, mean): upload %.3f, prepare %.3f, shoot %.3f (device %.3f), compact "
+                "%.3f (device %.3f, copy %.3f, unpack %.3f), rest %.3f\n",
+                p.upload_ms / n, p.prepare_ms / n, p.shoot_ms / n, p.shoot_gpu_ms / n, p.compact_ms / n,
+                p.compact_gpu_ms / n, p.readback_copy_ms / n, p.unpack_ms / n,
+                (m.shoot_total_ms - p.upload_ms - p.prepare_ms - p.shoot_ms - p.compact_ms) / n);
+  out << line;
+  std::snprintf(line, sizeof line,
+                "  waits:        decode (LCM thread) p50 %.2f ms p99 %.2f ms; queue p50 %.2f ms p99 %.2f ms; hand-off "
+                "to stage 2 p50 %.2f ms p99 %.2f ms\n",
+                m.decode.p50, m.decode.p99, m.queue_wait.p50, m.queue_wait.p99, m.handoff_wait.p50,
+                m.handoff_wait.p99);
+  out << line;
   std::snprintf(line, sizeof line,
                 "  overlap:      stage 1 busy %.3f s, stage 2 busy %.3f s, both at once %.3f s; %lld of %lld scans "
                 "had their octree update overlap another scan's shoot\n",

@@ -45,6 +45,7 @@ void ScanIntake::on_message(const lcm::ReceiveBuffer& rbuf, const std::string& c
   }
   item.producer = producer;
   item.received = received;
+  item.decoded = Clock::now();
   item.bytes = queued_bytes(item.msg);
   const int64_t seq = item.msg.seq, utime = item.msg.utime;
   producers_.admit(producer, seq, utime, [&] { return queue_.try_push(std::move(item)); });

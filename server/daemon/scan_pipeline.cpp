@@ -79,14 +79,21 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
   set_busy(0, true);
   const double token = metrics_.overlap().begin(0);
   const auto t0 = Clock::now();
+  const Clock::time_point decoded = item.decoded == Clock::time_point{} ? item.received : item.decoded;
+  job.waits.decode_ms = ms_between(item.received, decoded);
+  job.waits.queue_ms = ms_between(decoded, t0);
   bool ok = true;
   try {
-    const PosedMessageScan scan = to_posed_scan(item.msg);
-    const std::span<const octomap::point3d> pts(scan.points.size() ? &scan.points[0] : nullptr, scan.points.size());
     const double max_range = effective_max_range(item.msg.max_range, engine_.options().max_range);
-    if (scan.in_sensor_frame) {
-      engine_.shoot_posed(scan.pose, scan.origin, pts, max_range, job.shot);  // transformed on the GPU where it can
+    if (item.msg.points_frame == octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME) {
+      // The message's floats as they are: a back end preparing on its device copies them
+      // straight into its upload buffer (transformed on the GPU where it can).
+      const octomap::pose6d pose = scan_pose(item.msg);
+      const std::span<const float> xyz(item.msg.xyz.data(), item.msg.xyz.size() - item.msg.xyz.size() % 3);
+      engine_.shoot_posed_xyz(pose, pose.trans(), xyz, max_range, job.shot);
     } else {
+      const PosedMessageScan scan = to_posed_scan(item.msg);
+      const std::span<const octomap::point3d> pts(scan.points.size() ? &scan.points[0] : nullptr, scan.points.size());
       engine_.shoot(scan.origin, pts, max_range, job.shot);
     }
     if (!job.shot.prepare.origin_ok) {
@@ -112,7 +119,8 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
   job.utime = item.msg.utime;
   job.points = item.msg.num_xyz / 3;
   job.received = item.received;
-  job.shoot_ms = ms_between(t0, Clock::now());
+  job.shot_at = Clock::now();
+  job.shoot_ms = ms_between(t0, job.shot_at);
   return ok;
 }
 
@@ -133,6 +141,7 @@ void ScanPipeline::apply(ShotJob& job) {
   if (job.edit) return apply_edit(*job.edit);
   const double token = metrics_.overlap().begin(1);
   const auto t0 = Clock::now();
+  job.waits.handoff_ms = ms_between(job.shot_at, t0);
   set_busy(1, true);
   try {
     std::lock_guard lock(map_.mutex);
@@ -158,6 +167,9 @@ void ScanPipeline::apply(ShotJob& job) {
   t.end_to_end_ms = ms_between(job.received, t1);
   t.points = job.points;
   t.overlapped = overlap_s > 0;
+  t.waits = job.waits;
+  t.stage1 = job.shot.shoot.times;
+  t.stage1.octree_ms = 0;  // stage 2's
   metrics_.record(t);
   producers_.count_applied(job.producer, job.points, t.end_to_end_ms);
 }

@@ -27,6 +27,7 @@ struct QueuedScan {
   size_t producer = 0;
   uint64_t arrival = 0;        // global arrival number, set by the queue
   Clock::time_point received;  // when the LCM thread got it
+  Clock::time_point decoded;   // when the LCM thread had decoded and checked it (unset: = received)
   size_t bytes = 0;            // what it holds against the budget
   octomap_rt::scan_t msg;
   std::shared_ptr<MapEditItem> edit;  // set: a map edit, not a scan (msg is empty)

@@ -126,6 +126,11 @@ ServerConfig to_server_config(const ServerFlags& f) {
   ServerConfig c = f.server;
   c.engine = ort::cli::to_engine_options(f.engine);
   c.pipeline = !f.no_pipeline;
+  // Stage 1 shoots beside stage 2's octree update: the octree stage leaves it a core (a
+  // worker preempted by stage 1 stalls every join of the update), and the voxel list of a
+  // scan, small here, comes straight into host memory (one fence wait less a scan).
+  c.engine.shoots_beside_apply = c.pipeline;
+  c.engine.backend.compact_into_host_memory = true;
   c.engine.max_scan_walk_keys = f.max_scan_work;
   if (!(f.queue_mib >= 0 && f.queue_mib <= 1e9)) throw CLI::ValidationError("--queue-mib", "must be a number >= 0");
   c.queue_budget_bytes = static_cast<uint64_t>(f.queue_mib * 1048576.0);

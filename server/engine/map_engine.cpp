@@ -1,5 +1,6 @@
 #include "engine/map_engine.h"
 
+#include <stdexcept>
 #include <vector>
 
 #include "core/clock.h"
@@ -92,13 +93,14 @@ void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::p
   count_states(out);
 }
 
-void MapEngine::shoot_posed(const octomap::pose6d& pose, const octomap::point3d& origin,
-                            std::span<const octomap::point3d> sensor_points, double max_range, ShotScan& out) {
+void MapEngine::shoot_posed_xyz(const octomap::pose6d& pose, const octomap::point3d& origin,
+                                std::span<const float> sensor_xyz, double max_range, ShotScan& out) {
+  if (sensor_xyz.size() % 3) throw std::invalid_argument("scan points: x y z floats, a multiple of 3");
   if (backend_->prepares_on_device()) {
     out.reset();
     // The device shoots what fits one window plan; a far-flung scan comes back declined and
     // takes the CPU path below (tiles along the rays, the per-scan limits), as shoot() does.
-    backend_->shoot_posed({&pose, origin, sensor_points, max_range, kTiledAbove, opts_.max_scan_walk_keys},
+    backend_->shoot_posed({&pose, origin, sensor_xyz, max_range, kTiledAbove, opts_.max_scan_walk_keys},
                           opts_.traversal, out.voxels, out.shoot, out.prepare);
     if (!out.prepare.device_declined) {
       count_states(out);
@@ -107,7 +109,9 @@ void MapEngine::shoot_posed(const octomap::pose6d& pose, const octomap::point3d&
   }
   const bool declined = out.prepare.device_declined;
   const auto t0 = SteadyClock::now();
-  std::vector<octomap::point3d> world(sensor_points.begin(), sensor_points.end());
+  std::vector<octomap::point3d> world;
+  world.reserve(sensor_xyz.size() / 3);
+  for (size_t i = 0; i < sensor_xyz.size(); i += 3) world.emplace_back(sensor_xyz[i], sensor_xyz[i + 1], sensor_xyz[i + 2]);
   transform_to_map_frame(world, pose, opts_.octree.threads);
   const double transform_ms = ms_since(t0);
   shoot(origin, world, max_range, out);

@@ -92,7 +92,13 @@ class MapEngine {
   // CPU transforms and prepares; the rays are the same either way, bit for bit.
   // out.shoot.times.prepare_ms includes the transform.
   void shoot_posed(const octomap::pose6d& pose, const octomap::point3d& origin,
-                   std::span<const octomap::point3d> sensor_points, double max_range, ShotScan& out);
+                   std::span<const octomap::point3d> sensor_points, double max_range, ShotScan& out) {
+    shoot_posed_xyz(pose, origin, as_xyz(sensor_points), max_range, out);
+  }
+  // The same with the points as x y z floats (a scan message's layout): a back end that
+  // prepares on its device copies them straight into its upload buffer.
+  void shoot_posed_xyz(const octomap::pose6d& pose, const octomap::point3d& origin, std::span<const float> sensor_xyz,
+                       double max_range, ShotScan& out);
   // Stage 2. Adds its time to out.shoot.times.octree_ms. With `changes`: reset, then every
   // finest leaf the update changed, its value before and after (octree/leaf_changes.h).
   void apply(ShotScan& scan, octomap::OcTree& tree, LeafChanges* changes = nullptr) const;

@@ -93,13 +93,14 @@ void GpuPrepare::ensure_point_capacity(uint64_t points) {
   bound_ = false;
 }
 
-void GpuPrepare::stage_points(std::span<const octomap::point3d> sensor_points) {
-  if (sensor_points.size() > UINT32_MAX) throw std::runtime_error("GPU preparation: more than 2^32 points in one scan");
-  ensure_point_capacity(sensor_points.size());
+void GpuPrepare::stage_points(std::span<const float> sensor_xyz) {
+  const uint64_t points = sensor_xyz.size() / 3;
+  if (points > UINT32_MAX) throw std::runtime_error("GPU preparation: more than 2^32 points in one scan");
+  ensure_point_capacity(points);
   const vk::Buffer& host = unified_ ? points_ : points_staging_;
-  if (!sensor_points.empty()) std::memcpy(host.mapped(), sensor_points.data(), sensor_points.size_bytes());
+  if (points) std::memcpy(host.mapped(), sensor_xyz.data(), points * sizeof(octomap::point3d));
   host.flush();
-  staged_points_ = sensor_points.size();
+  staged_points_ = points;
 }
 
 void GpuPrepare::bind(VkBuffer rays) {

@@ -48,8 +48,9 @@ class GpuPrepare {
   GpuPrepare(const GpuPrepare&) = delete;
   GpuPrepare& operator=(const GpuPrepare&) = delete;
 
-  // Copies the points where the pass reads them (a staging buffer on discrete GPUs).
-  void stage_points(std::span<const octomap::point3d> sensor_points);
+  // Copies the points (x y z floats each) where the pass reads them (a staging buffer on
+  // discrete GPUs).
+  void stage_points(std::span<const float> sensor_xyz);
   // Prepares the staged points into rays[0, n) of `rays` (room for n rays), and waits.
   DevicePrepared run(const ScanFrame& frame, VkBuffer rays);
 

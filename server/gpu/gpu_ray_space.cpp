@@ -190,6 +190,7 @@ void GpuRaySpace::shoot_window(const RayBatch& batch, uint32_t ray_count, const 
   stamps_.fetch(kStampCount);
   const double gpu_upload = stamps_.elapsed_ms(kStampStart, kStampUploaded);
   const double gpu_compact = stamps_.elapsed_ms(kStampShot, kStampCompacted);
+  stats.times.shoot_gpu_ms += stamps_.elapsed_ms(kStampUploaded, kStampShot);
   stats.times.upload_ms += gpu_upload;
   stats.times.compact_ms += gpu_compact;
   stats.times.compact_gpu_ms += gpu_compact;

@@ -52,7 +52,7 @@ class VulkanBackend final : public RayBackend {
  public:
   VulkanBackend(const BackendOptions& opts, const VulkanTuning& tuning, const Log& log)
       : ctx_(make_context(opts)),
-        space_(ctx_, {.sizing = sizing_for(*ctx_, opts, tuning)}),
+        space_(ctx_, {.sizing = sizing_for(*ctx_, opts, tuning), .voxels_in_host_memory = opts.compact_into_host_memory}),
         shoot_octomap_(*ctx_, shoot_octomap_spv, 4, sizeof(gpu::ShootPush)),
         shoot_exact_(*ctx_, shoot_exact_spv, 4, sizeof(gpu::ShootPush)),
         max_groups_(ctx_->properties().limits.maxComputeWorkGroupCount[0]),
@@ -86,20 +86,21 @@ class VulkanBackend final : public RayBackend {
                    PrepareReport& report) override {
     if (!prepare_) return RayBackend::shoot_posed(scan, mode, out, stats, report);  // CPU preparation
     out.clear();
-    report.points_in += scan.points.size();
+    const size_t points = scan.point_count();
+    report.points_in += points;
     RayBatch header;  // origin, origin key, key box; the ends stay on the device
     if (!prepare_origin(scan.origin, resolution_, header, report)) return;
     const auto t_stage = Clock::now();
-    prepare_->stage_points(scan.points);
+    prepare_->stage_points(scan.xyz);
     stats.times.upload_ms += ms_since(t_stage);
     const auto t_prepare = Clock::now();
-    const VkBuffer rays = space_.device_rays(scan.points.size());
+    const VkBuffer rays = space_.device_rays(points);
     const gpu::DevicePrepared p = prepare_->run({*scan.pose, scan.origin, scan.max_range, resolution_}, rays);
     stats.times.prepare_ms += ms_since(t_prepare);
     report.nonfinite += p.nonfinite;
     report.out_of_range += p.out_of_range;
     report.cut_at_max_range += p.cut_at_max_range;
-    const uint64_t kept = scan.points.size() - p.nonfinite - p.out_of_range;
+    const uint64_t kept = points - p.nonfinite - p.out_of_range;
     report.rays += kept;
     if (kept == 0) return;  // as prepare_scan: no rays, nothing shot
     header.keys.include(octomap::OcTreeKey(p.end_keys.lo[0], p.end_keys.lo[1], p.end_keys.lo[2]));
@@ -111,7 +112,7 @@ class VulkanBackend final : public RayBackend {
     const vk::ComputePipeline& pass = mode == Traversal::kOctomap ? shoot_octomap_ : shoot_exact_;
     const std::vector<KeyBox> windows = plan_windows(header.keys, space_.grid_voxels(), kWindowMargin);
     space_.shoot_resident(
-        header, uint32_t(scan.points.size()), windows,
+        header, uint32_t(points), windows,
         [&](VkCommandBuffer cmd, gpu::ShootPush push) { record_shoot(cmd, pass, push); }, out, stats);
   }
 

@@ -62,7 +62,7 @@ class GpuPrepareTest : public ::testing::Test {
                          VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
       rays_bytes_ = bytes;
     }
-    prepare_->stage_points(s.points);
+    prepare_->stage_points(as_xyz(s.points));
     result = prepare_->run({s.pose, s.origin, s.max_range, s.resolution}, rays_.handle());
     rays_.invalidate();
     std::vector<RayEnd> kept;

@@ -184,13 +184,16 @@ TEST(ServerMemq, ThreeProducersWithoutPipelineEqualsSequentialInRecordedOrder) {
 
 // Real data: the 3dtk scans, one per producer, in the sensor frame. The server's map must
 // equal the OctoMap library's own insertPointCloud in the recorded order.
-TEST(ServerMemq, RealScansEqualOctomapInRecordedOrder) {
+void run_real_scans(BackendKind backend) {
   const std::string path = data_file("3dtk_dat/3dtk_3scans.graph");
   if (path.empty()) return;
   const ScanSet set = load_scan_graph(path);
   ASSERT_EQ(set.scans.size(), 3u);
   lcm::LCM lc("memq://");
-  const auto cfg = test_config(0.2, true);
+  auto cfg = test_config(0.2, true);
+  cfg.engine.backend.kind = backend;
+  cfg.engine.backend.compact_into_host_memory = true;  // as the daemon's command line sets it
+  cfg.engine.shoots_beside_apply = true;
   std::ostringstream log;
   daemon::MappingServer server(cfg, lc, log);
   server.start();
@@ -219,6 +222,12 @@ TEST(ServerMemq, RealScansEqualOctomapInRecordedOrder) {
     return 0;
   });
 }
+
+TEST(ServerMemq, RealScansEqualOctomapInRecordedOrder) { run_real_scans(BackendKind::kCpu); }
+
+// The same on the vulkan back end (lavapipe here): the scans' floats go from the message
+// straight to the device, which prepares and shoots them.
+TEST(ServerMemq, RealScansOnVulkanEqualOctomapInRecordedOrder) { run_real_scans(BackendKind::kVulkan); }
 
 // A producer over its byte budget loses its newest scans, counted as dropped; what is
 // applied keeps the arrival order, and the counts still balance.
