@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "core/prepare_scan.h"
+#include "daemon/scan_decode.h"
 #include "protocol/wire_layout.h"
 
 namespace ort::daemon {
@@ -56,9 +57,7 @@ Reject check_scan_wire(const uint8_t* data, size_t size, const ScanLimits& limit
 Reject check_scan_content(const octomap_rt::scan_t& m, const std::string& expected_robot_id,
                           const ScanLimits& limits) {
   if (m.num_xyz % 3 != 0) return Reject::kCountNotMultipleOf3;
-  for (float v : m.xyz) {
-    if (!std::isfinite(v)) return Reject::kNonFinitePoint;
-  }
+  if (!all_finite(m.xyz)) return Reject::kNonFinitePoint;
   for (double v : m.sensor_position) {
     if (!std::isfinite(v)) return Reject::kNonFinitePose;
   }
@@ -89,7 +88,7 @@ Reject validate_scan(const uint8_t* data, size_t size, const std::string& expect
                      const ScanLimits& limits, octomap_rt::scan_t& out) {
   if (Reject r = check_scan_wire(data, size, limits); r != Reject::kNone) return r;
   try {
-    const int used = out.decode(data, 0, static_cast<int>(size));
+    const int used = decode_scan(data, size, out);  // = out.decode(), the point array vectorized
     if (used < 0) return Reject::kDecodeFailed;
     if (static_cast<size_t>(used) != size) return Reject::kTrailingBytes;
   } catch (const std::exception&) {

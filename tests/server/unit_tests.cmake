@@ -1,6 +1,7 @@
 # In-process tests of octomap-rt-server's logic over memq:// (no network, no GPU: cpu back end).
 set(SERVER_TEST_FIXTURES ${CMAKE_CURRENT_LIST_DIR}/scan_fixtures.cpp)
 octomap_rt_add_test(server_validation_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/scan_validation_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/scan_decode_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 120)
 octomap_rt_add_test(server_memq_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_memq_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 600)
