@@ -1,12 +1,15 @@
 // libFuzzer target: one raw scan_t message, as the LCM thread gets it, through the server's
 // validator (wire checks, decode, content checks). Besides memory errors and UB, it checks
 // the validator's promise: when the wire checks pass, the generated decode() consumes the
-// message exactly and does not throw.
+// message exactly and does not throw, and the daemon's decode_scan gives what it gives, bit
+// for bit.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 
+#include "daemon/scan_decode.h"
 #include "daemon/scan_validation.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -23,6 +26,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     } catch (const std::exception&) {
       std::abort();  // the wire checks let through what decode() cannot read
     }
+    octomap_rt::scan_t ours;
+    if (decode_scan(data, size, ours) != static_cast<int>(size)) std::abort();
+    if (ours.xyz.size() != again.xyz.size() || ours.num_xyz != again.num_xyz || ours.robot_id != again.robot_id ||
+        ours.map_frame != again.map_frame || ours.seq != again.seq || ours.utime != again.utime ||
+        (!ours.xyz.empty() && std::memcmp(ours.xyz.data(), again.xyz.data(), ours.xyz.size() * sizeof(float)) != 0))
+      std::abort();
   }
   if (why == Reject::kNone && (msg.xyz.size() % 3 != 0 || msg.xyz.size() != static_cast<size_t>(msg.num_xyz)))
     std::abort();

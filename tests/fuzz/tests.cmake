@@ -29,7 +29,8 @@ function(octomap_rt_add_fuzz_target name)
 endfunction()
 
 octomap_rt_add_fuzz_target(fuzz_scan_message
-  SOURCES ${CMAKE_SOURCE_DIR}/server/daemon/scan_validation.cpp ${CMAKE_SOURCE_DIR}/server/daemon/reject_reason.cpp
+  SOURCES ${CMAKE_SOURCE_DIR}/server/daemon/scan_validation.cpp ${CMAKE_SOURCE_DIR}/server/daemon/scan_decode.cpp
+          ${CMAKE_SOURCE_DIR}/server/daemon/reject_reason.cpp
           ${CMAKE_SOURCE_DIR}/protocol/wire_layout.cpp
           ${CMAKE_SOURCE_DIR}/server/core/prepare_scan.cpp
   LIBS octomap_rt_lcmtypes octomap_rt_lcm)
