@@ -1,5 +1,5 @@
 // The cpu-grid's voxel layout inside one window: bricks of 8 x 8 x 4 voxels, one 64-byte
-// cache line of 2-bit states, each brick 16 words of 4 x 4 x 1 voxels.
+// cache line of 2-bit states, each brick 16 words of 8 x 2 x 1 voxels.
 //
 // Why: laid out x fastest, every y or z step of a ray's walk lands in another cache line
 // (and, over a window of tens of MiB, often another page); in a brick a walk stays in one line
@@ -32,9 +32,9 @@ class BrickLayout {
     ox_.resize(size_t(w.hi[0] - w.lo[0] + 1));
     oy_.resize(size_t(w.hi[1] - w.lo[1] + 1));
     oz_.resize(size_t(w.hi[2] - w.lo[2] + 1));
-    // Inside a brick: bits 0-1 x&3, 2-3 y&3 (slot in the word), 4 x>>2&1, 5 y>>2&1, 6-7 z&3.
-    for (uint32_t x = 0; x < ox_.size(); ++x) ox_[x] = (x & 3u) | ((x >> 2) & 1u) << 4 | (x >> 3) * kVoxelsPerBrick;
-    for (uint32_t y = 0; y < oy_.size(); ++y) oy_[y] = (y & 3u) << 2 | ((y >> 2) & 1u) << 5 | (y >> 3) * brick_row;
+    // Inside a brick: bits 0-2 x & 7, 3-5 y & 7, 6-7 z & 3 (a word is a row pair of 8 x 2 x 1).
+    for (uint32_t x = 0; x < ox_.size(); ++x) ox_[x] = (x & 7u) | (x >> 3) * kVoxelsPerBrick;
+    for (uint32_t y = 0; y < oy_.size(); ++y) oy_[y] = (y & 7u) << 3 | (y >> 3) * brick_row;
     for (uint32_t z = 0; z < oz_.size(); ++z) oz_[z] = (z & 3u) << 6 | (z >> 2) * brick_layer;
   }
 
@@ -58,14 +58,22 @@ class BrickLayout {
     return ox_[k[0] - w_.lo[0]] + oy_[k[1] - w_.lo[1]] + oz_[k[2] - w_.lo[2]];
   }
   // The key of slot `slot` (0-15) of word `word`.
-  octomap::OcTreeKey key_of(uint32_t word, uint32_t slot) const {
+  octomap::OcTreeKey key_of(uint32_t word, uint32_t slot) const { return word_key(word).voxel(slot); }
+
+  // The key of a word's slot 0, from which its other slots follow by bit operations (the
+  // brick's place takes divisions: once a word, not once a voxel).
+  struct WordKey {
+    int x, y, z;  // slot 0's key
+    octomap::OcTreeKey voxel(uint32_t slot) const {
+      return octomap::OcTreeKey(octomap::key_type(x + int(slot & 7u)), octomap::key_type(y + int(slot >> 3)),
+                                octomap::key_type(z));
+    }
+  };
+  WordKey word_key(uint32_t word) const {
     const uint32_t brick = word >> 4, in_brick = word & 15u;
     const uint32_t bx = brick % nbx_, by = (brick / nbx_) % nby_, bz = brick / (nbx_ * nby_);
-    const uint32_t x = bx * kBrickX + ((in_brick & 1u) << 2 | (slot & 3u));
-    const uint32_t y = by * kBrickY + (((in_brick >> 1) & 1u) << 2 | slot >> 2);
-    const uint32_t z = bz * kBrickZ + (in_brick >> 2);
-    return octomap::OcTreeKey(octomap::key_type(x + w_.lo[0]), octomap::key_type(y + w_.lo[1]),
-                              octomap::key_type(z + w_.lo[2]));
+    return WordKey{int(bx * kBrickX) + w_.lo[0], int(by * kBrickY + ((in_brick & 3u) << 1)) + w_.lo[1],
+                   int(bz * kBrickZ + (in_brick >> 2)) + w_.lo[2]};
   }
 
  private:

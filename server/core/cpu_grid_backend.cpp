@@ -197,13 +197,17 @@ class CpuGridBackend final : public RayBackend {
   // Turns touched words into voxel updates (occupied wins) and clears them: the grid is
   // cleared through the touched list only, never by a pass over the window.
   void compact(const BrickLayout& layout, const std::vector<uint32_t>& touched, VoxelList& out) {
+    uint32_t* grid = grid_.data();
     for (uint32_t word : touched) {
-      uint32_t bits = std::atomic_ref<uint32_t>(grid_.data()[word]).exchange(0, std::memory_order_relaxed);
+      uint32_t bits = grid[word];  // the walk's threads have joined: plain loads and stores
+      grid[word] = 0;
+      if (!bits) continue;
+      const BrickLayout::WordKey first = layout.word_key(word);
       while (bits) {
         const int slot = __builtin_ctz(bits) / 2;
         const uint32_t state = (bits >> (2 * slot)) & 3u;
         bits &= ~(3u << (2 * slot));
-        const octomap::OcTreeKey k = layout.key_of(word, uint32_t(slot));
+        const octomap::OcTreeKey k = first.voxel(uint32_t(slot));
         out.push_back(VoxelUpdate{k[0], k[1], k[2], uint16_t((state & kStateOccupied) ? kStateOccupied : kStateFree)});
       }
     }
