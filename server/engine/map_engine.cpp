@@ -119,8 +119,13 @@ void MapEngine::shoot_posed_xyz(const octomap::pose6d& pose, const octomap::poin
   out.prepare.device_declined = declined;  // said, so callers can count scans the device passed on
 }
 
+// A sum, not an increment of one of two counters chosen per voxel (that chains every voxel
+// through a store and a load of the same counter: twice the time on a 300K-voxel list).
 void MapEngine::count_states(ShotScan& out) const {
-  for (const VoxelUpdate& v : out.voxels) (v.occupied() ? out.occupied_voxels : out.free_voxels)++;
+  uint64_t occupied = 0;
+  for (const VoxelUpdate& v : out.voxels) occupied += v.occupied() ? 1 : 0;
+  out.occupied_voxels += occupied;
+  out.free_voxels += out.voxels.size() - occupied;
 }
 
 void MapEngine::shoot_tiled(const RayBatch& batch, ShotScan& out) {
