@@ -1,6 +1,32 @@
 #include "octree/worker_pool.h"
 
+#include <chrono>
+
 namespace ort {
+namespace {
+
+// How long a thread spins for a change before it sleeps: longer than the serial steps
+// between one scan's jobs (tens of microseconds), short against a scan.
+constexpr std::chrono::microseconds kSpin{100};
+
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#endif
+}
+
+// Returns once `value` no longer holds `old` (acquire); spins first when `spin`.
+void wait_for_change(const std::atomic<uint32_t>& value, uint32_t old, bool spin) {
+  const auto until = std::chrono::steady_clock::now() + kSpin;
+  for (unsigned i = 1; spin; ++i) {
+    if (value.load(std::memory_order_acquire) != old) return;
+    cpu_relax();
+    if (i % 64 == 0 && std::chrono::steady_clock::now() >= until) break;
+  }
+  while (value.load(std::memory_order_acquire) == old) value.wait(old, std::memory_order_acquire);
+}
+
+}  // namespace
 
 unsigned resolve_thread_count(unsigned requested) {
   if (requested > 0) return requested;
@@ -8,61 +34,51 @@ unsigned resolve_thread_count(unsigned requested) {
   return hw > 0 ? hw : 1;
 }
 
-WorkerPool::WorkerPool(unsigned workers) {
+WorkerPool::WorkerPool(unsigned workers, std::optional<bool> spin)
+    : spin_(spin.value_or(workers < std::thread::hardware_concurrency())) {
   for (unsigned w = 1; w < workers; ++w) threads_.emplace_back([this, w] { thread_main(w); });
 }
 
 WorkerPool::~WorkerPool() {
-  {
-    std::lock_guard lock(mutex_);
-    stopping_ = true;
-  }
-  job_ready_.notify_all();
+  stopping_.store(true, std::memory_order_relaxed);
+  generation_.fetch_add(1, std::memory_order_release);
+  generation_.notify_all();
   for (std::thread& t : threads_) t.join();
 }
 
 void WorkerPool::run(const std::function<void(unsigned)>& body) {
-  {
-    std::lock_guard lock(mutex_);
-    job_ = &body;
-    error_ = nullptr;
-    running_ = static_cast<unsigned>(threads_.size());
-    ++generation_;
-  }
-  job_ready_.notify_all();
+  error_ = nullptr;
+  job_ = &body;
+  const uint32_t threads = static_cast<uint32_t>(threads_.size());
+  running_.store(threads, std::memory_order_relaxed);
+  generation_.fetch_add(1, std::memory_order_release);
+  if (threads > 0) generation_.notify_all();
   std::exception_ptr own_error;
   try {
     body(0);
   } catch (...) {
     own_error = std::current_exception();
   }
-  std::unique_lock lock(mutex_);
-  job_done_.wait(lock, [this] { return running_ == 0; });
+  for (uint32_t left; (left = running_.load(std::memory_order_acquire)) != 0;) wait_for_change(running_, left, spin_);
   job_ = nullptr;
   if (own_error) std::rethrow_exception(own_error);
   if (error_) std::rethrow_exception(error_);
 }
 
 void WorkerPool::thread_main(unsigned worker) {
-  unsigned long long seen = 0;
+  uint32_t seen = 0;  // the generation this thread ran last (0: none yet)
   for (;;) {
-    const std::function<void(unsigned)>* job;
-    {
-      std::unique_lock lock(mutex_);
-      job_ready_.wait(lock, [&] { return stopping_ || generation_ != seen; });
-      if (stopping_) return;
-      seen = generation_;
-      job = job_;
-    }
-    std::exception_ptr error;
+    wait_for_change(generation_, seen, spin_);
+    seen = generation_.load(std::memory_order_acquire);
+    if (stopping_.load(std::memory_order_relaxed)) return;
     try {
-      (*job)(worker);
+      (*job_)(worker);
     } catch (...) {
-      error = std::current_exception();
+      std::lock_guard lock(error_mutex_);
+      if (!error_) error_ = std::current_exception();
     }
-    std::lock_guard lock(mutex_);
-    if (error && !error_) error_ = error;
-    if (--running_ == 0) job_done_.notify_one();
+    // acq_rel: the caller's acquire of 0 sees this thread's writes (and the error).
+    if (running_.fetch_sub(1, std::memory_order_acq_rel) == 1) running_.notify_one();
   }
 }
 
