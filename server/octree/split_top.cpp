@@ -79,7 +79,7 @@ void SplitTop::child_done(int parent, bool changed, octomap::OcTree& node_ops) {
     if (pending_[parent].fetch_sub(1, std::memory_order_acq_rel) != 1) return;
     const Node& n = nodes_[parent];
     changed = changed_[parent].load(std::memory_order_relaxed);
-    if (changed && !node_ops.pruneNode(n.node)) n.node->updateOccupancyChildren();
+    if (changed) settle_inner_node(node_ops, n.node);
     parent = n.parent;
   }
 }

@@ -31,7 +31,7 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
     for (; depth > target; --depth) {
       PathNode& p = path[depth];
       if (!p.changed) continue;
-      if (depth < kTreeDepth && !node_ops.pruneNode(p.node)) p.node->updateOccupancyChildren();
+      if (depth < kTreeDepth) settle_inner_node(node_ops, p.node);
       path[depth - 1].changed = true;
     }
   };
@@ -48,7 +48,7 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
         // An existing leaf is what updateNode's search finds: at the bound, nothing happens.
         if (p.just_created || !at_clamping_bound(tree, *p.node, update)) {
           const float before = p.node->getLogOdds();  // a created leaf's 0, or an expanded node's value
-          tree.updateNodeLogOdds(p.node, update);
+          update_leaf_log_odds(tree, *p.node, update);
           if (changes) log_leaf_change(*changes, sorted_voxel_code(v), p.just_created, before, p.node->getLogOdds());
           p.changed = true;
           p.just_created = false;  // a repeated key finds this leaf as it is now
@@ -77,7 +77,7 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
 
   // The root of the subtree is settled here too; its ancestors are the caller's.
   PathNode& top = path[root.depth];
-  if (top.changed && root.depth < kTreeDepth && !node_ops.pruneNode(top.node)) top.node->updateOccupancyChildren();
+  if (top.changed && root.depth < kTreeDepth) settle_inner_node(node_ops, top.node);
   return top.changed;
 }
 

@@ -8,6 +8,7 @@
 // gives (see batched_update.h for why the order of the voxels does not matter).
 #pragma once
 
+#include <limits>
 #include <span>
 
 #include <octomap/OcTree.h>
@@ -48,6 +49,44 @@ inline bool at_clamping_bound(const octomap::OcTree& tree, const octomap::OcTree
   const float v = node.getLogOdds();
   return (log_odds_update >= 0 && v >= tree.getClampingThresMaxLog()) ||
          (log_odds_update <= 0 && v <= tree.getClampingThresMinLog());
+}
+
+// updateNodeLogOdds of OctoMap's OccupancyOcTreeBase inlined (it is virtual and calls the
+// library's out-of-line addValue; this runs once per voxel): the same float addition, then
+// the same clamping comparisons. OcTree does not override it; tests/octree compares every
+// map with OctoMap's own.
+inline void update_leaf_log_odds(const octomap::OcTree& tree, octomap::OcTreeNode& leaf, float update) {
+  const float v = leaf.getLogOdds() + update;
+  if (v < tree.getClampingThresMinLog())
+    leaf.setLogOdds(tree.getClampingThresMinLog());
+  else if (v > tree.getClampingThresMaxLog())
+    leaf.setLogOdds(tree.getClampingThresMaxLog());
+  else
+    leaf.setLogOdds(v);
+}
+
+// Settles an inner node whose subtree changed, as the last updateNode through it leaves it:
+// pruned when its 8 children are leaves of one value (pruneNode), else the max of its
+// children's log-odds (updateOccupancyChildren). One read of the children decides both,
+// with isNodeCollapsible's and getMaxChildLogOdds's comparisons; the prune itself goes
+// through `node_ops` (it frees the children and counts them), which checks again.
+inline void settle_inner_node(octomap::OcTree& node_ops, octomap::OcTreeNode* node) {
+  float max = -std::numeric_limits<float>::max();
+  bool collapsible = true;
+  float first = 0;
+  for (unsigned i = 0; i < 8; ++i) {
+    if (!node_ops.nodeChildExists(node, i)) {
+      collapsible = false;
+      continue;
+    }
+    const octomap::OcTreeNode* child = node_ops.getNodeChild(node, i);
+    const float l = child->getLogOdds();
+    if (l > max) max = l;
+    if (i == 0) first = l;
+    if (node_ops.nodeHasChildren(child) || !(l == first)) collapsible = false;
+  }
+  if (collapsible && node_ops.pruneNode(node)) return;
+  node->setLogOdds(max);
 }
 
 }  // namespace ort
