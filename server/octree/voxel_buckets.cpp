@@ -63,10 +63,18 @@ unsigned build_rank_table(const uint64_t* bits, unsigned shift, uint32_t stride,
   const size_t nodes = size_t{1} << (16 - shift);
   cell_of.assign(nodes, 0);
   node_of.clear();
-  for (size_t g = 0; g < nodes; ++g) {
-    if (!group_occupied(bits, shift, g)) continue;
+  auto add = [&](size_t g) {
     cell_of[g] = static_cast<uint32_t>(node_of.size()) * stride;
     node_of.push_back(static_cast<uint16_t>(g));
+  };
+  if (shift >= 6) {
+    for (size_t g = 0; g < nodes; ++g)
+      if (group_occupied(bits, shift, g)) add(g);
+  } else {
+    // A word at a time (this is serial work per scan): the occupied groups' first bits.
+    for (size_t w = 0; w < kAxisWords; ++w)
+      for (uint64_t f = fold_groups(bits[w], shift); f != 0; f &= f - 1)
+        add((w * 64 + static_cast<size_t>(std::countr_zero(f))) >> shift);
   }
   return static_cast<unsigned>(node_of.size());
 }
@@ -148,10 +156,11 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
   const CellOf cell_of{scratch.cell_of_axis[0].data(), scratch.cell_of_axis[1].data(),
                       scratch.cell_of_axis[2].data(), shift};
 
-  // Pass 2: voxels per cell, per worker.
-  scratch.counts.assign(size_t{workers} * cells, 0);
+  // Pass 2: voxels per cell, per worker (each worker clears its own row first).
+  scratch.counts.resize(size_t{workers} * cells);
   run_on(pool, workers, [&, cell_of](unsigned w) {
     uint32_t* count = &scratch.counts[size_t{w} * cells];
+    std::fill_n(count, cells, 0u);
     const VoxelUpdate* u = updates.data();
     if (chunk_begin(w) == chunk_begin(w + 1)) return;
     // Runs of voxels in one cell (a ray's) are counted in a register, not through memory.
@@ -168,28 +177,40 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
     count[cell] += run;
   });
 
-  // Occupied cells in Morton order of their nodes; each worker's part of a bucket after the
-  // parts of the workers before it, so the buckets keep the list's order.
+  // Per cell, on the workers (a slice of the cells each): the cell's total, and each
+  // worker's count replaced by the sum of the workers' before it, so that each worker's part
+  // of a bucket comes after the parts of the workers before it (the buckets keep the list's
+  // order). Serially, this was a strided walk over every worker's row per cell.
+  scratch.totals.resize(cells);
+  run_on(pool, workers, [&](unsigned w) {
+    for (size_t c = cells * w / workers, e = cells * (w + 1) / workers; c < e; ++c) {
+      uint32_t sum = 0;
+      for (unsigned k = 0; k < workers; ++k) {
+        uint32_t& slot = scratch.counts[size_t{k} * cells + c];
+        const uint32_t n_here = slot;
+        slot = sum;
+        sum += n_here;
+      }
+      scratch.totals[c] = sum;
+    }
+  });
+
+  // Occupied cells in Morton order of their nodes, and where each one's bucket begins.
   scratch.nonempty.clear();
   for (size_t c = 0; c < cells; ++c) {
-    uint32_t total = 0;
-    for (unsigned w = 0; w < workers; ++w) total += scratch.counts[size_t{w} * cells + c];
-    if (total == 0) continue;
+    if (scratch.totals[c] == 0) continue;
     const size_t rx = c % nx, ry = c / nx % ny, rz = c / (size_t{nx} * ny);
     scratch.nonempty.emplace_back(morton_code(node_of[0][rx], node_of[1][ry], node_of[2][rz]),
                                   static_cast<uint32_t>(c));
   }
   std::sort(scratch.nonempty.begin(), scratch.nonempty.end());
   out.begin.reserve(scratch.nonempty.size() + 1);
+  scratch.cell_begin.resize(cells);
   size_t offset = 0;
   for (const auto& [code, c] : scratch.nonempty) {
     out.begin.push_back(offset);
-    for (unsigned w = 0; w < workers; ++w) {
-      uint32_t& slot = scratch.counts[size_t{w} * cells + c];
-      const uint32_t k = slot;
-      slot = static_cast<uint32_t>(offset);
-      offset += k;
-    }
+    scratch.cell_begin[c] = static_cast<uint32_t>(offset);
+    offset += scratch.totals[c];
   }
   out.begin.push_back(n);
 
@@ -199,6 +220,8 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
     uint32_t* next = &scratch.counts[size_t{w} * cells];
     const VoxelUpdate* u = updates.data();
     if (chunk_begin(w) == chunk_begin(w + 1)) return;
+    const uint32_t* cell_begin = scratch.cell_begin.data();
+    for (size_t c = 0; c < cells; ++c) next[c] += cell_begin[c];  // only nonempty cells are read
     uint32_t cell = cell_of(u[chunk_begin(w)]), pos = next[cell];
     for (size_t i = chunk_begin(w), e = chunk_begin(w + 1); i < e; ++i) {
       const uint32_t c = cell_of(u[i]);

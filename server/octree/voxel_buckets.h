@@ -47,7 +47,9 @@ struct VoxelBuckets {
 struct BucketScratch {
   std::vector<uint8_t> seen;       // [worker][axis][65536]: key coordinates that occur
   std::vector<uint64_t> occupied;  // [worker][axis][1024 words]: the same as bits; worker 0's: all
-  std::vector<uint32_t> counts;    // [worker][cell]
+  std::vector<uint32_t> counts;    // [worker][cell]: voxels, then the workers' offsets
+  std::vector<uint32_t> totals;    // [cell]: voxels
+  std::vector<uint32_t> cell_begin;  // [cell]: first index of its bucket (nonempty cells)
   std::vector<uint32_t> cell_of_axis[3];
   std::vector<std::pair<uint64_t, uint32_t>> nonempty;  // (node code, cell)
 };
