@@ -75,12 +75,15 @@ int main(int argc, char** argv) {
   std::vector<unsigned> threads;
   double resolution = 0.1;
   int repeat = 5, passes = 3;
+  bool batched_only = false;
   app.add_option("--data", data_dir, "data folder")->capture_default_str();
   app.add_option("--graph", graphs, "ScanGraph files below the data folder")->capture_default_str();
   app.add_option("--threads", threads, "thread counts of the batched stage (default: 1, 2, ..., hardware)");
   app.add_option("-r,--resolution", resolution, "voxel size [m]")->capture_default_str();
   app.add_option("--repeat", repeat, "runs of each, best taken")->capture_default_str();
   app.add_option("--passes", passes, "times the scan lists are applied in a row per run")->capture_default_str();
+  app.add_flag("--batched-only", batched_only,
+               "run only the batched stage (no OctoMap loop, no map check, no ordering comparison): for profilers");
   CLI11_PARSE(app, argc, argv);
 
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
@@ -99,7 +102,7 @@ int main(int argc, char** argv) {
 
     // Ordering alone: the stage's bucketing plus a sort of every bucket on 1 thread, and the
     // bucketing on all threads, against std::sort of the whole list's Morton codes.
-    {
+    if (!batched_only) {
       std::vector<ort::SortedVoxel> codes, tmp;
       ort::VoxelBuckets buckets;
       ort::BucketScratch scratch;
@@ -140,10 +143,12 @@ int main(int argc, char** argv) {
     for (int r = 0; r < repeat; ++r) {
       octomap::OcTree reference(resolution);
       auto t = Clock::now();
-      for (int p = 0; p < passes; ++p)
-        for (const auto& l : d.lists) ort::apply_updates_sequential(reference, l);
-      octomap_time.best_ms = std::min(octomap_time.best_ms, ms_since(t));
-      nodes = reference.size();
+      if (!batched_only) {
+        for (int p = 0; p < passes; ++p)
+          for (const auto& l : d.lists) ort::apply_updates_sequential(reference, l);
+        octomap_time.best_ms = std::min(octomap_time.best_ms, ms_since(t));
+        nodes = reference.size();
+      }
       for (size_t i = 0; i < threads.size(); ++i) {
         octomap::OcTree tree(resolution);
         ort::BatchedUpdateStats sum, one;
@@ -161,21 +166,27 @@ int main(int argc, char** argv) {
           }
         const double ms = ms_since(t);
         if (ms < batched_time[i].best_ms) batched_time[i] = Timing{ms, sum};
-        if (!(tree == reference)) {
+        if (batched_only) {
+          nodes = tree.size();
+        } else if (!(tree == reference)) {
           std::printf("  MISMATCH: batched map with %u threads differs from OctoMap's\n", threads[i]);
           ++failures;
         }
       }
     }
     const double passes_voxels = double(d.voxels) * passes;
-    std::printf("  OctoMap updateNode loop: %9.1f ms  (%.0f ns/voxel), %zu nodes\n", octomap_time.best_ms,
-                octomap_time.best_ms * 1e6 / passes_voxels, nodes);
+    if (batched_only)
+      std::printf("  OctoMap updateNode loop: not run (--batched-only; ratios below are meaningless), %zu nodes\n",
+                  nodes);
+    else
+      std::printf("  OctoMap updateNode loop: %9.1f ms  (%.0f ns/voxel), %zu nodes\n", octomap_time.best_ms,
+                  octomap_time.best_ms * 1e6 / passes_voxels, nodes);
     for (size_t i = 0; i < threads.size(); ++i) {
       const Timing& b = batched_time[i];
       std::printf("  batched, %2u thread(s):   %9.1f ms  (%.0f ns/voxel)  %6.1fx   [buckets %.1f, top %.1f, "
                   "subtrees %.1f (of which bucket sorts %.1f thread-ms) ms; %zu buckets at depth %u, %lld nodes "
                   "counted in]\n",
-                  threads[i], b.best_ms, b.best_ms * 1e6 / passes_voxels, octomap_time.best_ms / b.best_ms,
+                  threads[i], b.best_ms, b.best_ms * 1e6 / passes_voxels, batched_only ? 0.0 : octomap_time.best_ms / b.best_ms,
                   b.stats.bucket_ms, b.stats.top_ms, b.stats.subtrees_ms, b.stats.sort_cpu_ms, b.stats.subtrees,
                   b.stats.bucket_depth, b.stats.node_count_change);
     }
