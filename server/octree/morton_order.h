@@ -7,6 +7,7 @@
 // down to the depth their codes first differ at.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "core/voxel_update.h"
@@ -16,14 +17,19 @@ namespace ort {
 constexpr unsigned kTreeDepth = 16;  // OcTree's depth: 16-bit keys
 
 namespace detail {
+// Bit i of the byte moved to bit 3i, for every byte: 1 KiB that stays in L1. Two lookups
+// per coordinate replace five shift-and-mask steps; this runs for every voxel of every scan.
+constexpr std::array<uint32_t, 256> make_spread_table() {
+  std::array<uint32_t, 256> t{};
+  for (uint32_t b = 0; b < 256; ++b)
+    for (unsigned i = 0; i < 8; ++i) t[b] |= ((b >> i) & 1u) << (3 * i);
+  return t;
+}
+inline constexpr std::array<uint32_t, 256> kSpreadByte = make_spread_table();
+
 // Spreads the 16 bits of v to every third bit (bit i -> bit 3i).
-inline uint64_t spread_bits(uint64_t v) {
-  v &= 0xffffu;
-  v = (v | (v << 16)) & 0x0000ff0000ffull;
-  v = (v | (v << 8)) & 0x00f00f00f00full;
-  v = (v | (v << 4)) & 0x0c30c30c30c3ull;
-  v = (v | (v << 2)) & 0x249249249249ull;
-  return v;
+inline uint64_t spread_bits(uint16_t v) {
+  return uint64_t{kSpreadByte[v & 0xffu]} | (uint64_t{kSpreadByte[v >> 8]} << 24);
 }
 }  // namespace detail
 

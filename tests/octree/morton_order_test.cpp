@@ -27,6 +27,26 @@ TEST(MortonOrder, ChildIndicesAreOctomapsAtEveryDepth) {
   }
 }
 
+// The code by its definition, bit by bit: key bit i of x, y, z at code bits 3i, 3i+1, 3i+2.
+uint64_t morton_by_bits(uint16_t x, uint16_t y, uint16_t z) {
+  uint64_t code = 0;
+  for (unsigned i = 0; i < 16; ++i)
+    code |= (uint64_t{(x >> i) & 1u} << (3 * i)) | (uint64_t{(y >> i) & 1u} << (3 * i + 1)) |
+            (uint64_t{(z >> i) & 1u} << (3 * i + 2));
+  return code;
+}
+
+TEST(MortonOrder, EveryCoordinateOfEveryAxisIsInterleavedBitByBit) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> key(0, 65535);
+  for (uint32_t v = 0; v < 65536; ++v) {
+    const auto c = static_cast<uint16_t>(v), o1 = static_cast<uint16_t>(key(rng)), o2 = static_cast<uint16_t>(key(rng));
+    ASSERT_EQ(morton_code(c, o1, o2), morton_by_bits(c, o1, o2)) << "x " << v;
+    ASSERT_EQ(morton_code(o1, c, o2), morton_by_bits(o1, c, o2)) << "y " << v;
+    ASSERT_EQ(morton_code(o1, o2, c), morton_by_bits(o1, o2, c)) << "z " << v;
+  }
+}
+
 TEST(MortonOrder, KeyRangeEdges) {
   EXPECT_EQ(morton_code(0, 0, 0), 0u);
   EXPECT_EQ(morton_code(65535, 65535, 65535), (uint64_t{1} << 48) - 1);
