@@ -1,5 +1,6 @@
 #include "core/window_walk_avx2.h"
 
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
 
@@ -17,6 +18,36 @@ bool cpu_has_avx2() { return __builtin_cpu_supports("avx2"); }
 
 namespace {
 
+// Free marks found unset wait in a buffer of this many indices.
+constexpr int kPending = 64;
+
+// For each mask of 4 lanes, the permutation that moves the low 32 bits of each set lane's
+// 64-bit value to the front, in lane order (_mm256_permutevar8x32_epi32's control).
+struct PackTable {
+  alignas(32) int32_t control[16][8];
+};
+constexpr PackTable kPackLanes = [] {
+  PackTable table{};
+  for (int mask = 0; mask < 16; ++mask)
+    for (int lane = 0, n = 0; lane < 4; ++lane)
+      if (mask >> lane & 1) table.control[mask][n++] = 2 * lane;
+  return table;
+}();
+
+// BrickLayout::index in lanes: (key - window.lo) per axis -> the voxel's index in the grid
+// (bits 0-2 x & 7, 3-5 y & 7, 6-7 z & 3, then whole bricks).
+__attribute__((target("avx2"))) inline __m256i brick_index(__m256i x, __m256i y, __m256i z, __m256i brick_row,
+                                                          __m256i brick_layer) {
+  const __m256i seven = _mm256_set1_epi64x(7), three = _mm256_set1_epi64x(3);
+  const __m256i in_brick = _mm256_or_si256(
+      _mm256_or_si256(_mm256_and_si256(x, seven), _mm256_slli_epi64(_mm256_and_si256(y, seven), 3)),
+      _mm256_slli_epi64(_mm256_and_si256(z, three), 6));
+  const __m256i bricks = _mm256_add_epi64(
+      _mm256_add_epi64(_mm256_slli_epi64(_mm256_srli_epi64(x, 3), 8), _mm256_mul_epu32(_mm256_srli_epi64(y, 3), brick_row)),
+      _mm256_mul_epu32(_mm256_srli_epi64(z, 2), brick_layer));
+  return _mm256_add_epi64(in_brick, bricks);
+}
+
 // The DDA's start (octomap_ray_start) of up to four rays, computed in AVX2 lanes with the
 // same IEEE operations in the same order (float difference, float squared norm, double sqrt
 // cast to float, float division, double border/difference/division), so bit for bit the
@@ -25,6 +56,7 @@ struct alignas(32) StartBlock {
   double t_max[3][4], t_delta[3][4], length[4];
   int64_t step[3][4], end_key[3][4];
   int64_t out[3][4];  // the first coordinate (key - window.lo) outside the window along the step
+  int order[4];       // the rays (places above) that leave the origin voxel; the others are unused
   int count = 0, next = 0;
 };
 
@@ -44,40 +76,76 @@ class RayFeed {
       border_up_[i] = centre + (float)(1 * res * 0.5);
       border_down_[i] = centre + (float)(-1 * res * 0.5);
     }
+    for (int i = 0; i < 3; ++i) lo_minus_max_[i] = int64_t(w.lo[i]) - kTreeMaxVal;
+    brick_row_ = layout.brick_row(), brick_layer_ = layout.brick_layer();
     origin_index_ = layout.x_offsets()[origin_[0]] + layout.y_offsets()[origin_[1]] + layout.z_offsets()[origin_[2]];
   }
 
   // The next ray that walks at least one step: its place in block(); -1 when none is left.
   __attribute__((target("avx2"))) int take() {
     if (block_.next == block_.count && !fill_block()) return -1;
-    return block_.next++;
+    return block_.order[block_.next++];
   }
   const StartBlock& block() const { return block_; }
   const int64_t* origin() const { return origin_; }
+  // Sets the measured ends still waiting (call when no ray is left).
+  void finish() {
+    marker_.mark_all(occupied_, n_occupied_, kStateOccupied);
+    n_occupied_ = 0;
+  }
 
  private:
-  // Takes up to four rays that leave the origin voxel and computes their starts.
+  // Takes the next four rays (fewer at the batch's end): their end keys in lanes (OctoMap's
+  // coordToKeyChecked: floor(1 / resolution * coord) in double), their measured ends queued
+  // as occupied marks, and the starts of those that leave the origin voxel. False when no
+  // ray is left that leaves it.
   __attribute__((target("avx2"))) bool fill_block() {
-    alignas(16) float ends[3][4];
-    int n = 0;
-    const KeyBox& w = layout_.window();
-    while (n < 4 && next_ < end_) {
-      const RayEnd& e = b_.ends[next_++];
-      octomap::OcTreeKey end_key;
-      coord_to_key_checked(octomap::point3d(e.x, e.y, e.z), res_, end_key);  // prepare_scan kept only in-range ends
-      if ((e.flags & kRayEndOccupied) && layout_.contains(end_key)) marker_.mark(layout_.index(end_key), kStateOccupied);
-      if (end_key == b_.origin_key) continue;
-      marker_.mark(origin_index_, kStateFree);
-      ends[0][n] = e.x, ends[1][n] = e.y, ends[2][n] = e.z;
-      for (int i = 0; i < 3; ++i) block_.end_key[i][n] = end_key[i] - w.lo[i];
-      ++n;
+    while (next_ < end_) {
+      const size_t n = std::min<size_t>(4, end_ - next_);
+      __m128 e[4];  // x, y, z, flags of four rays
+      for (size_t j = 0; j < 4; ++j) e[j] = _mm_loadu_ps(&b_.ends[next_ + std::min(j, n - 1)].x);
+      next_ += n;
+      _MM_TRANSPOSE4_PS(e[0], e[1], e[2], e[3]);
+      __m256i key[3];  // key - window.lo
+      __m256i inside = _mm256_cmpgt_epi64(_mm256_set1_epi64x(int64_t(n)), _mm256_setr_epi64x(0, 1, 2, 3));
+      __m256i at_origin = inside;
+      for (int i = 0; i < 3; ++i) {
+        const __m256d scaled = _mm256_mul_pd(_mm256_set1_pd(1.0 / res_), _mm256_cvtps_pd(e[i]));
+        const __m128i floored = _mm256_cvttpd_epi32(_mm256_round_pd(scaled, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
+        key[i] = _mm256_sub_epi64(_mm256_cvtepi32_epi64(floored), _mm256_set1_epi64x(lo_minus_max_[i]));
+        inside = _mm256_and_si256(inside, _mm256_andnot_si256(_mm256_cmpgt_epi64(_mm256_setzero_si256(), key[i]),
+                                                              _mm256_cmpgt_epi64(_mm256_set1_epi64x(extent_[i]), key[i])));
+        at_origin = _mm256_and_si256(at_origin, _mm256_cmpeq_epi64(key[i], _mm256_set1_epi64x(origin_[i])));
+        _mm256_store_si256(reinterpret_cast<__m256i*>(block_.end_key[i]), key[i]);
+      }
+      const __m256i occupied = _mm256_cvtepi32_epi64(_mm_castps_si128(_mm_cmpneq_ps(
+          _mm_and_ps(e[3], _mm_castsi128_ps(_mm_set1_epi32(kRayEndOccupied))), _mm_setzero_ps())));
+      queue_occupied(_mm256_and_si256(occupied, inside), brick_index(key[0], key[1], key[2], _mm256_set1_epi64x(brick_row_), _mm256_set1_epi64x(brick_layer_)));
+      const __m256i valid = _mm256_cmpgt_epi64(_mm256_set1_epi64x(int64_t(n)), _mm256_setr_epi64x(0, 1, 2, 3));
+      const int walks = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_andnot_si256(at_origin, valid)));
+      if (!walks) continue;
+      if (!origin_marked_) marker_.mark(origin_index_, kStateFree), origin_marked_ = true;
+      block_.count = 0, block_.next = 0;
+      for (int bits = walks; bits; bits &= bits - 1) block_.order[block_.count++] = __builtin_ctz(unsigned(bits));
+      // Rays that do not walk take a direction that cannot divide by zero; their starts go unused.
+      const __m128 unused = _mm_castsi128_ps(_mm_cmpeq_epi32(
+          _mm_and_si128(_mm_set1_epi32(walks), _mm_setr_epi32(1, 2, 4, 8)), _mm_setzero_si128()));
+      alignas(16) float ends[3][4];
+      for (int i = 0; i < 3; ++i) _mm_store_ps(ends[i], _mm_blendv_ps(e[i], _mm_set1_ps(b_.origin(i) + 1.0f), unused));
+      compute_starts(ends);
+      return true;
     }
-    for (int k = n; k < 4; ++k)  // unused lanes repeat a real ray (no division by zero)
-      for (int i = 0; i < 3; ++i) ends[i][k] = n ? ends[i][0] : b_.origin(i) + 1.0f;
-    block_.count = n, block_.next = 0;
-    if (n == 0) return false;
-    compute_starts(ends);
-    return true;
+    return false;
+  }
+
+  // Queues the occupied marks of the lanes in `mask`, set in batches (as the walk's free marks).
+  __attribute__((target("avx2"))) void queue_occupied(__m256i mask, __m256i index) {
+    const int lanes = _mm256_movemask_pd(_mm256_castsi256_pd(mask));
+    const __m256i packed = _mm256_permutevar8x32_epi32(
+        index, _mm256_load_si256(reinterpret_cast<const __m256i*>(kPackLanes.control[lanes])));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(occupied_ + n_occupied_), _mm256_castsi256_si128(packed));
+    n_occupied_ += __builtin_popcount(unsigned(lanes));
+    if (n_occupied_ > kPending - 4) finish();
   }
 
   __attribute__((target("avx2"))) void compute_starts(const float (&ends)[3][4]) {
@@ -119,24 +187,13 @@ class RayFeed {
   int64_t origin_[3], extent_[3];
   double border_up_[3], border_down_[3];
   uint32_t origin_index_;
+  bool origin_marked_ = false;
+  int64_t lo_minus_max_[3];  // window.lo - 32768: key - window.lo = floor(...) - this
+  uint32_t brick_row_, brick_layer_;
+  alignas(16) uint32_t occupied_[kPending];
+  int n_occupied_ = 0;
   StartBlock block_;
 };
-
-// Free marks found unset wait in a buffer of this many indices.
-constexpr int kPending = 64;
-
-// For each mask of 4 lanes, the permutation that moves the low 32 bits of each set lane's
-// 64-bit value to the front, in lane order (_mm256_permutevar8x32_epi32's control).
-struct PackTable {
-  alignas(32) int32_t control[16][8];
-};
-constexpr PackTable kPackLanes = [] {
-  PackTable table{};
-  for (int mask = 0; mask < 16; ++mask)
-    for (int lane = 0, n = 0; lane < 4; ++lane)
-      if (mask >> lane & 1) table.control[mask][n++] = 2 * lane;
-  return table;
-}();
 
 // The four lanes' DDA state, kept in registers; a finished lane takes its next ray by
 // broadcast and blend (scalar stores into memory read back as vectors stall the walk).
@@ -166,20 +223,6 @@ struct LaneState {
     active = _mm256_andnot_si256(_mm256_castpd_si256(lane), active);
   }
 };
-
-// BrickLayout::index in lanes: (key - window.lo) per axis -> the voxel's index in the grid
-// (bits 0-2 x & 7, 3-5 y & 7, 6-7 z & 3, then whole bricks).
-__attribute__((target("avx2"))) inline __m256i brick_index(__m256i x, __m256i y, __m256i z, __m256i brick_row,
-                                                          __m256i brick_layer) {
-  const __m256i seven = _mm256_set1_epi64x(7), three = _mm256_set1_epi64x(3);
-  const __m256i in_brick = _mm256_or_si256(
-      _mm256_or_si256(_mm256_and_si256(x, seven), _mm256_slli_epi64(_mm256_and_si256(y, seven), 3)),
-      _mm256_slli_epi64(_mm256_and_si256(z, three), 6));
-  const __m256i bricks = _mm256_add_epi64(
-      _mm256_add_epi64(_mm256_slli_epi64(_mm256_srli_epi64(x, 3), 8), _mm256_mul_epu32(_mm256_srli_epi64(y, 3), brick_row)),
-      _mm256_mul_epu32(_mm256_srli_epi64(z, 2), brick_layer));
-  return _mm256_add_epi64(in_brick, bricks);
-}
 
 }  // namespace
 
@@ -261,6 +304,7 @@ __attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t be
     }
   }
   marker.mark_all(pending, n_pending, kStateFree);
+  feed.finish();
 }
 
 #else
