@@ -184,6 +184,7 @@ bool MappingServer::stop() {
   queue_.close();
   drain_until_deadline();
   pipeline_->join();
+  pipeline_drained_ = true;
   if (deltas_) deltas_->stop();  // sends the last change set
   map_.observer = nullptr;
   {
