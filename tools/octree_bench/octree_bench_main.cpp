@@ -23,6 +23,7 @@
 #include "octree/batched_update.h"
 #include "octree/morton_order.h"
 #include "octree/voxel_buckets.h"
+#include "octree/worker_pool.h"
 #include "scene/scan_set.h"
 
 namespace {
@@ -94,6 +95,18 @@ int main(int argc, char** argv) {
   std::printf("octree stage benchmark: %u hardware threads, %s\n", hw, cpu_model().c_str());
   std::printf("resolution %.3g m, %d pass(es) over each data set's lists, best of %d runs\n\n", resolution, passes,
               repeat);
+
+  // The worker pool's hand-over alone: a scan's update is four jobs on the pool, each
+  // started and joined (worker_pool.h), so this times an empty job per thread count.
+  for (unsigned t : threads) {
+    if (t < 2) continue;
+    ort::WorkerPool pool(t);
+    constexpr int kJobs = 2000;
+    const auto start = Clock::now();
+    for (int j = 0; j < kJobs; ++j) pool.run([](unsigned) {});
+    std::printf("worker pool, %2u threads: %.1f us per empty job (start and join)\n", t, ms_since(start) * 1e3 / kJobs);
+  }
+  std::printf("\n");
 
   int failures = 0;
   for (const std::string& g : graphs) {
