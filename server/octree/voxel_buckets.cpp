@@ -11,6 +11,7 @@ namespace {
 constexpr size_t kParallelMin = 32768;  // below this the threads cost more than they save
 constexpr size_t kAxisWords = 1024;     // 65536 bits: one per key coordinate
 constexpr size_t kInsertionMax = 32;
+constexpr unsigned kDirectMaxBits = 12;  // direct_sort: up to 4096 slots (32 KiB)
 
 // Runs body(worker) on the pool's workers, or once on this thread without a pool.
 template <class F>
@@ -94,6 +95,31 @@ void insertion_sort(SortedVoxel* v, size_t n) {
     for (; j > 0 && (v[j - 1] >> 1) > (x >> 1); --j) v[j] = v[j - 1];
     v[j] = x;
   }
+}
+
+// A bucket whose codes differ only in their low `bits` bits (a node of at most 4096 voxels,
+// the usual bucket) and whose keys are all different (a scan's list has each key once): each
+// voxel goes straight to the slot of its low bits, and the occupied slots are read back in
+// order. Returns false, with `data` untouched, on a repeated key: the stable radix sort
+// keeps the list's order of its updates.
+bool direct_sort(SortedVoxel* data, size_t n, unsigned bits, std::vector<SortedVoxel>& tmp) {
+  const size_t slots = size_t{1} << bits;
+  const uint64_t mask = slots - 1;
+  std::array<uint64_t, (size_t{1} << kDirectMaxBits) / 64> used;
+  const size_t words = (slots + 63) / 64;
+  std::fill_n(used.begin(), words, uint64_t{0});
+  tmp.resize(std::max(tmp.size(), slots));
+  for (size_t i = 0; i < n; ++i) {
+    const uint64_t slot = (data[i] >> 1) & mask;
+    const uint64_t bit = uint64_t{1} << (slot & 63);
+    if (used[slot >> 6] & bit) return false;
+    used[slot >> 6] |= bit;
+    tmp[slot] = data[i];
+  }
+  size_t out = 0;
+  for (size_t w = 0; w < words; ++w)
+    for (uint64_t f = used[w]; f != 0; f &= f - 1) data[out++] = tmp[w * 64 + static_cast<size_t>(std::countr_zero(f))];
+  return true;
 }
 
 }  // namespace
@@ -247,8 +273,9 @@ void sort_bucket(std::span<SortedVoxel> bucket, std::vector<SortedVoxel>& tmp) {
   for (size_t i = 0; i < n; ++i) varying |= data[i] ^ data[0];
   varying >>= 1;  // the code's bits
   if (varying == 0) return;
-  // LSD radix passes of at most 8 bits over the varying code bits, all counted in one read.
   const unsigned bits = 64u - static_cast<unsigned>(std::countl_zero(varying));
+  if (bits <= kDirectMaxBits && direct_sort(data, n, bits, tmp)) return;
+  // LSD radix passes of at most 8 bits over the varying code bits, all counted in one read.
   const unsigned passes = (bits + 7) / 8;
   const unsigned digit = (bits + passes - 1) / passes;
   const uint64_t mask = (uint64_t{1} << digit) - 1;

@@ -81,6 +81,38 @@ TEST(VoxelBuckets, SortedBucketsAreTheMortonSortOfTheList) {
   }
 }
 
+// sort_bucket alone, on buckets of nodes of 2^3 .. 2^6 voxels a side (the slot-per-key path
+// up to 4096 voxels, radix sorts above), full and sparse, with and without one repeated key
+// (which must keep the list's order of its two updates): always std::stable_sort's result.
+TEST(VoxelBuckets, SortBucketIsTheStableMortonSort) {
+  std::mt19937 rng(21);
+  std::vector<SortedVoxel> tmp;
+  for (unsigned side_bits : {3u, 4u, 5u, 6u}) {
+    const int side = 1 << side_bits;
+    for (size_t n : {size_t{33}, size_t{200}, size_t{1} << (3 * std::min(side_bits, 4u))}) {
+      for (bool repeat : {false, true}) {
+        // Unique keys inside one node at (32768 - side .. 32768) on each axis.
+        std::vector<octomap::OcTreeKey> all;
+        for (int x = 0; x < side; ++x)
+          for (int y = 0; y < side; ++y)
+            for (int z = 0; z < side; ++z) all.emplace_back(32768 - side + x, 32768 - side + y, 32768 - side + z);
+        std::shuffle(all.begin(), all.end(), rng);
+        std::vector<SortedVoxel> bucket;
+        for (size_t i = 0; i < n && i < all.size(); ++i) bucket.push_back(make_sorted_voxel(make_update(all[i], rng() % 2)));
+        if (repeat) {
+          // The first key again, in the other state, somewhere later.
+          const SortedVoxel again = bucket.front() ^ 1u;
+          bucket.insert(bucket.begin() + static_cast<long>(1 + rng() % (bucket.size() - 1)), again);
+        }
+        std::vector<SortedVoxel> expected = bucket;
+        std::stable_sort(expected.begin(), expected.end(), [](SortedVoxel a, SortedVoxel b) { return (a >> 1) < (b >> 1); });
+        sort_bucket(bucket, tmp);
+        ASSERT_EQ(bucket, expected) << "side " << side << ", " << n << " voxels, repeat " << repeat;
+      }
+    }
+  }
+}
+
 TEST(VoxelBuckets, ARepeatedKeyKeepsTheListsOrder) {
   std::mt19937 rng(8);
   WorkerPool pool(2);
