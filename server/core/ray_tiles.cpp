@@ -15,7 +15,15 @@ constexpr double kTreeMaxVal = 32768.0;
 // Continuous key coordinate of a map coordinate (floor gives OctoMap's key).
 double key_coord(double v, double res) { return v / res + kTreeMaxVal; }
 
-int clamp_key(double k) { return static_cast<int>(std::clamp(std::floor(k), 0.0, double(kKeyMax))); }
+// clamp(floor(k), 0, kKeyMax) without std::floor (a libm call without SSE4.1; this runs for
+// every ray of every scan): below 0 -> 0, from kKeyMax on -> kKeyMax, between them floor is
+// the truncation of a non-negative value. NaN, which never reaches here (prepare_scan drops
+// non-finite points), gives 0.
+int clamp_key(double k) {
+  if (!(k >= 0.0)) return 0;
+  if (k >= double(kKeyMax)) return kKeyMax;
+  return static_cast<int>(k);
+}
 
 using TileSet = std::array<uint32_t, 8>;
 

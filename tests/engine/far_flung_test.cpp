@@ -4,6 +4,7 @@
 // far-flung scan's map equals OctoMap's, its cost is bounded, and what cannot be processed
 // the way OctoMap does (a ray longer than OctoMap's KeyRay) or costs more than the bound is
 // refused with a reason instead of shot.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -70,6 +71,35 @@ TEST(RayTiles, TilesCoverEveryVoxelTheWalkVisits) {
     walk_octomap_ray(batch.origin, end, batch.origin_key, end_key, res, check);
     check(end_key);
     EXPECT_EQ(missing, 0u) << "ray " << r << ": " << missing << " of " << visited << " voxels in no tile of the ray";
+  }
+}
+
+// ray_walk_keys (the per-scan work estimate) against its formula with std::floor, on ends at
+// voxel borders +-1 ulp, at and past the key range's edges, negative coordinates, -0.0.
+TEST(RayTiles, WalkKeysCountEqualsItsFormulaOnBordersAndRangeEdges) {
+  for (double res : {0.1, 0.05, 0.25}) {
+    RayBatch batch;
+    batch.resolution = res;
+    batch.origin = octomap::point3d(0.05f, -0.05f, 1.0f);
+    PrepareReport rep;
+    ASSERT_TRUE(prepare_origin(batch.origin, res, batch, rep));
+    std::vector<float> coords = {0.0f, -0.0f, 1e9f, -1e9f};
+    for (double v : {0.1, -0.1, 0.3, -0.3, 12.5, -12.5, 3276.7, -3276.8, 3276.8, 3300.0, -3300.0, 1638.35, -1638.4}) {
+      const float f = float(v);
+      coords.insert(coords.end(), {f, std::nextafter(f, 1e10f), std::nextafter(f, -1e10f)});
+    }
+    for (float x : coords)
+      for (float y : {x, -x, 0.25f})
+        for (float z : {-x, 0.0f}) {
+          const RayEnd e{x, y, z, kRayEndOccupied};
+          uint64_t expected = 1;
+          const double c[3] = {e.x, e.y, e.z};
+          for (int i = 0; i < 3; ++i) {
+            const int key = int(std::clamp(std::floor(c[i] / res + 32768.0), 0.0, 65535.0));
+            expected += uint64_t(std::abs(key - int(batch.origin_key[i])));
+          }
+          ASSERT_EQ(ray_walk_keys(batch, e), expected) << x << " " << y << " " << z << " res " << res;
+        }
   }
 }
 
