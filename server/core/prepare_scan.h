@@ -26,9 +26,11 @@ struct PrepareReport {
 
 // Builds the rays of one scan. Points are in the map frame, as OctoMap's insertPointCloud
 // takes them. max_range < 0 means no limit. Large scans are prepared on `threads` threads
-// (0: hardware threads); the result is the same as on one thread, ray for ray.
+// (0: hardware threads); the result is the same as on one thread, ray for ray. `simd`: four
+// points at a time in AVX2 lanes where the CPU has it (false: point by point; the same batch).
 RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::point3d> points,
-                      double max_range, double resolution, PrepareReport& report, unsigned threads = 0);
+                      double max_range, double resolution, PrepareReport& report, unsigned threads = 0,
+                      bool simd = true);
 
 // The origin's part of prepare_scan: batch.origin, origin_key and the key box's first key,
 // or report.origin_ok = false (with the reason) when the origin is not finite or outside

@@ -190,5 +190,48 @@ TEST(PrepareScan, ThreadsGiveTheSameBatchRayForRay) {
   }
 }
 
+// The AVX2 preparation (four points at a time) against the point-by-point loop: the same
+// rays in the same order, the same key box and counts, on points at voxel borders +-1 ulp,
+// at and past the key range's edges, -0.0, NaN and inf in any lane, and counts not a multiple
+// of four; with and without a max range (which takes the point-by-point loop).
+TEST(PrepareScan, FourPointsAtATimeGiveThePointByPointBatch) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-60.0f, 60.0f);
+  std::uniform_int_distribution<int> pick(0, 15);
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  const float special[] = {0.0f, -0.0f, 0.1f, -0.1f, 0.3f, -0.3f, 3276.7f, -3276.8f, 3276.8f, -3276.9f, 1e7f, nan, inf, -inf};
+  for (double res : {0.1, 0.05}) {
+    for (size_t count : {0u, 1u, 3u, 4u, 7u, 50001u}) {
+      std::vector<octomap::point3d> pts;
+      for (size_t i = 0; i < count; ++i) {
+        octomap::point3d p(u(rng), u(rng), u(rng));
+        for (int a = 0; a < 3; ++a) {
+          const int k = pick(rng);
+          if (k < 14 && i % 5 == 0) p(a) = special[k];
+          else if (k == 14) p(a) = std::nextafter(std::round(p(a) * 10) / 10, 1e9f);
+          else if (k == 15) p(a) = std::nextafter(std::round(p(a) * 10) / 10, -1e9f);
+        }
+        pts.push_back(p);
+      }
+      for (double max_range : {-1.0, 30.0}) {
+        PrepareReport rs, rv;
+        const RayBatch s = prepare_scan({0.05f, -2.0f, 1.0f}, pts, max_range, res, rs, 1, false);
+        const RayBatch v = prepare_scan({0.05f, -2.0f, 1.0f}, pts, max_range, res, rv, 1, true);
+        EXPECT_EQ(rs.rays, rv.rays);
+        EXPECT_EQ(rs.nonfinite, rv.nonfinite);
+        EXPECT_EQ(rs.out_of_range, rv.out_of_range);
+        EXPECT_EQ(rs.cut_at_max_range, rv.cut_at_max_range);
+        if (count > 1000) EXPECT_GT(rs.nonfinite, 0u);
+        for (int i = 0; i < 3; ++i) {
+          EXPECT_EQ(s.keys.lo[i], v.keys.lo[i]) << "count " << count;
+          EXPECT_EQ(s.keys.hi[i], v.keys.hi[i]) << "count " << count;
+        }
+        ASSERT_EQ(s.ends.size(), v.ends.size());
+        ASSERT_EQ(0, std::memcmp(s.ends.data(), v.ends.data(), s.ends.size() * sizeof(RayEnd))) << "count " << count;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ort
