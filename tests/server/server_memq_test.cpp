@@ -226,8 +226,16 @@ void run_real_scans(BackendKind backend) {
 TEST(ServerMemq, RealScansEqualOctomapInRecordedOrder) { run_real_scans(BackendKind::kCpu); }
 
 // The same on the vulkan back end (lavapipe here): the scans' floats go from the message
-// straight to the device, which prepares and shoots them.
-TEST(ServerMemq, RealScansOnVulkanEqualOctomapInRecordedOrder) { run_real_scans(BackendKind::kVulkan); }
+// straight to the device, which prepares and shoots them. Not in the ASan step, which leaves
+// the GPU back ends out (tools/run-tests): lavapipe's driver leaves a 128-byte allocation
+// that LeakSanitizer finds in an unknown (JIT) module; the plain build runs it.
+TEST(ServerMemq, RealScansOnVulkanEqualOctomapInRecordedOrder) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "the vulkan back end is outside the ASan step (lavapipe's driver leaks 128 bytes)";
+#else
+  run_real_scans(BackendKind::kVulkan);
+#endif
+}
 
 // A producer over its byte budget loses its newest scans, counted as dropped; what is
 // applied keeps the arrival order, and the counts still balance.
