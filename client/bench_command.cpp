@@ -306,6 +306,7 @@ int run_bench(const BenchArgs& a) {
             opts.octree.mode = octree == "batched" ? OctreeUpdateMode::kBatched : OctreeUpdateMode::kSequential;
             opts.octree.threads = a.threads;
             opts.shoots_beside_apply = !a.no_pipeline;
+            opts.stage1_helpers_yield = true;
             std::fprintf(stderr, "  %s @ %.2f m: %s, %s traversal, %s octree ...", name.c_str(), res, backend.c_str(),
                          traversal.c_str(), octree.c_str());
             try {

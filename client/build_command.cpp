@@ -48,6 +48,7 @@ void write_map(const octomap::OcTree& tree, const std::string& path) {
 int run_build(const BuildArgs& a) {
   EngineOptions opts = to_engine_options(a.engine);
   opts.shoots_beside_apply = !a.no_pipeline;
+  opts.stage1_helpers_yield = true;
   const auto t_load = std::chrono::steady_clock::now();
   const ScanSet set = a.input == "synthetic" ? make_synthetic_rooms() : load_scan_graph(a.input);
   const double load_ms =

@@ -37,6 +37,10 @@ struct BackendOptions {
   // instead of device memory copied back in a submission of its own (one fence wait less a
   // scan: the daemon's choice, whose scans' lists are small; gpu/gpu_ray_space.h).
   bool compact_into_host_memory = false;
+  // cpu-grid: the walk's helper threads run at the lowest priority, so that a stage 1 beside
+  // the octree stage takes only the cores that stage leaves idle (set by MapEngine for the
+  // batch programs; not the daemon: a starved helper would hold up a scan's latency).
+  bool helpers_yield = false;
   bool verbose = false;
 };
 

@@ -10,6 +10,10 @@
 #include <limits>
 #include <new>
 #include <thread>
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 #include <vector>
 
 #include "core/brick_layout.h"
@@ -90,6 +94,10 @@ struct WindowStepper {
   int x_out = 0, y_out = 0, z_out = 0;  // the first coordinate outside the window along each step
 };
 
+// Nice 19 for the calling thread only (Linux: a thread's nice value is its own). Best effort:
+// a refusal leaves the thread as it was.
+void lower_own_priority() { (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19); }
+
 class CpuGridBackend final : public RayBackend {
  public:
   explicit CpuGridBackend(const CpuGridOptions& o)
@@ -97,6 +105,7 @@ class CpuGridBackend final : public RayBackend {
         threads_(o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency())),
         words_((o.grid_budget_bytes ? o.grid_budget_bytes : (256ull << 20)) / 4),
         simd_(o.simd && cpu_has_avx2()),
+        helpers_yield_(o.helpers_yield),
         grid_(words_) {}
 
   BackendKind kind() const override { return BackendKind::kCpuGrid; }
@@ -117,14 +126,21 @@ class CpuGridBackend final : public RayBackend {
     for (const KeyBox& w : windows) {
       const auto t_shoot = Clock::now();
       const BrickLayout layout(w);
+      // Rays are taken in chunks from a shared counter, so a helper thread that gets little
+      // CPU (helpers_yield) holds up the window by one chunk at most.
+      std::atomic<size_t> next{0};
+      constexpr size_t kChunk = 1024;
       run_parallel(n_threads, [&](unsigned t) {
-        const size_t begin = batch.ends.size() * t / n_threads, end = batch.ends.size() * (t + 1) / n_threads;
+        if (t > 0 && helpers_yield_) lower_own_priority();
         touched[t].clear();
         GridMarker marker{grid_.data(), touched[t], n_threads > 1};
-        if (mode == Traversal::kOctomap && simd_ && layout.contains(batch.origin_key)) {
-          walk_rays_avx2(batch, begin, end, layout, res_, marker);
-        } else {
-          for (size_t i = begin; i < end; ++i) shoot_ray(batch, batch.ends[i], mode, layout, marker);
+        for (size_t begin; (begin = next.fetch_add(kChunk)) < batch.ends.size();) {
+          const size_t end = std::min(batch.ends.size(), begin + kChunk);
+          if (mode == Traversal::kOctomap && simd_ && layout.contains(batch.origin_key)) {
+            walk_rays_avx2(batch, begin, end, layout, res_, marker);
+          } else {
+            for (size_t i = begin; i < end; ++i) shoot_ray(batch, batch.ends[i], mode, layout, marker);
+          }
         }
       });
       stats.times.shoot_ms += ms_since(t_shoot);
@@ -217,6 +233,7 @@ class CpuGridBackend final : public RayBackend {
   unsigned threads_;
   uint64_t words_;
   bool simd_;  // OctoMap walks in AVX2 lanes (window_walk_avx2.h) where the CPU has AVX2
+  bool helpers_yield_;
   GridMemory grid_;
 };
 

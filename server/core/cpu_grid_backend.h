@@ -16,6 +16,9 @@ struct CpuGridOptions {
   uint64_t grid_budget_bytes = 256ull << 20;  // the persistent grid; 0 = 256 MiB
   unsigned threads = 0;                       // 0 = hardware threads
   bool simd = true;                           // AVX2 ray walk where the CPU has it (false: scalar only)
+  // The walk's threads other than the caller run at the lowest priority (nice 19): they take
+  // the cores another stage leaves idle and give way when it runs (BackendOptions::helpers_yield).
+  bool helpers_yield = false;
 };
 
 std::unique_ptr<RayBackend> make_cpu_grid_backend(const CpuGridOptions& opts);

@@ -21,8 +21,15 @@ MapEngine::MapEngine(const EngineOptions& opts, const Log& log) : opts_(opts), o
   opts_.backend.resolution = opts.resolution;
   opts_.backend.max_range = opts.max_range;
   opts_.backend.traversal = opts.traversal;
+  const bool share_cores = opts_.shoots_beside_apply && opts_.stage1_helpers_yield && opts_.backend.threads == 0 &&
+                           opts_.octree.threads == 0;
+  opts_.backend.helpers_yield = share_cores;  // read by cpu-grid only
   backend_ = make_backend(opts_.backend, log);
   const unsigned hardware = resolve_thread_count(0);
+  if (share_cores && backend_->kind() == BackendKind::kCpuGrid) {
+    opts_.octree.threads = std::max(1u, hardware / 2);
+    octree_stage_ = OctreeStage(opts_.octree);  // its threads start on first use
+  }
   if (opts_.shoots_beside_apply && opts_.octree.threads == 0 && on_device(backend_->kind()) &&
       hardware >= kSpareCoreAbove) {
     opts_.octree.threads = hardware - 1;

@@ -69,10 +69,10 @@ std::vector<octomap::point3d> scan_points(const octomap::point3d& origin, float 
 }
 
 void expect_grid_equals_cpu(const octomap::point3d& origin, float reach, uint64_t grid_bytes, unsigned threads,
-                            bool expect_split, bool simd) {
+                            bool expect_split, bool simd, bool helpers_yield = false) {
   const double res = 0.1;
   auto reference = make_cpu_backend(res);
-  auto grid = make_cpu_grid_backend({res, grid_bytes, threads, simd});
+  auto grid = make_cpu_grid_backend({res, grid_bytes, threads, simd, helpers_yield});
   for (uint32_t seed = 1; seed <= 3; ++seed) {
     PrepareReport rep;
     const RayBatch b = prepare_scan(origin, scan_points(origin, reach, seed), seed == 2 ? reach * 0.5 : -1.0, res, rep);
@@ -107,6 +107,15 @@ TEST(CpuGridBackend, BrickedWalkEqualsCpuBackendAcrossWindows) {
       expect_grid_equals_cpu({0.05f, 0.05f, 0.05f}, 12.0f, 128u << 10, threads, true, simd);
       expect_grid_equals_cpu({3276.0f, -3276.0f, 3270.0f}, 6.0f, 16u << 10, threads, true, simd);
     }
+  }
+}
+
+// Rays are taken in chunks from a shared counter: 3 threads on 2 cores, helpers at the lowest
+// priority (as bench and build run the walk beside the octree stage), in one and in many windows.
+TEST(CpuGridBackend, YieldingHelperThreadsGiveTheSameVoxels) {
+  for (bool simd : {false, true}) {
+    expect_grid_equals_cpu({0.8f, -1.6f, 0.4f}, 9.0f, 0, 3, false, simd, true);
+    expect_grid_equals_cpu({0.05f, 0.05f, 0.05f}, 12.0f, 128u << 10, 3, true, simd, true);
   }
 }
 

@@ -132,6 +132,23 @@ TEST(PipelinedInsertion, TheOctreeStageLeavesAThreadToADeviceStageOne) {
   EXPECT_EQ(MapEngine(asked).octree_threads(), 3u);
 }
 
+// bench and build (stage1_helpers_yield): with cpu-grid the octree stage takes half the
+// hardware threads, the walk keeps all of them; asked-for counts and the daemon keep theirs.
+TEST(PipelinedInsertion, BatchProgramsShareTheCoresBetweenTheWalkAndTheOctreeStage) {
+  const unsigned hardware = resolve_thread_count(0);
+  EngineOptions batch = engine_options(BackendKind::kCpuGrid);
+  batch.stage1_helpers_yield = true;
+  EXPECT_EQ(MapEngine(batch).octree_threads(), std::max(1u, hardware / 2));
+  EngineOptions asked = batch;
+  asked.octree.threads = 2;
+  EXPECT_EQ(MapEngine(asked).octree_threads(), 2u);
+  EngineOptions sequential = batch;
+  sequential.shoots_beside_apply = false;
+  EXPECT_EQ(MapEngine(sequential).octree_threads(), hardware);
+  EngineOptions daemon = engine_options(BackendKind::kCpuGrid);  // stage1_helpers_yield unset
+  EXPECT_EQ(MapEngine(daemon).octree_threads(), hardware);
+}
+
 // A small scene: a wall of points in front of the sensor.
 ScanSet small_scans(size_t n) {
   ScanSet set;
