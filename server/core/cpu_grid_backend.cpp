@@ -1,6 +1,9 @@
 #include "core/cpu_grid_backend.h"
 
 #include <sys/mman.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -10,10 +13,6 @@
 #include <limits>
 #include <new>
 #include <thread>
-
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 #include <vector>
 
 #include "core/brick_layout.h"
