@@ -5,8 +5,10 @@ octomap_rt_add_test(server_validation_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/sca
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 120)
 octomap_rt_add_test(server_memq_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_memq_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/server_status_counts_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/server_published_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 600)
-octomap_rt_lcm_handler_sources(server_memq_test ${CMAKE_CURRENT_LIST_DIR}/server_memq_test.cpp)
+octomap_rt_lcm_handler_sources(server_memq_test ${CMAKE_CURRENT_LIST_DIR}/server_memq_test.cpp
+                               ${CMAKE_CURRENT_LIST_DIR}/server_published_test.cpp)
 octomap_rt_add_test(server_persistence_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_store_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/server_persistence_test.cpp ${CMAKE_CURRENT_LIST_DIR}/map_file_integrity_test.cpp
                     ${SERVER_TEST_FIXTURES}
