@@ -44,7 +44,7 @@ struct EngineOptions {
   // (at least one) and the walk all of them, its helper threads at the lowest priority: the
   // walk then has a core of its own and the octree stage's idle ones. On 2 cores this took
   // fr079-real from 1.06-1.25 s to 0.73 s and fr079 0.1 from 197-243 to 166-210 ms, where one
-  // thread a stage lost 35-60 % on the sets stage 1 dominates (docs/BENCHMARKS.md, issue 12).
+  // thread a stage lost 27-60 % on the sets stage 1 dominates (docs/BENCHMARKS.md, issue 12).
   // Not for the daemon: a helper starved by other processes would hold up a scan.
   bool stage1_helpers_yield = false;
 };
