@@ -6,6 +6,10 @@
 #include <cstdlib>
 #include <unordered_map>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 namespace ort {
 namespace {
 
@@ -91,6 +95,59 @@ uint64_t ray_walk_keys(const RayBatch& batch, const RayEnd& e) {
     n += uint64_t(std::abs(key - int(batch.origin_key[i])));
   }
   return n;
+}
+
+namespace {
+
+#if defined(__x86_64__)
+// ray_walk_keys of rays [0, 4 * groups) in AVX2 lanes: key_coord's v / res + 32768 in double,
+// clamp_key as max(k, 0) (MAXPD returns its second operand, 0, for NaN and for -0.0) then
+// min(k, 65535) and truncation, |key - origin key| summed over the axes.
+__attribute__((target("avx2"))) WalkKeyTotals walk_keys_avx2(const RayBatch& b, size_t groups) {
+  const __m256d res = _mm256_set1_pd(b.resolution), max_val = _mm256_set1_pd(kTreeMaxVal);
+  const __m256d zero = _mm256_setzero_pd(), key_max = _mm256_set1_pd(double(kKeyMax));
+  const __m128i origin[3] = {_mm_set1_epi32(b.origin_key[0]), _mm_set1_epi32(b.origin_key[1]),
+                             _mm_set1_epi32(b.origin_key[2])};
+  __m256i sum = _mm256_setzero_si256();
+  __m128i longest = _mm_setzero_si128();
+  for (size_t g = 0; g < groups; ++g) {
+    __m128 c[4];  // x, y, z, flags of four rays
+    for (int j = 0; j < 4; ++j) c[j] = _mm_loadu_ps(&b.ends[4 * g + j].x);
+    _MM_TRANSPOSE4_PS(c[0], c[1], c[2], c[3]);
+    __m128i n = _mm_set1_epi32(1);
+    for (int i = 0; i < 3; ++i) {
+      const __m256d k = _mm256_add_pd(_mm256_div_pd(_mm256_cvtps_pd(c[i]), res), max_val);
+      const __m128i key = _mm256_cvttpd_epi32(_mm256_min_pd(_mm256_max_pd(k, zero), key_max));
+      n = _mm_add_epi32(n, _mm_abs_epi32(_mm_sub_epi32(key, origin[i])));
+    }
+    sum = _mm256_add_epi64(sum, _mm256_cvtepu32_epi64(n));
+    longest = _mm_max_epu32(longest, n);
+  }
+  alignas(32) uint64_t s[4];
+  alignas(16) uint32_t l[4];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(s), sum);
+  _mm_store_si128(reinterpret_cast<__m128i*>(l), longest);
+  return {s[0] + s[1] + s[2] + s[3], std::max({l[0], l[1], l[2], l[3]})};
+}
+#endif
+
+}  // namespace
+
+WalkKeyTotals batch_walk_keys(const RayBatch& batch, bool simd) {
+  WalkKeyTotals t;
+  size_t done = 0;
+#if defined(__x86_64__)
+  if (simd && __builtin_cpu_supports("avx2")) {
+    t = walk_keys_avx2(batch, batch.ends.size() / 4);
+    done = batch.ends.size() / 4 * 4;
+  }
+#endif
+  for (size_t i = done; i < batch.ends.size(); ++i) {
+    const uint64_t k = ray_walk_keys(batch, batch.ends[i]);
+    t.sum += k;
+    t.longest = std::max(t.longest, k);
+  }
+  return t;
 }
 
 uint64_t tiled_walk_keys(const RayBatch& batch, int side, int margin) {

@@ -28,6 +28,14 @@ inline constexpr uint64_t kMaxRayWalkKeys = 100'000 - 2;
 // Keys the walk of `e` from the batch's origin visits at most: |dx| + |dy| + |dz| + 1.
 uint64_t ray_walk_keys(const RayBatch& batch, const RayEnd& e);
 
+// ray_walk_keys over every ray of the batch: the sum (the scan's work) and the longest walk.
+struct WalkKeyTotals {
+  uint64_t sum = 0, longest = 0;
+};
+// Four rays at a time where the CPU has AVX2 (the same double division, addition, clamp and
+// truncation in lanes, so the same counts), else ray by ray. `simd` false: ray by ray.
+WalkKeyTotals batch_walk_keys(const RayBatch& batch, bool simd = true);
+
 struct RayTile {
   KeyBox box;                  // the tile, cut to the scan's widened key box
   std::vector<uint32_t> rays;  // indices into RayBatch::ends, ascending

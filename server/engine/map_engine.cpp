@@ -76,12 +76,7 @@ void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::p
   if (!out.prepare.origin_ok) return;
   // Bounded work whatever the geometry: OctoMap's own limit per ray, then the scan's cost
   // (tiles for a box too large for one window) against the configured bound.
-  uint64_t longest = 0, single = 0;
-  for (const RayEnd& e : batch.ends) {
-    const uint64_t k = ray_walk_keys(batch, e);
-    longest = std::max(longest, k);
-    single += k;
-  }
+  const auto [single, longest] = batch_walk_keys(batch);
   if (longest > kMaxRayWalkKeys)
     return refuse(out, ShotRefusal::kRayTooLong,
                   "a ray walks " + std::to_string(longest) + " keys; OctoMap's ray walk holds at most " +

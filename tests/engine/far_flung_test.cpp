@@ -103,6 +103,43 @@ TEST(RayTiles, WalkKeysCountEqualsItsFormulaOnBordersAndRangeEdges) {
   }
 }
 
+// batch_walk_keys (four rays at a time in AVX2 lanes where the CPU has it) against
+// ray_walk_keys ray by ray: the same sum and longest walk on ends at voxel borders +-1 ulp,
+// past the key range's edges, inf, NaN, -0.0, for every count 0-9 (the lanes' remainders)
+// and the whole set, with the rays in two orders (the longest walk in any lane).
+TEST(RayTiles, BatchWalkKeysEqualRayByRay) {
+  for (double res : {0.1, 0.05, 0.25}) {
+    RayBatch batch;
+    batch.resolution = res;
+    batch.origin = octomap::point3d(0.05f, -0.05f, 1.0f);
+    PrepareReport rep;
+    ASSERT_TRUE(prepare_origin(batch.origin, res, batch, rep));
+    std::vector<float> coords = {0.0f, -0.0f, 1e9f, -1e9f, INFINITY, -INFINITY, NAN};
+    for (double v : {0.1, -0.1, 0.3, -0.3, 12.5, -12.5, 3276.7, -3276.8, 3276.8, 3300.0, -3300.0, 1638.35, -1638.4}) {
+      const float f = float(v);
+      coords.insert(coords.end(), {f, std::nextafter(f, 1e10f), std::nextafter(f, -1e10f)});
+    }
+    std::vector<RayEnd> all;
+    for (float x : coords)
+      for (float y : {x, -x, 0.25f})
+        for (float z : {-x, 0.0f}) all.push_back(RayEnd{x, y, z, kRayEndOccupied});
+    for (int order = 0; order < 2; ++order) {
+      if (order) std::reverse(all.begin(), all.end());
+      for (size_t n : {size_t(0), size_t(1), size_t(2), size_t(3), size_t(4), size_t(5), size_t(6), size_t(7),
+                       size_t(8), size_t(9), all.size()}) {
+        batch.ends.assign(all.begin(), all.begin() + n);
+        uint64_t sum = 0, longest = 0;
+        for (const RayEnd& e : batch.ends) sum += ray_walk_keys(batch, e), longest = std::max(longest, ray_walk_keys(batch, e));
+        for (bool simd : {true, false}) {
+          const WalkKeyTotals t = batch_walk_keys(batch, simd);
+          EXPECT_EQ(t.sum, sum) << "res " << res << " n " << n << " simd " << simd;
+          EXPECT_EQ(t.longest, longest) << "res " << res << " n " << n << " simd " << simd;
+        }
+      }
+    }
+  }
+}
+
 TEST(FarFlung, FiftyPointsThreeKilometresAwayGiveOctoMapsMapAtBoundedCost) {
   for (BackendKind kind : {BackendKind::kCpuGrid, BackendKind::kCpu}) {
     EngineOptions o;
