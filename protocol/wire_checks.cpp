@@ -14,8 +14,9 @@ namespace {
 template <class T>
 std::string checked_decode(const void* data, size_t size, std::initializer_list<WireSegment> layout, T& out) {
   if (size > kMaxMessageBytes + 4096) return "too large";
-  if (std::string bad = check_wire(static_cast<const uint8_t*>(data), size, T::getHash(), layout); !bad.empty())
-    return bad.rfind("count too large", 0) == 0 ? "count too large" : bad;
+  // The short name (no bound): these answers go into logs and the client's error messages.
+  if (const WireCheck c = check_wire(static_cast<const uint8_t*>(data), size, T::getHash(), layout); !c.ok())
+    return wire_fault_name(c.fault);
   try {
     const int n = out.decode(data, 0, static_cast<int>(size));
     if (n < 0) return "truncated";

@@ -33,10 +33,35 @@ constexpr WireSegment wire_array(int64_t elem_bytes) { return {WireSegment::kArr
 constexpr WireSegment wire_string(int64_t max_bytes) { return {WireSegment::kString, max_bytes}; }
 constexpr WireSegment wire_strings(int64_t per_elem, int64_t max_bytes) { return {WireSegment::kStrings, max_bytes, per_elem}; }
 
-// "" when the bytes are exactly one message of this layout with the 8-byte fingerprint
-// `hash` first; else why not: "truncated", "wrong fingerprint", "negative count",
-// "count too large (at most N)", "count exceeds data", "bad string length",
-// "string not terminated", "trailing bytes".
-std::string check_wire(const uint8_t* data, size_t size, int64_t hash, std::initializer_list<WireSegment> layout);
+// Why a message's bytes are not one message of its layout (kNone: they are).
+enum class WireFault {
+  kNone,
+  kTruncated,           // the bytes end inside a field
+  kWrongFingerprint,    // the first 8 bytes are not the type's hash
+  kNegativeCount,       // an array count below zero
+  kCountTooLarge,       // an array count above its bound (WireCheck::limit)
+  kCountExceedsData,    // an array count with fewer bytes behind it than it needs
+  kBadStringLength,     // a string length below 1 (the NUL counts) or above its bound
+  kStringNotTerminated, // a string's last byte is not NUL
+  kTrailingBytes,       // bytes after the message's end
+};
+
+struct WireCheck {
+  WireFault fault = WireFault::kNone;
+  int64_t limit = 0;  // for kCountTooLarge: the bound the count broke
+  bool ok() const { return fault == WireFault::kNone; }
+};
+
+// The fault's short name: "truncated", "wrong fingerprint", "negative count", "count too
+// large", "count exceeds data", "bad string length", "string not terminated", "trailing
+// bytes"; "" for kNone.
+const char* wire_fault_name(WireFault fault);
+
+// The short name with the bound where there is one: "count too large (at most N)".
+std::string describe(const WireCheck& check);
+
+// Whether the bytes are exactly one message of this layout with the 8-byte fingerprint
+// `hash` first, and if not, the first fault in encoding order.
+WireCheck check_wire(const uint8_t* data, size_t size, int64_t hash, std::initializer_list<WireSegment> layout);
 
 }  // namespace ort::protocol

@@ -11,7 +11,10 @@
 namespace ort::daemon {
 namespace {
 
-using protocol::check_wire;
+// The fault with its bound ("count too large (at most N)"): the text goes back to the client.
+std::string check_wire(const uint8_t* d, size_t n, int64_t hash, std::initializer_list<protocol::WireSegment> layout) {
+  return protocol::describe(protocol::check_wire(d, n, hash, layout));
+}
 constexpr auto fixed = protocol::wire_fixed;
 constexpr auto count = protocol::wire_count;
 constexpr auto array = protocol::wire_array;

@@ -11,16 +11,21 @@
 namespace ort::daemon {
 namespace {
 
-// protocol::check_wire's reason as the daemon's typed one (a string without its NUL has a
+// protocol::check_wire's fault as the daemon's reject reason (a string without its NUL has a
 // length that does not match it: a bad string length).
-Reject reject_of(const std::string& why) {
-  if (why.empty()) return Reject::kNone;
-  if (why == "wrong fingerprint") return Reject::kWrongFingerprint;
-  if (why == "negative count") return Reject::kNegativeCount;
-  if (why.rfind("count too large", 0) == 0) return Reject::kCountTooLarge;
-  if (why == "count exceeds data") return Reject::kCountExceedsData;
-  if (why == "bad string length" || why == "string not terminated") return Reject::kBadStringLength;
-  if (why == "trailing bytes") return Reject::kTrailingBytes;
+Reject reject_of(protocol::WireFault fault) {
+  using F = protocol::WireFault;
+  switch (fault) {
+    case F::kNone: return Reject::kNone;
+    case F::kTruncated: return Reject::kTruncated;
+    case F::kWrongFingerprint: return Reject::kWrongFingerprint;
+    case F::kNegativeCount: return Reject::kNegativeCount;
+    case F::kCountTooLarge: return Reject::kCountTooLarge;
+    case F::kCountExceedsData: return Reject::kCountExceedsData;
+    case F::kBadStringLength:
+    case F::kStringNotTerminated: return Reject::kBadStringLength;
+    case F::kTrailingBytes: return Reject::kTrailingBytes;
+  }
   return Reject::kTruncated;
 }
 
@@ -48,10 +53,11 @@ Reject check_scan_wire(const uint8_t* data, size_t size, const ScanLimits& limit
   if (size > max_size) return Reject::kTooLarge;
   // scan_t's layout (lcmtypes/octomap_rt_scan_t.lcm): the fixed fields, num_xyz, xyz[], robot_id, map_frame.
   namespace p = protocol;
-  return reject_of(p::check_wire(
-      data, size, octomap_rt::scan_t::getHash(),
-      {p::wire_fixed(kScanNumXyzOffset - 8), p::wire_count(3 * static_cast<int64_t>(limits.max_points)),
-       p::wire_array(4), p::wire_string(kMaxRobotIdLength), p::wire_string(kMaxMapFrameLength)}));
+  return reject_of(p::check_wire(data, size, octomap_rt::scan_t::getHash(),
+                                  {p::wire_fixed(kScanNumXyzOffset - 8),
+                                   p::wire_count(3 * static_cast<int64_t>(limits.max_points)), p::wire_array(4),
+                                   p::wire_string(kMaxRobotIdLength), p::wire_string(kMaxMapFrameLength)})
+                       .fault);
 }
 
 Reject check_scan_content(const octomap_rt::scan_t& m, const std::string& expected_robot_id,

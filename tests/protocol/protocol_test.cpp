@@ -11,6 +11,7 @@
 #include "protocol/delta_codec.h"
 #include "protocol/map_protocol.h"
 #include "protocol/wire_checks.h"
+#include "protocol/wire_layout.h"
 #include "protocol/zstd_codec.h"
 
 namespace ort::test {
@@ -58,6 +59,32 @@ TEST(Protocol, CountsSitAtTheirFixedOffsets) {
   m.producer_last_seq = {1, 2};
   m.producer_id = {"a", "b"};
   EXPECT_EQ(be32(encode(m), kInfoNumProducersOffset), 2);
+}
+
+// The walk's typed faults, which the daemon maps to its reject reasons and the query answers
+// describe to clients: each in encoding order, the broken bound carried with its fault.
+TEST(Protocol, TheWireWalkNamesEachFaultWithItsBound) {
+  const auto good = encode(request(3));
+  const int64_t hash = octomap_rt::map_request_t::getHash();
+  const auto layout = {wire_fixed(kRequestNumIndicesOffset - 8), wire_count(5), wire_array(4), wire_string(64),
+                       wire_string(64)};
+  const auto check = [&](const std::vector<uint8_t>& b, size_t n) { return check_wire(b.data(), n, hash, layout); };
+  EXPECT_TRUE(check(good, good.size()).ok());
+  EXPECT_EQ(check(good, 7).fault, WireFault::kTruncated);
+  auto b = good;
+  put_be32(b, kRequestNumIndicesOffset, 6);
+  const WireCheck too_many = check(b, b.size());
+  EXPECT_EQ(too_many.fault, WireFault::kCountTooLarge);
+  EXPECT_EQ(too_many.limit, 5);
+  EXPECT_EQ(describe(too_many), "count too large (at most 5)");
+  b = good;
+  b.back() = 'x';  // the last string's NUL
+  EXPECT_EQ(check(b, b.size()).fault, WireFault::kStringNotTerminated);
+  EXPECT_STREQ(wire_fault_name(WireFault::kStringNotTerminated), "string not terminated");
+  b = good;
+  b.push_back(0);
+  EXPECT_EQ(describe(check(b, b.size())), "trailing bytes");
+  EXPECT_EQ(describe(WireCheck{}), "");
 }
 
 TEST(Protocol, CraftedRequestsAreRefusedWithAReason) {

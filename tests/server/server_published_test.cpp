@@ -74,7 +74,9 @@ TEST(ServerMemq, StatusIsPublished) {
   bool running_seen = false;
   for (size_t i = 0; i < sink.got.size(); ++i) {
     running_seen |= sink.got[i].state == octomap_rt::server_status_t::STATE_RUNNING;
-    if (i) EXPECT_EQ(sink.got[i].seq, sink.got[i - 1].seq + 1);
+    if (i > 0) {
+      EXPECT_EQ(sink.got[i].seq, sink.got[i - 1].seq + 1);
+    }
   }
   EXPECT_TRUE(running_seen);
 }
