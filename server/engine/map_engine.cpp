@@ -1,11 +1,11 @@
 #include "engine/map_engine.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 
 #include "core/clock.h"
 #include "core/map_frame.h"
-
 #include "core/ray_tiles.h"
 #include "octree/worker_pool.h"
 
@@ -15,27 +15,39 @@ namespace {
 
 bool on_device(BackendKind k) { return k == BackendKind::kVulkan || k == BackendKind::kRt; }
 
+// The engine's options with the back end's shared fields filled in from the engine's, and
+// whether the cpu-grid walk's helper threads yield (both stages then share the cores).
+EngineOptions with_backend_filled(EngineOptions o) {
+  o.backend.resolution = o.resolution;
+  o.backend.max_range = o.max_range;
+  o.backend.traversal = o.traversal;
+  o.backend.helpers_yield = o.shoots_beside_apply && o.stage1_helpers_yield && o.backend.threads == 0 &&
+                            o.octree.threads == 0;  // read by cpu-grid only
+  return o;
+}
+
+// The octree stage's threads when the caller left them at 0 and shoots beside apply():
+// half the hardware threads beside a cpu-grid walk whose helpers yield (the walk keeps a
+// core), all but one beside a device back end on a machine of kSpareCoreAbove threads or
+// more (the stage-1 thread keeps one); else as given. Recorded in `o` and returned.
+OctreeUpdateOptions settle_octree_threads(EngineOptions& o, BackendKind kind) {
+  const unsigned hardware = resolve_thread_count(0);
+  if (o.backend.helpers_yield && kind == BackendKind::kCpuGrid) {
+    o.octree.threads = std::max(1u, hardware / 2);
+  } else if (o.shoots_beside_apply && o.octree.threads == 0 && on_device(kind) && hardware >= kSpareCoreAbove) {
+    o.octree.threads = hardware - 1;
+  }
+  return o.octree;
+}
+
 }  // namespace
 
-MapEngine::MapEngine(const EngineOptions& opts, const Log& log) : opts_(opts), octree_stage_(opts.octree) {
-  opts_.backend.resolution = opts.resolution;
-  opts_.backend.max_range = opts.max_range;
-  opts_.backend.traversal = opts.traversal;
-  const bool share_cores = opts_.shoots_beside_apply && opts_.stage1_helpers_yield && opts_.backend.threads == 0 &&
-                           opts_.octree.threads == 0;
-  opts_.backend.helpers_yield = share_cores;  // read by cpu-grid only
-  backend_ = make_backend(opts_.backend, log);
-  const unsigned hardware = resolve_thread_count(0);
-  if (share_cores && backend_->kind() == BackendKind::kCpuGrid) {
-    opts_.octree.threads = std::max(1u, hardware / 2);
-    octree_stage_ = OctreeStage(opts_.octree);  // its threads start on first use
-  }
-  if (opts_.shoots_beside_apply && opts_.octree.threads == 0 && on_device(backend_->kind()) &&
-      hardware >= kSpareCoreAbove) {
-    opts_.octree.threads = hardware - 1;
-    octree_stage_ = OctreeStage(opts_.octree);  // its threads start on first use
-  }
-}
+// Members in declaration order: the options, the back end they choose, then the octree stage
+// whose threads depend on the back end's kind (its threads start on first use).
+MapEngine::MapEngine(const EngineOptions& opts, const Log& log)
+    : opts_(with_backend_filled(opts)),
+      backend_(make_backend(opts_.backend, log)),
+      octree_stage_(settle_octree_threads(opts_, backend_->kind())) {}
 
 unsigned MapEngine::octree_threads() const { return resolve_thread_count(opts_.octree.threads); }
 
