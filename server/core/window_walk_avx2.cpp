@@ -54,7 +54,8 @@ __attribute__((target("avx2"))) inline __m256i brick_index(__m256i x, __m256i y,
 // scalar start: the start's seven divisions a ray were a quarter of the walk's time.
 struct alignas(32) StartBlock {
   double t_max[3][4], t_delta[3][4], length[4];
-  int64_t step[3][4], end_key[3][4];
+  int64_t step[3][4];
+  int64_t end_index[4];  // the end voxel's index in the grid; -1 (no voxel's) where the end lies outside the window
   int64_t out[3][4];  // the first coordinate (key - window.lo) outside the window along the step
   int order[4];       // the rays (places above) that leave the origin voxel; the others are unused
   int count = 0, next = 0;
@@ -116,11 +117,13 @@ class RayFeed {
         inside = _mm256_and_si256(inside, _mm256_andnot_si256(_mm256_cmpgt_epi64(_mm256_setzero_si256(), key[i]),
                                                               _mm256_cmpgt_epi64(_mm256_set1_epi64x(extent_[i]), key[i])));
         at_origin = _mm256_and_si256(at_origin, _mm256_cmpeq_epi64(key[i], _mm256_set1_epi64x(origin_[i])));
-        _mm256_store_si256(reinterpret_cast<__m256i*>(block_.end_key[i]), key[i]);
       }
       const __m256i occupied = _mm256_cvtepi32_epi64(_mm_castps_si128(_mm_cmpneq_ps(
           _mm_and_ps(e[3], _mm_castsi128_ps(_mm_set1_epi32(kRayEndOccupied))), _mm_setzero_ps())));
-      queue_occupied(_mm256_and_si256(occupied, inside), brick_index(key[0], key[1], key[2], _mm256_set1_epi64x(brick_row_), _mm256_set1_epi64x(brick_layer_)));
+      const __m256i index = brick_index(key[0], key[1], key[2], _mm256_set1_epi64x(brick_row_), _mm256_set1_epi64x(brick_layer_));
+      queue_occupied(_mm256_and_si256(occupied, inside), index);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(block_.end_index),
+                         _mm256_or_si256(index, _mm256_xor_si256(inside, _mm256_set1_epi64x(-1))));
       const __m256i valid = _mm256_cmpgt_epi64(_mm256_set1_epi64x(int64_t(n)), _mm256_setr_epi64x(0, 1, 2, 3));
       const int walks = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_andnot_si256(at_origin, valid)));
       if (!walks) continue;
@@ -199,7 +202,7 @@ class RayFeed {
 // broadcast and blend (scalar stores into memory read back as vectors stall the walk).
 struct LaneState {
   __m256d tx, ty, tz, dx, dy, dz, length;
-  __m256i x, y, z, sx, sy, sz, x_out, y_out, z_out, ex, ey, ez, active;
+  __m256i x, y, z, sx, sy, sz, x_out, y_out, z_out, end, active;
 
   __attribute__((target("avx2"), always_inline)) static __m256d put(__m256d v, const double& from, __m256d lane) {
     return _mm256_blendv_pd(v, _mm256_broadcast_sd(&from), lane);
@@ -216,7 +219,7 @@ struct LaneState {
     x = put(x, origin[0], lane), y = put(y, origin[1], lane), z = put(z, origin[2], lane);
     sx = put(sx, b.step[0][r], lane), sy = put(sy, b.step[1][r], lane), sz = put(sz, b.step[2][r], lane);
     x_out = put(x_out, b.out[0][r], lane), y_out = put(y_out, b.out[1][r], lane), z_out = put(z_out, b.out[2][r], lane);
-    ex = put(ex, b.end_key[0][r], lane), ey = put(ey, b.end_key[1][r], lane), ez = put(ez, b.end_key[2][r], lane);
+    end = put(end, b.end_index[r], lane);
     active = _mm256_or_si256(active, _mm256_castpd_si256(lane));
   }
   __attribute__((target("avx2"), always_inline)) void stop(__m256d lane) {
@@ -235,7 +238,6 @@ __attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t be
   const long long* grid = reinterpret_cast<const long long*>(marker.grid);
   RayFeed feed(b, begin, end, layout, resolution, marker);
   const int64_t* origin = feed.origin();
-  const __m256i ones = _mm256_set1_epi64x(-1);
   const __m256d lane_masks[4] = {_mm256_castsi256_pd(_mm256_setr_epi64x(-1, 0, 0, 0)),
                                  _mm256_castsi256_pd(_mm256_setr_epi64x(0, -1, 0, 0)),
                                  _mm256_castsi256_pd(_mm256_setr_epi64x(0, 0, -1, 0)),
@@ -250,33 +252,35 @@ __attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t be
   }
   alignas(32) uint32_t pending[kPending];
   int n_pending = 0;
-  auto& [tx, ty, tz, dx, dy, dz, length, x, y, z, sx, sy, sz, x_out, y_out, z_out, ex, ey, ez, active] = L;
+  auto& [tx, ty, tz, dx, dy, dz, length, x, y, z, sx, sy, sz, x_out, y_out, z_out, end_index, active] = L;
   while (live > 0) {
     // The scalar walk: x if tx < ty and tx < tz; else y if !(tx < ty) and ty < tz; else z.
     const __m256d x_lt_y = _mm256_cmp_pd(tx, ty, _CMP_LT_OQ), x_lt_z = _mm256_cmp_pd(tx, tz, _CMP_LT_OQ),
                   y_lt_z = _mm256_cmp_pd(ty, tz, _CMP_LT_OQ);
     const __m256d step_x = _mm256_and_pd(x_lt_y, x_lt_z), step_y = _mm256_andnot_pd(x_lt_y, y_lt_z);
-    const __m256d step_z = _mm256_andnot_pd(_mm256_or_pd(step_x, step_y), _mm256_castsi256_pd(ones));
+    const __m256d step_xy = _mm256_or_pd(step_x, step_y);  // z steps where neither does
     x = _mm256_add_epi64(x, _mm256_and_si256(_mm256_castpd_si256(step_x), sx));
     y = _mm256_add_epi64(y, _mm256_and_si256(_mm256_castpd_si256(step_y), sy));
-    z = _mm256_add_epi64(z, _mm256_and_si256(_mm256_castpd_si256(step_z), sz));
+    z = _mm256_add_epi64(z, _mm256_andnot_si256(_mm256_castpd_si256(step_xy), sz));
     tx = _mm256_add_pd(tx, _mm256_and_pd(step_x, dx));  // + 0.0 in the other lanes: unchanged
     ty = _mm256_add_pd(ty, _mm256_and_pd(step_y, dy));
-    tz = _mm256_add_pd(tz, _mm256_and_pd(step_z, dz));
+    tz = _mm256_add_pd(tz, _mm256_andnot_pd(step_xy, dz));
     // Stops: out of the window along the step, at the end voxel, past the length.
     const __m256i left = _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi64(x, x_out), _mm256_cmpeq_epi64(y, y_out)),
                                          _mm256_cmpeq_epi64(z, z_out));
-    const __m256i at_end = _mm256_and_si256(_mm256_and_si256(_mm256_cmpeq_epi64(x, ex), _mm256_cmpeq_epi64(y, ey)),
-                                            _mm256_cmpeq_epi64(z, ez));
+    // The voxel's index in the grid (BrickLayout::index as bit operations; meaningless in a lane
+    // that left the window, which stops on `left`); the end voxel by its index, a bijection of
+    // the window's keys (an end outside the window has index -1, no voxel's).
+    const __m256i index = brick_index(x, y, z, brick_row, brick_layer);
+    const __m256i at_end = _mm256_cmpeq_epi64(index, end_index);
     // std::min(a, b) is (b < a ? b : a), which _mm256_min_pd(b, a) computes.
     const __m256d dist = _mm256_min_pd(tz, _mm256_min_pd(ty, tx));
     const __m256i past = _mm256_castpd_si256(_mm256_cmp_pd(dist, length, _CMP_GT_OQ));
     const __m256i done = _mm256_and_si256(_mm256_or_si256(_mm256_or_si256(left, at_end), past), active);
     const __m256i visiting = _mm256_andnot_si256(done, active);
-    // The mark's test in lanes: the voxel index as BrickLayout's tables give it, the grid
-    // word of each visiting lane gathered (word 0 for the others), and only the lanes whose
-    // free bit is not set yet go on to the scalar mark (most visits near the sensor find it set).
-    const __m256i index = brick_index(x, y, z, brick_row, brick_layer);
+    // The mark's test in lanes: the grid word of each visiting lane gathered (word 0 for the
+    // others), and only the lanes whose free bit is not set yet go on to the scalar mark (most
+    // visits near the sensor find it set).
     const __m256i word = _mm256_and_si256(_mm256_srli_epi64(index, 4), visiting);
     const __m256i bit = _mm256_sllv_epi64(free_bit, _mm256_slli_epi64(_mm256_and_si256(index, fifteen), 1));
     const __m256i got = _mm256_i64gather_epi64(grid, word, 4);  // the word and the next: the low 32 bits count

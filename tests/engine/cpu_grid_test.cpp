@@ -3,6 +3,7 @@
 // back end (OctoMap's computeRayKeys + a hash set), on whole scans: rays along each axis, in
 // the axis planes, across brick and window borders, at the key range's edges, one thread
 // (plain stores) and two (atomic OR), scalar and AVX2.
+#include <map>
 #include <random>
 #include <set>
 #include <tuple>
@@ -12,6 +13,8 @@
 #include "core/brick_layout.h"
 #include "core/cpu_backend.h"
 #include "core/cpu_grid_backend.h"
+#include "core/grid_marker.h"
+#include "core/octomap_ray_walk.h"
 #include "core/prepare_scan.h"
 #include "core/window_walk_avx2.h"
 
@@ -151,6 +154,64 @@ TEST(CpuGridBackend, BundlesOfRaysThroughTheSameVoxelsEqualCpuBackend) {
         ASSERT_GT(a.size(), 10000u);
       }
     }
+  }
+}
+
+// The AVX2 walk on a window of 16 x 16 x 8 voxels (2 x 2 x 2 bricks) that holds the origin,
+// with most ray ends outside it: a lane stops at its end voxel by the end's grid index, and
+// an end outside the window must match no voxel's (its brick arithmetic would otherwise name
+// a voxel inside: x + 16 in the row of bricks above). Voxel sets equal OctoMap's walk cut to
+// the window.
+TEST(CpuGridWalk, EndsOutsideTheWindowStopNoLaneInside) {
+  if (!cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this CPU";
+  const double res = 0.1;
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<float> u(-1.6f, 3.2f), uz(-0.8f, 1.6f);
+  for (const octomap::point3d origin : {octomap::point3d(0.001f, 1.205f, 0.15f), octomap::point3d(0.75f, 0.85f, 0.35f)}) {
+    RayBatch b;
+    PrepareReport rep;
+    ASSERT_TRUE(prepare_origin(origin, res, b, rep));
+    KeyBox w;
+    for (int i = 0; i < 3; ++i) w.lo[i] = 32768, w.hi[i] = 32768 + (i < 2 ? 15 : 7);
+    const BrickLayout layout(w);
+    ASSERT_TRUE(layout.contains(b.origin_key));
+    b.ends.push_back(RayEnd{1.65f, 0.35f, 0.15f, kRayEndOccupied});  // from the first origin: through (0, 11, 1), ends at (16, 3, 1)
+    for (int i = 0; i < 20000; ++i) b.ends.push_back(RayEnd{u(rng), u(rng), uz(rng), uint32_t(i % 3 ? kRayEndOccupied : 0)});
+    // Ray by ray (a union over many rays would hide one ray's early stop), then all at once.
+    std::vector<uint32_t> grid(BrickLayout::padded_voxels(w) / 16 + 2, 0), touched;
+    int mismatches = 0;
+    auto walk = [&](size_t begin, size_t end) {
+      std::map<std::tuple<int, int, int>, uint32_t> expected, got;
+      for (size_t r = begin; r < end; ++r) {
+        const RayEnd& e = b.ends[r];
+        octomap::OcTreeKey end_key;
+        EXPECT_TRUE(coord_to_key_checked(octomap::point3d(e.x, e.y, e.z), res, end_key));
+        walk_octomap_ray(b.origin, octomap::point3d(e.x, e.y, e.z), b.origin_key, end_key, res, [&](const octomap::OcTreeKey& k) {
+          if (layout.contains(k)) expected[{k[0], k[1], k[2]}] |= kStateFree;
+        });
+        if ((e.flags & kRayEndOccupied) && layout.contains(end_key)) expected[{end_key[0], end_key[1], end_key[2]}] |= kStateOccupied;
+      }
+      touched.clear();
+      GridMarker marker{grid.data(), touched, false};
+      walk_rays_avx2(b, begin, end, layout, res, marker);
+      for (uint32_t word : touched) {
+        for (uint32_t slot = 0; slot < 16; ++slot)
+          if (const uint32_t bits = grid[word] >> (2 * slot) & 3u) {
+            const octomap::OcTreeKey k = layout.key_of(word, slot);
+            got[{k[0], k[1], k[2]}] = bits;
+          }
+        grid[word] = 0;
+      }
+      if (got != expected && ++mismatches <= 3)
+        ADD_FAILURE() << "origin " << origin << " rays " << begin << "-" << end << ": " << got.size() << " voxels, OctoMap's walk "
+                      << expected.size();
+      return expected.size();
+    };
+    size_t inside = 0;
+    for (size_t r = 0; r < b.ends.size(); ++r) inside += walk(r, r + 1) > 1;
+    EXPECT_GT(inside, 1000u);
+    EXPECT_GT(walk(0, b.ends.size()), 500u);
+    EXPECT_EQ(mismatches, 0);
   }
 }
 
