@@ -14,6 +14,7 @@ void PipelineMetrics::record(const AppliedTiming& t) {
   queue_wait_.add(t.waits.queue_ms);
   handoff_wait_.add(t.waits.handoff_ms);
   stage1_total_.add(t.stage1);
+  slowest_.add(t);
   scans_++;
   points_ += t.points;
   overlapped_ += t.overlapped ? 1 : 0;
@@ -40,6 +41,7 @@ MetricsSnapshot PipelineMetrics::snapshot() {
   s.queue_wait = both(queue_wait_);
   s.handoff_wait = both(handoff_wait_);
   s.stage1_total = stage1_total_;
+  s.slowest = slowest_.slowest();
   while (!recent_.empty() && std::chrono::duration<double>(now - recent_.front().first).count() > kRateWindowS)
     recent_.pop_front();
   const double window = std::min(kRateWindowS, std::chrono::duration<double>(now - start_).count());

@@ -6,30 +6,15 @@
 #include <cstdint>
 #include <deque>
 #include <mutex>
+#include <vector>
 
 #include "core/ray_backend.h"
+#include "daemon/applied_timing.h"
 #include "daemon/latency_window.h"
 #include "daemon/overlap_meter.h"
+#include "daemon/slowest_scans.h"
 
 namespace ort::daemon {
-
-// Where one scan's end-to-end time went besides the two stages: receipt -> decoded and
-// queued (LCM thread) -> taken by stage 1 -> stage 1 done -> taken by stage 2.
-struct ScanWaits {
-  double decode_ms = 0;   // the LCM thread decoding and checking the message
-  double queue_ms = 0;    // in the scan queue, behind scans that came before it
-  double handoff_ms = 0;  // shot, waiting for stage 2 to finish the scan before it
-};
-
-struct AppliedTiming {
-  double shoot_ms = 0;       // stage 1 wall time: to map frame + MapEngine::shoot
-  double octree_ms = 0;      // stage 2 wall time: MapEngine::apply (map lock held)
-  double end_to_end_ms = 0;  // receipt by the LCM thread -> applied
-  int64_t points = 0;
-  bool overlapped = false;   // its octree update overlapped a shoot of another scan
-  ScanWaits waits;
-  StageTimes stage1;         // the engine's parts of stage 1 (prepare, upload, shoot, compact)
-};
 
 // p50 / p99 of one latency over the window.
 struct Percentiles {
@@ -44,6 +29,7 @@ struct MetricsSnapshot {
   OverlapTotals overlap;
   Percentiles decode, queue_wait, handoff_wait;  // ScanWaits over the latency window
   StageTimes stage1_total;                       // the engine's parts of stage 1, summed over every scan
+  std::vector<SlowScan> slowest;                 // the run's slowest scans end to end, slowest first
 };
 
 class PipelineMetrics {
@@ -58,6 +44,7 @@ class PipelineMetrics {
   std::mutex mutex_;
   LatencyWindow shoot_, octree_, e2e_, decode_, queue_wait_, handoff_wait_;
   StageTimes stage1_total_;
+  SlowestScans slowest_;
   std::deque<std::pair<Clock::time_point, int64_t>> recent_;  // applied scans: time, points
   Clock::time_point start_ = Clock::now();
   int64_t scans_ = 0, points_ = 0, overlapped_ = 0;

@@ -60,6 +60,27 @@ void print_stages(std::ostream& out, const MetricsSnapshot& m) {
   out << line;
 }
 
+// One line a scan: its end-to-end time split into the parts that add up to it.
+void print_slowest(std::ostream& out, const MetricsSnapshot& m) {
+  if (m.slowest.empty()) return;
+  out << "  slowest scans (end to end = decode + queue + stage 1 + hand-off + stage 2; of all "
+      << m.scans_applied << " applied):\n";
+  char line[768];
+  for (const SlowScan& s : m.slowest) {
+    const AppliedTiming& t = s.timing;
+    const StageTimes& p = t.stage1;
+    std::snprintf(line, sizeof line,
+                  "    #%lld %s seq %lld at +%.3f s: %.2f ms = decode %.2f + queue %.2f + stage 1 %.2f (upload %.2f, "
+                  "prepare %.2f, shoot %.2f, compact %.2f) + hand-off %.2f + stage 2 %.2f (lock wait %.2f, octree "
+                  "%.2f, deltas %.2f); %llu voxels, %lld new nodes\n",
+                  (long long)s.applied_index, t.robot_id.c_str(), (long long)t.seq, s.received_s, t.end_to_end_ms,
+                  t.waits.decode_ms, t.waits.queue_ms, t.shoot_ms, p.upload_ms, p.prepare_ms, p.shoot_ms, p.compact_ms,
+                  t.waits.handoff_ms, t.octree_ms, t.stage2.lock_wait_ms, t.stage2.update_ms, t.stage2.publish_ms,
+                  (unsigned long long)t.voxels, (long long)t.new_nodes);
+    out << line;
+  }
+}
+
 void print_files(std::ostream& out, const RunSummaryInputs& in) {
   const StatusInputs& s = in.status;
   char line[1024];
@@ -123,6 +144,7 @@ void print_run_summary(std::ostream& out, const RunSummaryInputs& in) {
   out << line;
   print_producers(out, s);
   print_stages(out, s.metrics);
+  print_slowest(out, s.metrics);
   std::snprintf(line, sizeof line, "  map:          %lld nodes (%lld leaves), %.1f MiB in memory, %zu scans applied in total\n",
                 (long long)s.num_nodes, (long long)s.num_leaf_nodes, s.memory_bytes / 1048576.0, in.scans_in_map);
   out << line;

@@ -143,14 +143,21 @@ void ScanPipeline::apply(ShotJob& job) {
   const auto t0 = Clock::now();
   job.waits.handoff_ms = ms_between(job.shot_at, t0);
   set_busy(1, true);
+  Stage2Parts parts;
+  int64_t new_nodes = 0;
   try {
     std::lock_guard lock(map_.mutex);
+    const auto locked = Clock::now();
+    const auto nodes_before = static_cast<int64_t>(map_.tree->size());
     engine_.apply(job.shot, *map_.tree, map_.observer ? &changes_ : nullptr);
+    new_nodes = static_cast<int64_t>(map_.tree->size()) - nodes_before;
     map_.order.append(AppliedEntry{job.robot_id, job.seq, job.utime});
     map_.version++;
     map_.last_scan_utime = std::max(map_.last_scan_utime, job.utime);
+    const auto updated = Clock::now();
     if (map_.observer) map_.observer->applied(changes_, *map_.tree, map_.version);
     map_.applied_seq[lower_case(job.robot_id)] = job.seq;
+    parts = {ms_between(t0, locked), ms_between(locked, updated), ms_between(updated, Clock::now())};
   } catch (const std::exception& e) {
     set_busy(1, false);
     metrics_.overlap().end(1, token);
@@ -170,6 +177,12 @@ void ScanPipeline::apply(ShotJob& job) {
   t.waits = job.waits;
   t.stage1 = job.shot.shoot.times;
   t.stage1.octree_ms = 0;  // stage 2's
+  t.stage2 = parts;
+  t.robot_id = job.robot_id;
+  t.seq = job.seq;
+  t.received = job.received;
+  t.voxels = job.shot.free_voxels + job.shot.occupied_voxels;
+  t.new_nodes = new_nodes;
   metrics_.record(t);
   producers_.count_applied(job.producer, job.points, t.end_to_end_ms);
 }

@@ -15,6 +15,9 @@ octomap_rt_add_test(server_persistence_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/ma
                     LIBS octomap_rt_daemon TIMEOUT 300)
 octomap_rt_add_test(lcm_loop_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/lcm_loop_test.cpp LIBS octomap_rt_daemon TIMEOUT 120)
 octomap_rt_lcm_handler_sources(lcm_loop_test ${CMAKE_CURRENT_LIST_DIR}/lcm_loop_test.cpp)
+# The run summary's slowest scans and what it says about them.
+octomap_rt_add_test(server_run_summary_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/run_summary_test.cpp
+                    LIBS octomap_rt_daemon TIMEOUT 60)
 octomap_rt_add_test(server_producer_registry_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/producer_registry_test.cpp
                     LIBS octomap_rt_daemon TIMEOUT 60)
 # The rule behind the status' DEGRADED state and its causes.
