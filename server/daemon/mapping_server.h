@@ -74,6 +74,8 @@ class MappingServer {
   MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ostream& log);
   void load_or_create_map();
   void open_map_serving();
+  // The engine's warm-up scan (ServerConfig::warm_up_points), logged.
+  void warm_up_engine();
   void drain_until_deadline();
   std::unique_ptr<octomap::OcTree> load_checked_map();  // nullptr: moved aside, start anew
   void set_state(int8_t state, std::string message);

@@ -41,6 +41,10 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                  "size cap of one octomap.raw_t [KiB]; a larger map is sent depth-limited, or not at all (said in "
                  "the status); default: 90 % of net.core.rmem_default");
   app.add_flag("--no-pipeline", f.no_pipeline, "run the GPU and CPU stages on one thread, one scan after another");
+  app.add_option("--warm-up-points", s.warm_up_points,
+                 "points of the synthetic scan shot and applied to a scratch tree at start-up, so the first scans "
+                 "pay no one-time costs (buffers sized, threads started); the map is untouched; 0: no warm-up")
+      ->capture_default_str();
   app.add_option("--server-id", s.server_id, "name in status messages (default octomap-rt-server@HOST)");
   app.add_option("--queue-mib", f.queue_mib,
                  "per-producer queue budget [MiB]; 0: 1/64 of physical memory within [64, 1024]")
@@ -130,6 +134,12 @@ ServerConfig to_server_config(const ServerFlags& f) {
   // worker preempted by stage 1 stalls every join of the update), and the voxel list of a
   // scan, small here, comes straight into host memory (one fence wait less a scan).
   c.engine.shoots_beside_apply = c.pipeline;
+  // ... and, in a daemon, more: its LCM thread receives and decodes the scans (300 RGB-D
+  // scans/s = 930 MB/s) beside the kernel's network work. On the H200 (16 hardware threads)
+  // 12 octree workers instead of 15 took the p99 of stage 2 over runs mapping new space from
+  // 2.4-6.4 ms to 1.9-2.8 ms, end to end from 5.7-10.0 ms to 5.2-6.9 ms (docs/BENCHMARKS.md,
+  // issue 12, fourth session).
+  c.engine.spare_threads = 4;
   c.engine.backend.compact_into_host_memory = true;
   c.engine.max_scan_walk_keys = f.max_scan_work;
   if (!(f.queue_mib >= 0 && f.queue_mib <= 1e9)) throw CLI::ValidationError("--queue-mib", "must be a number >= 0");

@@ -32,6 +32,10 @@ struct ServerConfig {
   double save_interval_s = 30;                 // <= 0: save only at exit
   double status_period_s = 1.0;
   bool pipeline = true;                        // false: both stages on one thread
+  // Points of the synthetic scan the engine shoots and applies to a scratch tree before the
+  // intake opens (engine/engine_warm_up.h), so the first scans pay no one-time costs; 0: none.
+  // Default: one VGA depth image (640 x 480).
+  size_t warm_up_points = 640 * 480;
   std::string server_id;                       // "": octomap-rt-server@<host>
   uint64_t queue_budget_bytes = 0;             // per producer; 0: automatic_queue_budget()
   uint64_t max_points = octomap_rt::wire::kDefaultMaxScanPoints;  // per scan

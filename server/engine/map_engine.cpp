@@ -28,14 +28,15 @@ EngineOptions with_backend_filled(EngineOptions o) {
 
 // The octree stage's threads when the caller left them at 0 and shoots beside apply():
 // half the hardware threads beside a cpu-grid walk whose helpers yield (the walk keeps a
-// core), all but one beside a device back end on a machine of kSpareCoreAbove threads or
-// more (the stage-1 thread keeps one); else as given. Recorded in `o` and returned.
+// core), all but spare_threads (at least one, at most half) beside a device back end on a
+// machine of kSpareCoreAbove threads or more (the stage-1 thread keeps one, the daemon's LCM
+// thread more); else as given. Recorded in `o` and returned.
 OctreeUpdateOptions settle_octree_threads(EngineOptions& o, BackendKind kind) {
   const unsigned hardware = resolve_thread_count(0);
   if (o.backend.helpers_yield && kind == BackendKind::kCpuGrid) {
     o.octree.threads = std::max(1u, hardware / 2);
   } else if (o.shoots_beside_apply && o.octree.threads == 0 && on_device(kind) && hardware >= kSpareCoreAbove) {
-    o.octree.threads = hardware - 1;
+    o.octree.threads = hardware - std::clamp(o.spare_threads, 1u, hardware / 2);
   }
   return o.octree;
 }

@@ -39,6 +39,10 @@ struct EngineOptions {
   // thread free for that stage-1 thread: with a worker on every core, stage 1 preempts one
   // and the others wait for it at each of the stage's joins (docs/BENCHMARKS.md, issue 12).
   bool shoots_beside_apply = false;
+  // The hardware threads the octree stage then leaves to others (at most half of them): 1,
+  // stage 1's, in bench and build. The daemon leaves more (its LCM thread receives and
+  // decodes ~1 GB/s of scans beside the kernel's network work: server_cli.cpp).
+  unsigned spare_threads = 1;
   // Set by the batch programs (bench, build) beside shoots_beside_apply. With the cpu-grid
   // back end and both thread counts at 0, the octree stage takes half the hardware threads
   // (at least one) and the walk all of them, its helper threads at the lowest priority: the

@@ -130,6 +130,11 @@ TEST(PipelinedInsertion, TheOctreeStageLeavesAThreadToADeviceStageOne) {
   EngineOptions asked = engine_options(BackendKind::kVulkan);
   asked.octree.threads = 3;
   EXPECT_EQ(MapEngine(asked).octree_threads(), 3u);
+  // The daemon leaves four (its LCM thread, the kernel's network work), at most half of them.
+  EngineOptions daemon = engine_options(BackendKind::kVulkan);
+  daemon.spare_threads = 4;
+  const unsigned daemon_spared = hardware >= kSpareCoreAbove ? hardware - std::min(4u, hardware / 2) : hardware;
+  EXPECT_EQ(MapEngine(daemon).octree_threads(), daemon_spared);
 }
 
 // bench and build (stage1_helpers_yield): with cpu-grid the octree stage takes half the

@@ -13,4 +13,5 @@ octomap_rt_add_test(engine_ray_walk_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/ray_w
 octomap_rt_add_test(engine_far_flung_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/far_flung_test.cpp TIMEOUT 600)
 
 # Issue 12: the two-stage pipeline of `octomap-rt bench` / `build` gives the sequential map.
-octomap_rt_add_test(engine_pipeline_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/pipeline_test.cpp TIMEOUT 600)
+octomap_rt_add_test(engine_pipeline_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/pipeline_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/warm_up_test.cpp TIMEOUT 600)

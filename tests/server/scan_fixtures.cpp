@@ -67,6 +67,9 @@ daemon::ServerConfig test_config(double res, bool pipelined) {
   // or the drain deadline; the tests of those policies set them.
   c.latency_bound_s = 0;
   c.drain_timeout_s = 600;
+  // A warm-up scan at every start would add up over the many servers the tests start; the
+  // tests of the warm-up turn it on.
+  c.warm_up_points = 0;
   return c;
 }
 
