@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -148,13 +149,22 @@ void MappingServer::start() {
 }
 
 void MappingServer::warm_up_engine() {
-  if (cfg_.warm_up_points == 0) return;
-  const WarmUpReport w = warm_up(*engine_, cfg_.warm_up_points);
-  char line[256];
-  std::snprintf(line, sizeof line,
-                "octomap-rt-server: warmed up on a scan of %zu points (%llu voxels) on a scratch tree: stage 1 %.1f "
-                "ms, stage 2 %.1f ms\n",
-                w.points, (unsigned long long)w.voxels, w.shoot_ms, w.apply_ms);
+  // No scan may be larger than --max-points: a bigger warm-up would size buffers for nothing.
+  const size_t points = std::min<size_t>(cfg_.warm_up_points, cfg_.max_points);
+  if (points == 0) return;
+  char line[320];
+  try {
+    const WarmUpReport w = warm_up(*engine_, points);
+    std::snprintf(line, sizeof line,
+                  "octomap-rt-server: warmed up on a scan of %zu points (%llu voxels) on a scratch tree: stage 1 %.1f "
+                  "ms, stage 2 %.1f ms%s\n",
+                  w.points, (unsigned long long)w.voxels, w.shoot_ms, w.apply_ms,
+                  w.refused ? " (the engine refused the scan: the first scans may pay one-time costs)" : "");
+  } catch (const std::exception& e) {
+    // The map is untouched either way; scans then meet the engine as they would have without.
+    std::snprintf(line, sizeof line, "octomap-rt-server: warning: the warm-up failed (%s); serving without it\n",
+                  e.what());
+  }
   log_ << line;
 }
 

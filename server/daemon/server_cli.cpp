@@ -43,7 +43,8 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
   app.add_flag("--no-pipeline", f.no_pipeline, "run the GPU and CPU stages on one thread, one scan after another");
   app.add_option("--warm-up-points", s.warm_up_points,
                  "points of the synthetic scan shot and applied to a scratch tree at start-up, so the first scans "
-                 "pay no one-time costs (buffers sized, threads started); the map is untouched; 0: no warm-up")
+                 "pay no one-time costs (buffers sized, threads started); at most --max-points; the map is untouched; 0: "
+                 "no warm-up")
       ->capture_default_str();
   app.add_option("--server-id", s.server_id, "name in status messages (default octomap-rt-server@HOST)");
   app.add_option("--queue-mib", f.queue_mib,

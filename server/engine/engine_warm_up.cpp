@@ -39,6 +39,7 @@ WarmUpReport warm_up(MapEngine& engine, size_t points) {
   engine.shoot_posed_xyz(identity, identity.trans(), xyz, engine.options().max_range, shot);
   report.shoot_ms = ms_since(t0);
   report.voxels = shot.voxels.size();
+  report.refused = !shot.prepare.origin_ok || shot.refusal != ShotRefusal::kNone;
   const auto scratch = engine.make_tree();
   const auto t1 = Clock::now();
   engine.apply(shot, *scratch);

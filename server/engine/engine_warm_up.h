@@ -18,6 +18,7 @@ struct WarmUpReport {
   size_t points = 0;
   uint64_t voxels = 0;  // the scratch tree's voxel updates
   double shoot_ms = 0, apply_ms = 0;
+  bool refused = false;  // the engine refused the scan (origin, ray length, --max-scan-work)
 };
 
 // Shoots `points` points (0: does nothing) on a sphere of kWarmUpRadiusVoxels voxels' radius

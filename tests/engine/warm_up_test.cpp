@@ -54,6 +54,7 @@ TEST_P(EngineWarmUp, LeavesNoTraceInTheScansOrTheMap) {
   const WarmUpReport w = warm_up(warmed, 640 * 480);
   EXPECT_EQ(w.points, 640u * 480u);
   EXPECT_GT(w.voxels, 1000u) << "the warm-up scan was shot and applied";
+  EXPECT_FALSE(w.refused);
   auto tree = warmed.make_tree();
   for (size_t i = 0; i < set.scans.size(); ++i) {
     ShotScan a, b;

@@ -249,6 +249,19 @@ TEST(ServerMemq, RealScansOnVulkanAfterWarmUpEqualOctomapInRecordedOrder) {
 #endif
 }
 
+// The warm-up scan is never larger than the largest scan the daemon accepts.
+TEST(ServerMemq, WarmUpIsNoLargerThanMaxPoints) {
+  lcm::LCM lc("memq://");
+  auto cfg = test_config(0.1, true);
+  cfg.warm_up_points = 640 * 480;
+  cfg.max_points = 1000;
+  std::ostringstream log;
+  daemon::MappingServer server(cfg, lc, log);
+  server.start();
+  server.stop();
+  EXPECT_NE(log.str().find("warmed up on a scan of 1000 points"), std::string::npos) << log.str();
+}
+
 // A producer over its byte budget loses its newest scans, counted as dropped; what is
 // applied keeps the arrival order, and the counts still balance.
 TEST(ServerMemq, FullQueueDropsNewestAndCountsIt) {
