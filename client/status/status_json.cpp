@@ -3,45 +3,57 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <sstream>
+#include <vector>
 
 #include "status_text.h"
 
 namespace ort::status {
 namespace {
 
-// Writes "key": value pairs separated by commas; the caller writes the braces.
-class Fields {
+// A JSON object written field by field; close() gives it with its braces.
+class JsonObject {
  public:
-  explicit Fields(std::ostringstream& o) : o_(o) {}
-  Fields& raw(const char* key, const std::string& json) {
-    o_ << (first_ ? "" : ",") << '"' << key << "\":" << json;
-    first_ = false;
+  JsonObject& raw(const char* key, const std::string& json) {
+    if (text_.size() > 1) text_ += ',';
+    text_ += '"';
+    text_ += key;
+    text_ += "\":";
+    text_ += json;
     return *this;
   }
-  Fields& num(const char* key, int64_t v) { return raw(key, std::to_string(v)); }
-  Fields& num(const char* key, double v) {
+  JsonObject& num(const char* key, int64_t v) { return raw(key, std::to_string(v)); }
+  JsonObject& num(const char* key, double v) {
     if (!std::isfinite(v)) return raw(key, "null");  // JSON has no NaN or infinity
     char buf[40];
     std::snprintf(buf, sizeof buf, "%.17g", v);
     return raw(key, buf);
   }
-  Fields& str(const char* key, const std::string& v) { return raw(key, json_string(v)); }
-  Fields& flag(const char* key, bool v) { return raw(key, v ? "true" : "false"); }
+  JsonObject& str(const char* key, const std::string& v) { return raw(key, json_string(v)); }
+  JsonObject& flag(const char* key, bool v) { return raw(key, v ? "true" : "false"); }
+  std::string close() const { return text_ + "}"; }
 
  private:
-  std::ostringstream& o_;
-  bool first_ = true;
+  std::string text_ = "{";
 };
 
+// {"name":count,...} from a message's parallel lists of reasons and their counts.
+std::string counts_json(const std::vector<std::string>& names, const std::vector<int64_t>& counts) {
+  std::string out = "{";
+  for (size_t i = 0; i < std::min(names.size(), counts.size()); ++i)
+    out += (i ? "," : "") + json_string(names[i]) + ":" + std::to_string(counts[i]);
+  return out + "}";
+}
+
+// [item,...] with each item written by `to_json`.
+template <class Item, class ToJson>
+std::string array_json(const std::vector<Item>& items, ToJson to_json) {
+  std::string out = "[";
+  for (size_t i = 0; i < items.size(); ++i) out += (i ? "," : "") + to_json(items[i]);
+  return out + "]";
+}
+
 std::string robot_json(const octomap_rt::robot_stats_t& r) {
-  std::ostringstream o, reasons;
-  reasons << "{";
-  for (size_t i = 0; i < std::min(r.reject_reason.size(), r.reject_count.size()); ++i)
-    reasons << (i ? "," : "") << json_string(r.reject_reason[i]) << ":" << r.reject_count[i];
-  reasons << "}";
-  o << "{";
-  Fields(o)
+  return JsonObject()
       .str("robot_id", r.robot_id)
       .str("channel", r.channel)
       .num("last_scan_utime", r.last_scan_utime)
@@ -55,15 +67,12 @@ std::string robot_json(const octomap_rt::robot_stats_t& r) {
       .num("queue_depth", int64_t(r.queue_depth))
       .num("queue_bytes", r.queue_bytes)
       .num("last_end_to_end_ms", double(r.last_end_to_end_ms))
-      .raw("reject_reasons", reasons.str());
-  o << "}";
-  return o.str();
+      .raw("reject_reasons", counts_json(r.reject_reason, r.reject_count))
+      .close();
 }
 
 std::string query_client_json(const octomap_rt::query_client_stats_t& c) {
-  std::ostringstream o;
-  o << "{";
-  Fields(o)
+  return JsonObject()
       .str("client_id", c.client_id)
       .str("reply_channel", c.reply_channel)
       .num("received", c.received)
@@ -76,23 +85,13 @@ std::string query_client_json(const octomap_rt::query_client_stats_t& c) {
       .num("edits_refused", c.edits_refused)
       .num("queue_depth", int64_t(c.queue_depth))
       .num("last_utime", c.last_utime)
-      .str("last_error", c.last_error);
-  o << "}";
-  return o.str();
+      .str("last_error", c.last_error)
+      .close();
 }
 
 // "queries": totals, refusal reasons (name -> count) and the clients.
 std::string queries_json(const octomap_rt::server_status_t& s) {
-  std::ostringstream o, reasons, clients;
-  reasons << "{";
-  for (size_t i = 0; i < std::min(s.query_refusal_reason.size(), s.query_refusal_count.size()); ++i)
-    reasons << (i ? "," : "") << json_string(s.query_refusal_reason[i]) << ":" << s.query_refusal_count[i];
-  reasons << "}";
-  clients << "[";
-  for (size_t i = 0; i < s.query_clients.size(); ++i) clients << (i ? "," : "") << query_client_json(s.query_clients[i]);
-  clients << "]";
-  o << "{";
-  Fields(o)
+  return JsonObject()
       .num("received", s.queries_received)
       .num("answered", s.queries_answered)
       .num("bad", s.queries_bad)
@@ -102,10 +101,9 @@ std::string queries_json(const octomap_rt::server_status_t& s) {
       .num("edits_applied", s.edits_applied)
       .num("edits_refused", s.edits_refused)
       .num("grids_published", s.grids_published)
-      .raw("refusal_reasons", reasons.str())
-      .raw("clients", clients.str());
-  o << "}";
-  return o.str();
+      .raw("refusal_reasons", counts_json(s.query_refusal_reason, s.query_refusal_count))
+      .raw("clients", array_json(s.query_clients, query_client_json))
+      .close();
 }
 
 }  // namespace
@@ -128,12 +126,7 @@ std::string json_string(const std::string& text) {
 }
 
 std::string status_json(const octomap_rt::server_status_t& s) {
-  std::ostringstream o, robots;
-  robots << "[";
-  for (size_t i = 0; i < s.robots.size(); ++i) robots << (i ? "," : "") << robot_json(s.robots[i]);
-  robots << "]";
-  o << "{";
-  Fields(o)
+  return JsonObject()
       .num("utime", s.utime)
       .num("seq", s.seq)
       .str("server_id", s.server_id)
@@ -183,10 +176,9 @@ std::string status_json(const octomap_rt::server_status_t& s) {
       .num("chunks_sent", s.chunks_sent)
       .num("deltas_sent", s.deltas_sent)
       .num("last_delta_seq", s.last_delta_seq)
-      .raw("robots", robots.str())
-      .raw("queries", queries_json(s));
-  o << "}";
-  return o.str();
+      .raw("robots", array_json(s.robots, robot_json))
+      .raw("queries", queries_json(s))
+      .close();
 }
 
 }  // namespace ort::status
