@@ -1,6 +1,7 @@
 #include "daemon/status_message.h"
 
 #include <algorithm>
+#include <array>
 
 namespace ort::daemon {
 namespace {
@@ -21,6 +22,38 @@ octomap_rt::query_client_stats_t client_message(const QueryClientStats& c) {
   m.reply_channel = c.reply_channel;
   m.last_error = c.last_error;
   return m;
+}
+
+// The reasons counted at least once, by name, in the order of Reject; returns how many.
+int32_t add_reasons(const std::array<int64_t, kRejectReasonCount>& counted, std::vector<std::string>& names,
+                    std::vector<int64_t>& counts) {
+  for (size_t k = 0; k < kRejectReasonCount; ++k) {
+    if (counted[k] == 0) continue;
+    names.push_back(to_string(static_cast<Reject>(k)));
+    counts.push_back(counted[k]);
+  }
+  return static_cast<int32_t>(names.size());
+}
+
+octomap_rt::robot_stats_t robot_message(const ProducerStats& p, int64_t queue_bytes) {
+  octomap_rt::robot_stats_t r;
+  r.last_scan_utime = p.last_utime;
+  r.last_seq = p.last_seq;
+  r.scans_received = p.received;
+  r.scans_applied = p.applied;
+  r.scans_rejected = p.rejected;
+  r.scans_dropped = p.dropped;
+  r.scans_missed = p.missed;
+  r.points_applied = p.points_applied;
+  r.queue_depth = static_cast<int32_t>(p.in_flight);
+  r.queue_bytes = queue_bytes;
+  r.last_end_to_end_ms = static_cast<float>(p.last_end_to_end_ms);
+  r.num_reject_reasons = add_reasons(p.rejects, r.reject_reason, r.reject_count);
+  r.num_drop_reasons = add_reasons(p.drop_reasons, r.drop_reason, r.drop_count);
+  r.seq_restarts = p.seq_restarts;
+  r.robot_id = p.robot_id;
+  r.channel = p.channel;
+  return r;
 }
 
 void add_queries(octomap_rt::server_status_t& s, const QueryServiceStats& q) {
@@ -99,37 +132,9 @@ octomap_rt::server_status_t make_status(const StatusInputs& in) {
   s.chunks_sent = in.chunks_sent;
   s.deltas_sent = in.deltas_sent;
   s.last_delta_seq = in.last_delta_seq;
-  for (size_t i = 0; i < in.producers.size(); ++i) {
-    const ProducerStats& p = in.producers[i];
-    octomap_rt::robot_stats_t r;
-    r.last_scan_utime = p.last_utime;
-    r.last_seq = p.last_seq;
-    r.scans_received = p.received;
-    r.scans_applied = p.applied;
-    r.scans_rejected = p.rejected;
-    r.scans_dropped = p.dropped;
-    r.scans_missed = p.missed;
-    r.points_applied = p.points_applied;
-    r.queue_depth = static_cast<int32_t>(p.in_flight);
-    r.queue_bytes = i < in.producer_queue_bytes.size() ? in.producer_queue_bytes[i] : 0;
-    r.last_end_to_end_ms = static_cast<float>(p.last_end_to_end_ms);
-    for (size_t k = 0; k < kRejectReasonCount; ++k) {
-      if (p.rejects[k] == 0) continue;
-      r.reject_reason.push_back(to_string(static_cast<Reject>(k)));
-      r.reject_count.push_back(p.rejects[k]);
-    }
-    r.num_reject_reasons = static_cast<int32_t>(r.reject_reason.size());
-    for (size_t k = 0; k < kRejectReasonCount; ++k) {
-      if (p.drop_reasons[k] == 0) continue;
-      r.drop_reason.push_back(to_string(static_cast<Reject>(k)));
-      r.drop_count.push_back(p.drop_reasons[k]);
-    }
-    r.num_drop_reasons = static_cast<int32_t>(r.drop_reason.size());
-    r.seq_restarts = p.seq_restarts;
-    r.robot_id = p.robot_id;
-    r.channel = p.channel;
-    s.robots.push_back(std::move(r));
-  }
+  for (size_t i = 0; i < in.producers.size(); ++i)
+    s.robots.push_back(
+        robot_message(in.producers[i], i < in.producer_queue_bytes.size() ? in.producer_queue_bytes[i] : 0));
   s.num_robots = static_cast<int32_t>(s.robots.size());
   s.server_id = in.server_id;
   s.host = in.host;
