@@ -50,37 +50,38 @@ __attribute__((target("avx2"))) void store4(float* f, __m128 x, __m128 y, __m128
   _mm_storeu_ps(f + 8, _mm_shuffle_ps(z2x3, y3z3, _MM_SHUFFLE(2, 0, 2, 0)));
 }
 
-// Points [0, 8 * groups) of p: (q * (0, v)) * inv + t, eight points a group.
-__attribute__((target("avx2"))) void apply_avx2(octomap::point3d* p, size_t groups, const MapFrameTransform::Quat& q,
+// Points [0, 8 * groups) of xyz into dst: (q * (0, v)) * inv + t, eight points a group.
+__attribute__((target("avx2"))) void apply_avx2(const float* xyz, float* dst, size_t groups, const MapFrameTransform::Quat& q,
                                                 const MapFrameTransform::Quat& inv, const float* t) {
-  static_assert(sizeof(octomap::point3d) == 12);
   const QuatLanes ql = broadcast(q), il = broadcast(inv);
   const __m256 zero = _mm256_setzero_ps(), tx = _mm256_set1_ps(t[0]), ty = _mm256_set1_ps(t[1]), tz = _mm256_set1_ps(t[2]);
   for (size_t g = 0; g < groups; ++g) {
-    float* f = &p[8 * g](0);
+    const float* f = xyz + 24 * g;
+    float* out = dst + 24 * g;
     __m128 x[2], y[2], z[2];
     load4(f, x[0], y[0], z[0]);
     load4(f + 12, x[1], y[1], z[1]);
     const QuatLanes v{zero, _mm256_set_m128(x[1], x[0]), _mm256_set_m128(y[1], y[0]), _mm256_set_m128(z[1], z[0])};
     const QuatLanes r = mul(mul(ql, v), il);
     const __m256 rx = _mm256_add_ps(r.x, tx), ry = _mm256_add_ps(r.y, ty), rz = _mm256_add_ps(r.z, tz);
-    store4(f, _mm256_castps256_ps128(rx), _mm256_castps256_ps128(ry), _mm256_castps256_ps128(rz));
-    store4(f + 12, _mm256_extractf128_ps(rx, 1), _mm256_extractf128_ps(ry, 1), _mm256_extractf128_ps(rz, 1));
+    store4(out, _mm256_castps256_ps128(rx), _mm256_castps256_ps128(ry), _mm256_castps256_ps128(rz));
+    store4(out + 12, _mm256_extractf128_ps(rx, 1), _mm256_extractf128_ps(ry, 1), _mm256_extractf128_ps(rz, 1));
   }
 }
 #endif
 
 }  // namespace
 
-void MapFrameTransform::apply(octomap::point3d* p, size_t n, bool simd) const {
+void MapFrameTransform::apply(const float* xyz, octomap::point3d* dst, size_t n, bool simd) const {
+  static_assert(sizeof(octomap::point3d) == 3 * sizeof(float), "a point3d is its three floats");
   size_t done = 0;
 #if defined(__x86_64__)
-  if (simd && __builtin_cpu_supports("avx2")) {
-    apply_avx2(p, n / 8, q_, inv_, t_);
+  if (simd && n >= 8 && __builtin_cpu_supports("avx2")) {
+    apply_avx2(xyz, &dst[0](0), n / 8, q_, inv_, t_);
     done = n / 8 * 8;
   }
 #endif
-  for (size_t i = done; i < n; ++i) p[i] = (*this)(p[i]);
+  for (size_t i = done; i < n; ++i) dst[i] = (*this)(octomap::point3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
 }
 
 }  // namespace ort

@@ -32,10 +32,15 @@ class MapFrameTransform {
     const Quat r = mul(mul(q_, Quat{0.0f, v.x(), v.y(), v.z()}), inv_);
     return octomap::point3d(r.x + t_[0], r.y + t_[1], r.z + t_[2]);
   }
-  // operator() on points [0, n) of p in place: eight at a time in AVX2 lanes where the CPU has
-  // it (the same float operations in the same order, so bit for bit; map_frame.cpp), the rest
-  // one by one. `simd` false: one by one.
-  void apply(octomap::point3d* p, size_t n, bool simd = true) const;
+  // operator() on n points given as x y z floats (`xyz`, three a point), written to dst[0, n)
+  // (xyz may be dst's own floats: in place): eight at a time in AVX2 lanes where the CPU has it
+  // (the same float operations in the same order, so bit for bit; map_frame.cpp), the rest one
+  // by one. `simd` false: one by one.
+  void apply(const float* xyz, octomap::point3d* dst, size_t n, bool simd = true) const;
+  void apply(octomap::point3d* p, size_t n, bool simd = true) const {
+    static_assert(sizeof(octomap::point3d) == 3 * sizeof(float), "a point3d is its three floats");
+    if (n) apply(&p[0](0), p, n, simd);
+  }
 
   struct Quat {
     float u, x, y, z;
@@ -50,14 +55,17 @@ class MapFrameTransform {
   float t_[3];
 };
 
-inline void transform_to_map_frame(std::span<octomap::point3d> pc, const octomap::pose6d& pose, unsigned threads = 0) {
+// Points given as x y z floats (a scan message's layout) into dst (dst.size() points; xyz
+// holds 3 * dst.size() floats), without a copy into point3d first.
+inline void transform_to_map_frame(std::span<const float> xyz, std::span<octomap::point3d> dst,
+                                   const octomap::pose6d& pose, unsigned threads = 0) {
   constexpr size_t kMinPointsPerThread = 16384;
-  const size_t n = pc.size();
+  const size_t n = dst.size();
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   threads = unsigned(std::min<size_t>(threads, std::max<size_t>(1, n / kMinPointsPerThread)));
   auto run = [&](unsigned t) {
     const size_t begin = n * t / threads, end = n * (t + 1) / threads;
-    MapFrameTransform(pose).apply(pc.data() + begin, end - begin);
+    MapFrameTransform(pose).apply(xyz.data() + 3 * begin, dst.data() + begin, end - begin);
   };
   if (threads <= 1) {
     run(0);
@@ -69,6 +77,11 @@ inline void transform_to_map_frame(std::span<octomap::point3d> pc, const octomap
   run(0);
 }
 
+inline void transform_to_map_frame(std::span<octomap::point3d> pc, const octomap::pose6d& pose, unsigned threads = 0) {
+  static_assert(sizeof(octomap::point3d) == 3 * sizeof(float), "a point3d is its three floats");
+  if (pc.empty()) return;
+  transform_to_map_frame(std::span<const float>(&pc[0](0), 3 * pc.size()), pc, pose, threads);
+}
 inline void transform_to_map_frame(octomap::Pointcloud& pc, const octomap::pose6d& pose, unsigned threads = 0) {
   if (pc.size() == 0) return;
   transform_to_map_frame(std::span<octomap::point3d>(&pc[0], pc.size()), pose, threads);

@@ -124,10 +124,12 @@ void MapEngine::shoot_posed_xyz(const octomap::pose6d& pose, const octomap::poin
   }
   const bool declined = out.prepare.device_declined;
   const auto t0 = SteadyClock::now();
-  std::vector<octomap::point3d> world;
-  world.reserve(sensor_xyz.size() / 3);
-  for (size_t i = 0; i < sensor_xyz.size(); i += 3) world.emplace_back(sensor_xyz[i], sensor_xyz[i + 1], sensor_xyz[i + 2]);
-  transform_to_map_frame(world, pose, opts_.octree.threads);
+  // Straight from the floats into a buffer kept between scans (no copy into point3d first,
+  // no fresh pages a scan).
+  const size_t n = sensor_xyz.size() / 3;
+  if (map_points_.size() < n) map_points_.resize(n);
+  const std::span<octomap::point3d> world(map_points_.data(), n);
+  transform_to_map_frame(sensor_xyz, world, pose, opts_.octree.threads);
   const double transform_ms = ms_since(t0);
   shoot(origin, world, max_range, out);
   out.shoot.times.prepare_ms += transform_ms;

@@ -147,6 +147,7 @@ class MapEngine {
   EngineOptions opts_;
   std::unique_ptr<RayBackend> backend_;
   mutable OctreeStage octree_stage_;  // keeps the batched stage's threads between scans; only apply() uses it
+  std::vector<octomap::point3d> map_points_;  // shoot_posed_xyz's map-frame points, kept between scans
 };
 
 }  // namespace ort

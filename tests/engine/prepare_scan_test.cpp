@@ -150,8 +150,9 @@ TEST(MapFrame, InlinedTransformEqualsPose6dTransformBitForBit) {
   }
 }
 
-// MapFrameTransform::apply (eight points at a time in AVX2 lanes where the CPU has it)
-// against operator() point by point, bit for bit (memcmp): 23 poses, every count 0-17 (the
+// MapFrameTransform::apply (eight points at a time in AVX2 lanes where the CPU has it; in
+// place and from x y z floats into another array) against operator() point by point, bit for
+// bit (memcmp): 23 poses, every count 0-17 (the
 // lanes' remainders) and 20,000 points with zeros, -0.0, inf and NaN in every lane position.
 TEST(MapFrame, TransformInLanesEqualsPointByPointBitForBit) {
   std::mt19937 rng(9);
@@ -171,12 +172,14 @@ TEST(MapFrame, TransformInLanesEqualsPointByPointBitForBit) {
   for (const auto& pose : poses) {
     const MapFrameTransform transform(pose);
     for (size_t n = 0; n <= points.size(); n = n < 17 ? n + 1 : points.size() + (n == points.size())) {
-      std::vector<octomap::point3d> lanes(points.begin(), points.begin() + n), one_by_one(lanes);
+      std::vector<octomap::point3d> lanes(points.begin(), points.begin() + n), one_by_one(lanes), apart(n);
       transform.apply(lanes.data(), n);
       transform.apply(one_by_one.data(), n, false);
+      transform.apply(&points[0](0), apart.data(), n);  // from x y z floats into another array
       for (size_t i = 0; i < n; ++i) {
         const octomap::point3d expected = transform(points[i]);
         ASSERT_EQ(std::memcmp(&one_by_one[i], &expected, sizeof expected), 0) << i;
+        ASSERT_EQ(std::memcmp(&apart[i], &expected, sizeof expected), 0) << i;
         ASSERT_EQ(std::memcmp(&lanes[i], &expected, sizeof expected), 0)
             << points[i] << " under " << pose << ": " << lanes[i] << " vs " << expected << " (point " << i << " of " << n << ")";
       }
