@@ -20,6 +20,12 @@
 //      and settle the nodes above when it was their last child (split_top.h)
 //   4. the worker threads' net node count added to the tree's counter (node_count.h)
 //
+// A node this batch creates whose whole subtree the list updates one way (8^k keys, one
+// state: new free space near a LiDAR, mostly) is made a leaf of 0 + update at once: OctoMap's
+// loop creates its 8^k leaves, each 0 + update, and prunes them back level by level into that
+// same leaf (subtree_update.cpp). On campus-like scans (~7.7 M voxels a scan, most in new
+// space) about 31 % of the voxels lie in such blocks of 8 or more.
+//
 // Trees with change detection on (enableChangeDetection) go through the plain updateNode
 // loop, which also records the changed keys.
 //

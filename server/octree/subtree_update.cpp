@@ -13,6 +13,21 @@ struct PathNode {
   bool changed;       // a voxel below was applied: settle this node when leaving it
 };
 
+// Voxels from voxels[i] on that fill the whole subtree of a node at `depth` (8^(16 - depth)
+// keys, each once, all of one state), voxels[i] being its first key; 0 when they do not.
+// Sorted voxels with consecutive codes and one state are consecutive SortedVoxel values.
+size_t full_block_at(std::span<const SortedVoxel> voxels, size_t i, unsigned depth) {
+  const size_t block = size_t{1} << (3 * (kTreeDepth - depth));
+  const SortedVoxel first = voxels[i];
+  if ((sorted_voxel_code(first) & (block - 1)) != 0 || voxels.size() - i < block) return 0;
+  if (voxels[i + block - 1] != first + 2 * (block - 1)) return 0;  // cheap reject before the scan
+  for (size_t k = 1; k < block - 1; ++k)
+    if (voxels[i + k] != first + 2 * k) return 0;
+  // A key repeated after the block (a stable sort keeps it there) finds the block's leaf,
+  // as it finds the pruned node in OctoMap's loop: nothing to exclude.
+  return block;
+}
+
 }  // namespace
 
 bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, const SubtreeRoot& root,
@@ -69,6 +84,20 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
       } else {
         child = node_ops.createNodeChild(p.node, pos);
         created = true;
+        // A new node whose every voxel this list updates, all the same way: OctoMap's loop
+        // creates its leaves, each 0 + update, and prunes them level by level back into this
+        // node, which ends a leaf of that value. Made so directly (batched_update.h).
+        if (depth + 1 < kTreeDepth) {
+          if (const size_t block = full_block_at(voxels, i, depth + 1)) {
+            update_leaf_log_odds(tree, *child, update);
+            if (changes)
+              for (size_t k = 0; k < block; ++k)
+                log_leaf_change(*changes, sorted_voxel_code(voxels[i + k]), true, 0.0f, child->getLogOdds());
+            p.changed = true;
+            i += block - 1;
+            break;
+          }
+        }
       }
       path[++depth] = PathNode{child, created, false};
     }

@@ -9,6 +9,7 @@ octomap_rt_add_test(octree_test
           ${CMAKE_CURRENT_LIST_DIR}/voxel_buckets_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/real_data_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/leaf_changes_test.cpp
+          ${CMAKE_CURRENT_LIST_DIR}/full_blocks_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/worker_pool_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp
   TIMEOUT 900)
