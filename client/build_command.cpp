@@ -89,9 +89,11 @@ int run_build(const BuildArgs& a) {
     voxels += shot.voxels.size();
     windows += shot.shoot.windows;
     if (!a.quiet) {
-      std::fprintf(stderr, "  [%zu/%zu] %zu points, %zu voxels (%llu occupied), %.1f ms\n", i + 1, set.scans.size(),
-                   set.scans[i].points.size(), shot.voxels.size(), (unsigned long long)shot.occupied_voxels,
-                   shot.shoot.times.total_ms());
+      const StageTimes& t = shot.shoot.times;
+      std::fprintf(stderr, "  [%zu/%zu] %zu points, %zu voxels (%llu occupied), %.1f ms (stage 1 %.1f, of which "
+                   "compact+readback %.1f; octree %.1f)\n", i + 1, set.scans.size(), set.scans[i].points.size(),
+                   shot.voxels.size(), (unsigned long long)shot.occupied_voxels, t.total_ms(), t.total_ms() - t.octree_ms,
+                   t.compact_ms, t.octree_ms);
     }
   };
   insert_scans(engine, set.scans.size(), scan_input, *tree, account, !a.no_pipeline);

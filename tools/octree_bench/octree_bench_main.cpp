@@ -15,9 +15,12 @@
 #include <thread>
 #include <vector>
 
+#include <sys/resource.h>
+
 #include <CLI/CLI.hpp>
 #include <octomap/OcTree.h>
 
+#include "core/backend_kind.h"
 #include "core/clock.h"
 #include "engine/map_engine.h"
 #include "octree/batched_update.h"
@@ -37,11 +40,11 @@ struct DataSet {
   size_t voxels = 0;
 };
 
-DataSet shoot_lists(const std::string& path, double resolution) {
+DataSet shoot_lists(const std::string& path, double resolution, ort::BackendKind backend) {
   const ort::ScanSet set = ort::load_scan_graph(path);
   ort::EngineOptions opts;
   opts.resolution = resolution;
-  opts.backend.kind = ort::BackendKind::kCpu;
+  opts.backend.kind = backend;
   ort::MapEngine engine(opts);
   DataSet d;
   d.name = path.substr(path.find_last_of('/') + 1);
@@ -65,7 +68,24 @@ std::string cpu_model() {
 struct Timing {
   double best_ms = 1e300;
   ort::BatchedUpdateStats stats;  // summed over the lists of the best run
+  // The first run builds its tree in memory the process never touched before (later runs
+  // mostly reuse what the allocator kept of the trees before them): its time, page faults and
+  // kernel time (zeroing the pages) are the figures of a map that grows into new memory.
+  double first_ms = 0;
+  long first_faults = 0;
+  double first_sys_ms = 0;
 };
+
+struct ProcessTimes {
+  long minor_faults = 0;
+  double sys_ms = 0;
+};
+
+ProcessTimes process_times() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return {u.ru_minflt, u.ru_stime.tv_sec * 1e3 + u.ru_stime.tv_usec * 1e-3};
+}
 
 }  // namespace
 
@@ -77,6 +97,7 @@ int main(int argc, char** argv) {
   double resolution = 0.1;
   int repeat = 5, passes = 3;
   bool batched_only = false;
+  std::string backend_name = "cpu";
   app.add_option("--data", data_dir, "data folder")->capture_default_str();
   app.add_option("--graph", graphs, "ScanGraph files below the data folder")->capture_default_str();
   app.add_option("--threads", threads, "thread counts of the batched stage (default: 1, 2, ..., hardware)");
@@ -85,7 +106,15 @@ int main(int argc, char** argv) {
   app.add_option("--passes", passes, "times the scan lists are applied in a row per run")->capture_default_str();
   app.add_flag("--batched-only", batched_only,
                "run only the batched stage (no OctoMap loop, no map check, no ordering comparison): for profilers");
+  app.add_option("--backend", backend_name,
+                 "back end that shoots the lists (the same voxels from each; cpu-grid is quicker on large scans)")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  ort::BackendKind backend = ort::BackendKind::kCpu;
+  if (!ort::parse_backend(backend_name, backend)) {
+    std::fprintf(stderr, "unknown back end %s\n", backend_name.c_str());
+    return 2;
+  }
 
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
   if (threads.empty()) {
@@ -110,7 +139,7 @@ int main(int argc, char** argv) {
 
   int failures = 0;
   for (const std::string& g : graphs) {
-    const DataSet d = shoot_lists(data_dir + "/" + g, resolution);
+    const DataSet d = shoot_lists(data_dir + "/" + g, resolution, backend);
     std::printf("%s: %zu scans, %zu voxel updates per pass\n", d.name.c_str(), d.lists.size(), d.voxels);
 
     // Ordering alone: the stage's bucketing plus a sort of every bucket on 1 thread, and the
@@ -165,6 +194,7 @@ int main(int argc, char** argv) {
       for (size_t i = 0; i < threads.size(); ++i) {
         octomap::OcTree tree(resolution);
         ort::BatchedUpdateStats sum, one;
+        const ProcessTimes before = process_times();
         t = Clock::now();
         for (int p = 0; p < passes; ++p)
           for (const auto& l : d.lists) {
@@ -178,7 +208,13 @@ int main(int argc, char** argv) {
             sum.node_count_change += one.node_count_change;
           }
         const double ms = ms_since(t);
-        if (ms < batched_time[i].best_ms) batched_time[i] = Timing{ms, sum};
+        const ProcessTimes after = process_times();
+        Timing& bt = batched_time[i];
+        if (r == 0) bt = Timing{ms, sum, ms, after.minor_faults - before.minor_faults, after.sys_ms - before.sys_ms};
+        if (ms < bt.best_ms) {
+          bt.best_ms = ms;
+          bt.stats = sum;
+        }
         if (batched_only) {
           nodes = tree.size();
         } else if (!(tree == reference)) {
@@ -202,6 +238,8 @@ int main(int argc, char** argv) {
                   threads[i], b.best_ms, b.best_ms * 1e6 / passes_voxels, batched_only ? 0.0 : octomap_time.best_ms / b.best_ms,
                   b.stats.bucket_ms, b.stats.top_ms, b.stats.subtrees_ms, b.stats.sort_cpu_ms, b.stats.subtrees,
                   b.stats.bucket_depth, b.stats.node_count_change);
+      std::printf("      first run (fresh memory): %9.1f ms, %ld page faults, %.1f ms in the kernel\n", b.first_ms,
+                  b.first_faults, b.first_sys_ms);
     }
     std::printf("\n");
   }
