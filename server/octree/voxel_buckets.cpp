@@ -127,7 +127,11 @@ bool direct_sort(SortedVoxel* data, size_t n, unsigned bits, std::vector<SortedV
 void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& opts, WorkerPool* pool,
                    VoxelBuckets& out, BucketScratch& scratch) {
   const size_t n = updates.size();
-  out.voxels.resize(n);
+  if (n > out.voxels.capacity()) {
+    out.voxels = {};  // the last list is not kept: growing copies nothing, and a quarter spare
+    out.voxels.reserve(n + n / 4);
+  }
+  out.voxels.resize(n);  // unwritten (UninitializedAllocator): the scatter pass writes them
   out.begin.clear();
   out.depth = 0;
   if (n == 0) return;

@@ -14,6 +14,9 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
+#include <new>
+#include <utility>
 #include <span>
 #include <vector>
 
@@ -34,8 +37,30 @@ struct BucketOptions {
   unsigned min_shift = 3;
 };
 
+// Allocates like std::allocator but leaves new elements of a trivial type unwritten on
+// resize: bucket_voxels writes every one in its scatter pass, on all its threads, so a list
+// longer than any before is neither zeroed first nor first touched (page faults) on one thread.
+template <class T>
+struct UninitializedAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitializedAllocator<U>;
+  };
+  UninitializedAllocator() = default;
+  template <class U>
+  UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;  // default-initialised: no value written
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
 struct VoxelBuckets {
-  std::vector<SortedVoxel> voxels;  // grouped by bucket, buckets in Morton order
+  std::vector<SortedVoxel, UninitializedAllocator<SortedVoxel>> voxels;  // grouped by bucket, buckets in Morton order
   std::vector<size_t> begin;        // bucket b is voxels[begin[b], begin[b + 1])
   unsigned depth = 0;               // D: every bucket holds the voxels below one node at D
 

@@ -81,6 +81,25 @@ TEST(VoxelBuckets, SortedBucketsAreTheMortonSortOfTheList) {
   }
 }
 
+// The storage a scan's buckets leave behind is reused, unwritten, by the next scan's
+// (UninitializedAllocator): lists longer and shorter than before give what fresh buckets give.
+TEST(VoxelBuckets, ReusedBucketsGiveWhatFreshOnesGive) {
+  std::mt19937 rng(11);
+  WorkerPool pool(3);
+  VoxelBuckets reused;
+  BucketScratch reused_scratch;
+  for (size_t n : {1000u, 200000u, 50000u, 0u, 300000u, 10u, 250000u}) {
+    const VoxelList list = random_unique_list(rng, n, 32000, 33000);
+    VoxelBuckets fresh;
+    BucketScratch scratch;
+    bucket_voxels(list, BucketOptions{}, &pool, fresh, scratch);
+    bucket_voxels(list, BucketOptions{}, &pool, reused, reused_scratch);
+    ASSERT_EQ(reused.voxels, fresh.voxels) << n << " voxels";
+    ASSERT_EQ(reused.begin, fresh.begin) << n << " voxels";
+    ASSERT_EQ(reused.depth, fresh.depth) << n << " voxels";
+  }
+}
+
 // sort_bucket alone, on buckets of nodes of 2^3 .. 2^6 voxels a side (the slot-per-key path
 // up to 4096 voxels, radix sorts above), full and sparse, with and without one repeated key
 // (which must keep the list's order of its two updates): always std::stable_sort's result.
