@@ -28,6 +28,16 @@ size_t full_block_at(std::span<const SortedVoxel> voxels, size_t i, unsigned dep
   return block;
 }
 
+// `leaf` (a node that stays without children) takes the update of every key of `block`; the
+// change log gets each key, from the leaf's value before (0 for a node just made).
+void apply_to_block(const octomap::OcTree& tree, octomap::OcTreeNode& leaf, float update,
+                    std::span<const SortedVoxel> block, bool just_created, std::vector<LeafChange>* changes) {
+  const float before = leaf.getLogOdds();
+  update_leaf_log_odds(tree, leaf, update);
+  if (changes)
+    for (const SortedVoxel v : block) log_leaf_change(*changes, sorted_voxel_code(v), just_created, before, leaf.getLogOdds());
+}
+
 }  // namespace
 
 bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, const SubtreeRoot& root,
@@ -79,6 +89,18 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
         // A pruned leaf: it is the deepest node search() finds on this voxel's path (its
         // value is the one the voxel had before this batch: expansions copy it unchanged).
         if (at_clamping_bound(tree, *p.node, update)) break;
+        // Its whole subtree updated one way from this voxel on: OctoMap's loop expands it down
+        // to every key, gives each its value + update and prunes them back into this node,
+        // which ends a leaf of value + update (batched_update.h). Not the subtree's root: the
+        // caller settles that one as an inner node.
+        if (depth > root.depth) {
+          if (const size_t block = full_block_at(voxels, i, depth)) {
+            apply_to_block(tree, *p.node, update, voxels.subspan(i, block), false, changes);
+            path[depth - 1].changed = true;  // final as a leaf: never settled as an inner node
+            i += block - 1;
+            break;
+          }
+        }
         node_ops.expandNode(p.node);
         child = node_ops.getNodeChild(p.node, pos);
       } else {
@@ -89,10 +111,7 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
         // node, which ends a leaf of that value. Made so directly (batched_update.h).
         if (depth + 1 < kTreeDepth) {
           if (const size_t block = full_block_at(voxels, i, depth + 1)) {
-            update_leaf_log_odds(tree, *child, update);
-            if (changes)
-              for (size_t k = 0; k < block; ++k)
-                log_leaf_change(*changes, sorted_voxel_code(voxels[i + k]), true, 0.0f, child->getLogOdds());
+            apply_to_block(tree, *child, update, voxels.subspan(i, block), true, changes);
             p.changed = true;
             i += block - 1;
             break;

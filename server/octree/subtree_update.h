@@ -37,7 +37,7 @@ struct SubtreeRoot {
 // counter is a plain size_t; see node_count.h).
 //
 // With `changes`, every finest leaf whose value the pass changed is appended to it, in the
-// voxels' order (leaf_changes.h), also each leaf of a block made a single leaf at once
+// voxels' order (leaf_changes.h), also each key of a block made a single leaf at once
 // (batched_update.h).
 bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, const SubtreeRoot& root,
                     std::span<const SortedVoxel> voxels, std::vector<LeafChange>* changes = nullptr);
