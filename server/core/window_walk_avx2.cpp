@@ -55,6 +55,7 @@ __attribute__((target("avx2"))) inline __m256i brick_index(__m256i x, __m256i y,
 struct alignas(32) StartBlock {
   double t_max[3][4], t_delta[3][4], length[4];
   int64_t step[3][4];
+  int64_t index_step[3][4];  // row-by-row layouts: the index's change for a step along each axis
   int64_t end_index[4];  // the end voxel's index in the grid; -1 (no voxel's) where the end lies outside the window
   int64_t out[3][4];  // the first coordinate (key - window.lo) outside the window along the step
   int order[4];       // the rays (places above) that leave the origin voxel; the others are unused
@@ -79,7 +80,9 @@ class RayFeed {
     }
     for (int i = 0; i < 3; ++i) lo_minus_max_[i] = int64_t(w.lo[i]) - kTreeMaxVal;
     brick_row_ = layout.brick_row(), brick_layer_ = layout.brick_layer();
+    rows_ = layout.rows(), stride_[0] = 1, stride_[1] = layout.y_stride(), stride_[2] = layout.z_stride();
     origin_index_ = layout.x_offsets()[origin_[0]] + layout.y_offsets()[origin_[1]] + layout.z_offsets()[origin_[2]];
+    origin_index64_ = origin_index_;
   }
 
   // The next ray that walks at least one step: its place in block(); -1 when none is left.
@@ -89,6 +92,7 @@ class RayFeed {
   }
   const StartBlock& block() const { return block_; }
   const int64_t* origin() const { return origin_; }
+  const int64_t& origin_index() const { return origin_index64_; }
   // Sets the measured ends still waiting (call when no ray is left).
   void finish() {
     marker_.mark_all(occupied_, n_occupied_, kStateOccupied);
@@ -120,7 +124,10 @@ class RayFeed {
       }
       const __m256i occupied = _mm256_cvtepi32_epi64(_mm_castps_si128(_mm_cmpneq_ps(
           _mm_and_ps(e[3], _mm_castsi128_ps(_mm_set1_epi32(kRayEndOccupied))), _mm_setzero_ps())));
-      const __m256i index = brick_index(key[0], key[1], key[2], _mm256_set1_epi64x(brick_row_), _mm256_set1_epi64x(brick_layer_));
+      const __m256i index =
+          rows_ ? _mm256_add_epi64(key[0], _mm256_add_epi64(_mm256_mul_epu32(key[1], _mm256_set1_epi64x(stride_[1])),
+                                                            _mm256_mul_epu32(key[2], _mm256_set1_epi64x(stride_[2]))))
+                : brick_index(key[0], key[1], key[2], _mm256_set1_epi64x(brick_row_), _mm256_set1_epi64x(brick_layer_));
       queue_occupied(_mm256_and_si256(occupied, inside), index);
       _mm256_store_si256(reinterpret_cast<__m256i*>(block_.end_index),
                          _mm256_or_si256(index, _mm256_xor_si256(inside, _mm256_set1_epi64x(-1))));
@@ -169,6 +176,7 @@ class RayFeed {
       // step: 1, -1 or 0 (the masks are all ones: -1 & 1 = 1, -1 = -1).
       const __m256i step = _mm256_or_si256(_mm256_and_si256(up64, _mm256_set1_epi64x(1)), down64);
       _mm256_store_si256((__m256i*)block_.step[i], step);
+      _mm256_store_si256((__m256i*)block_.index_step[i], _mm256_mul_epi32(step, _mm256_set1_epi64x(stride_[i])));
       _mm256_store_si256((__m256i*)block_.out[i], _mm256_blendv_epi8(_mm256_set1_epi64x(-1),
                                                                       _mm256_set1_epi64x(extent_[i]), up64));
       const __m256d moving = _mm256_castsi256_pd(_mm256_or_si256(up64, down64));
@@ -193,6 +201,9 @@ class RayFeed {
   bool origin_marked_ = false;
   int64_t lo_minus_max_[3];  // window.lo - 32768: key - window.lo = floor(...) - this
   uint32_t brick_row_, brick_layer_;
+  bool rows_;
+  int64_t stride_[3];  // row by row: the index's change for +1 along x, y, z
+  int64_t origin_index64_;
   alignas(16) uint32_t occupied_[kPending];
   int n_occupied_ = 0;
   StartBlock block_;
@@ -203,6 +214,7 @@ class RayFeed {
 struct LaneState {
   __m256d tx, ty, tz, dx, dy, dz, length;
   __m256i x, y, z, sx, sy, sz, x_out, y_out, z_out, end, active;
+  __m256i index, index_dx, index_dy, index_dz;  // row-by-row layouts: the index kept step by step
 
   __attribute__((target("avx2"), always_inline)) static __m256d put(__m256d v, const double& from, __m256d lane) {
     return _mm256_blendv_pd(v, _mm256_broadcast_sd(&from), lane);
@@ -212,7 +224,8 @@ struct LaneState {
         _mm256_blendv_pd(_mm256_castsi256_pd(v), _mm256_broadcast_sd(reinterpret_cast<const double*>(&from)), lane));
   }
   // Lane `lane` (all ones there, zeros elsewhere) starts ray r of block b at the origin voxel.
-  __attribute__((target("avx2"), always_inline)) void start(const StartBlock& b, int r, const int64_t* origin, __m256d lane) {
+  __attribute__((target("avx2"), always_inline)) void start(const StartBlock& b, int r, const int64_t* origin,
+                                                             const int64_t& origin_index, __m256d lane) {
     tx = put(tx, b.t_max[0][r], lane), ty = put(ty, b.t_max[1][r], lane), tz = put(tz, b.t_max[2][r], lane);
     dx = put(dx, b.t_delta[0][r], lane), dy = put(dy, b.t_delta[1][r], lane), dz = put(dz, b.t_delta[2][r], lane);
     length = put(length, b.length[r], lane);
@@ -220,6 +233,9 @@ struct LaneState {
     sx = put(sx, b.step[0][r], lane), sy = put(sy, b.step[1][r], lane), sz = put(sz, b.step[2][r], lane);
     x_out = put(x_out, b.out[0][r], lane), y_out = put(y_out, b.out[1][r], lane), z_out = put(z_out, b.out[2][r], lane);
     end = put(end, b.end_index[r], lane);
+    index = put(index, origin_index, lane);
+    index_dx = put(index_dx, b.index_step[0][r], lane), index_dy = put(index_dy, b.index_step[1][r], lane);
+    index_dz = put(index_dz, b.index_step[2][r], lane);
     active = _mm256_or_si256(active, _mm256_castpd_si256(lane));
   }
   __attribute__((target("avx2"), always_inline)) void stop(__m256d lane) {
@@ -227,12 +243,11 @@ struct LaneState {
   }
 };
 
-}  // namespace
-
-__attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t begin, size_t end,
-                                                     const BrickLayout& layout, double resolution,
-                                                     GridMarker& marker) {
-  if (!layout.contains(b.origin_key)) throw std::logic_error("walk_rays_avx2: the origin lies outside the window");
+// The walk in lanes; kRows: the layout is row by row (the index kept with one add a step),
+// else bricks (the index from the keys, BrickLayout::index as bit operations).
+template <bool kRows>
+__attribute__((target("avx2"))) void walk_lanes(const RayBatch& b, size_t begin, size_t end, const BrickLayout& layout,
+                                                double resolution, GridMarker& marker) {
   const __m256i brick_row = _mm256_set1_epi64x(layout.brick_row()), brick_layer = _mm256_set1_epi64x(layout.brick_layer());
   const __m256i free_bit = _mm256_set1_epi64x(kStateFree), fifteen = _mm256_set1_epi64x(15);
   const long long* grid = reinterpret_cast<const long long*>(marker.grid);
@@ -247,12 +262,13 @@ __attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t be
   for (int l = 0; l < 4; ++l) {
     const int r = feed.take();
     if (r < 0) break;
-    L.start(feed.block(), r, origin, lane_masks[l]);
+    L.start(feed.block(), r, origin, feed.origin_index(), lane_masks[l]);
     ++live;
   }
   alignas(32) uint32_t pending[kPending];
   int n_pending = 0;
-  auto& [tx, ty, tz, dx, dy, dz, length, x, y, z, sx, sy, sz, x_out, y_out, z_out, end_index, active] = L;
+  auto& [tx, ty, tz, dx, dy, dz, length, x, y, z, sx, sy, sz, x_out, y_out, z_out, end_index, active, row_index, index_dx,
+         index_dy, index_dz] = L;
   while (live > 0) {
     // The scalar walk: x if tx < ty and tx < tz; else y if !(tx < ty) and ty < tz; else z.
     const __m256d x_lt_y = _mm256_cmp_pd(tx, ty, _CMP_LT_OQ), x_lt_z = _mm256_cmp_pd(tx, tz, _CMP_LT_OQ),
@@ -271,7 +287,13 @@ __attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t be
     // The voxel's index in the grid (BrickLayout::index as bit operations; meaningless in a lane
     // that left the window, which stops on `left`); the end voxel by its index, a bijection of
     // the window's keys (an end outside the window has index -1, no voxel's).
-    const __m256i index = brick_index(x, y, z, brick_row, brick_layer);
+    if constexpr (kRows) {
+      // The stepping axis's change: x's where x steps, else y's where y steps, else z's.
+      row_index = _mm256_add_epi64(row_index, _mm256_castpd_si256(_mm256_blendv_pd(
+          _mm256_blendv_pd(_mm256_castsi256_pd(index_dz), _mm256_castsi256_pd(index_dy), step_y),
+          _mm256_castsi256_pd(index_dx), step_x)));
+    }
+    const __m256i index = kRows ? row_index : brick_index(x, y, z, brick_row, brick_layer);
     const __m256i at_end = _mm256_cmpeq_epi64(index, end_index);
     // std::min(a, b) is (b < a ? b : a), which _mm256_min_pd(b, a) computes.
     const __m256d dist = _mm256_min_pd(tz, _mm256_min_pd(ty, tx));
@@ -300,7 +322,7 @@ __attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t be
     for (int bits = finished; bits; bits &= bits - 1) {
       const int l = __builtin_ctz(unsigned(bits)), r = feed.take();
       if (r >= 0) {
-        L.start(feed.block(), r, origin, lane_masks[l]);
+        L.start(feed.block(), r, origin, feed.origin_index(), lane_masks[l]);
       } else {
         L.stop(lane_masks[l]);
         --live;
@@ -309,6 +331,16 @@ __attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t be
   }
   marker.mark_all(pending, n_pending, kStateFree);
   feed.finish();
+}
+
+}  // namespace
+
+__attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t begin, size_t end,
+                                                     const BrickLayout& layout, double resolution,
+                                                     GridMarker& marker) {
+  if (!layout.contains(b.origin_key)) throw std::logic_error("walk_rays_avx2: the origin lies outside the window");
+  if (layout.rows()) return walk_lanes<true>(b, begin, end, layout, resolution, marker);
+  walk_lanes<false>(b, begin, end, layout, resolution, marker);
 }
 
 #else

@@ -21,13 +21,22 @@
 namespace ort {
 namespace {
 
+// Both layouts: bricks, and rows of whole words (the default for windows up to kRowsUpTo voxels).
 TEST(BrickLayout, IndexIsABijectionAndKeyOfInvertsIt) {
   KeyBox w;
   w.lo[0] = 5, w.lo[1] = 1000, w.lo[2] = 65520;
-  w.hi[0] = 5 + 12, w.hi[1] = 1000 + 8, w.hi[2] = 65535;  // 13 x 9 x 16: partial bricks in x and y
-  const BrickLayout layout(w);
-  const uint64_t padded = BrickLayout::padded_voxels(w);
-  EXPECT_EQ(padded, 2u * 2u * 4u * 256u);
+  w.hi[0] = 5 + 20, w.hi[1] = 1000 + 8, w.hi[2] = 65535;  // 21 x 9 x 16: partial bricks in x and y, rows of 2 words
+  EXPECT_TRUE(BrickLayout::rows_for(w));
+  EXPECT_EQ(BrickLayout::padded_voxels(w), 32u * 9u * 16u);
+  KeyBox big = w;
+  big.hi[0] = 5 + 1000, big.hi[1] = 1000 + 1000;  // 1001 x 1001 x 16 voxels: bricks
+  EXPECT_FALSE(BrickLayout::rows_for(big));
+  EXPECT_EQ(BrickLayout::padded_voxels(big), 126u * 126u * 4u * 256u);
+  for (bool rows : {false, true}) {
+  const BrickLayout layout(w, rows);
+  EXPECT_EQ(layout.rows(), rows);
+  const uint64_t padded = layout.voxels();
+  EXPECT_EQ(padded, rows ? 32u * 9u * 16u : 3u * 2u * 4u * 256u);
   std::set<uint32_t> seen;
   for (int z = w.lo[2]; z <= w.hi[2]; ++z)
     for (int y = w.lo[1]; y <= w.hi[1]; ++y)
@@ -37,10 +46,11 @@ TEST(BrickLayout, IndexIsABijectionAndKeyOfInvertsIt) {
         const uint32_t i = layout.index(k);
         ASSERT_LT(i, padded);
         ASSERT_TRUE(seen.insert(i).second) << "two keys share index " << i;
-        ASSERT_TRUE(layout.key_of(i / 16, i % 16) == k) << x << " " << y << " " << z;
+        ASSERT_TRUE(layout.key_of(i / 16, i % 16) == k) << x << " " << y << " " << z << " rows " << rows;
       }
   EXPECT_FALSE(layout.contains(octomap::OcTreeKey(4, 1000, 65535)));
   EXPECT_FALSE(layout.contains(octomap::OcTreeKey(5, 1009, 65535)));
+  }
 }
 
 std::set<std::tuple<int, int, int, int>> as_set(const VoxelList& l) {
@@ -157,11 +167,11 @@ TEST(CpuGridBackend, BundlesOfRaysThroughTheSameVoxelsEqualCpuBackend) {
   }
 }
 
-// The AVX2 walk on a window of 16 x 16 x 8 voxels (2 x 2 x 2 bricks) that holds the origin,
-// with most ray ends outside it: a lane stops at its end voxel by the end's grid index, and
-// an end outside the window must match no voxel's (its brick arithmetic would otherwise name
-// a voxel inside: x + 16 in the row of bricks above). Voxel sets equal OctoMap's walk cut to
-// the window.
+// The AVX2 walk on a window of 16 x 16 x 8 voxels (2 x 2 x 2 bricks, or rows) that holds the
+// origin, with most ray ends outside it: a lane stops at its end voxel by the end's grid index,
+// and an end outside the window must match no voxel's (its brick arithmetic would otherwise
+// name a voxel inside: x + 16 in the row of bricks above). Both layouts (in rows the index is
+// kept step by step). Voxel sets equal OctoMap's walk cut to the window.
 TEST(CpuGridWalk, EndsOutsideTheWindowStopNoLaneInside) {
   if (!cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this CPU";
   const double res = 0.1;
@@ -173,12 +183,14 @@ TEST(CpuGridWalk, EndsOutsideTheWindowStopNoLaneInside) {
     ASSERT_TRUE(prepare_origin(origin, res, b, rep));
     KeyBox w;
     for (int i = 0; i < 3; ++i) w.lo[i] = 32768, w.hi[i] = 32768 + (i < 2 ? 15 : 7);
-    const BrickLayout layout(w);
-    ASSERT_TRUE(layout.contains(b.origin_key));
-    b.ends.push_back(RayEnd{1.65f, 0.35f, 0.15f, kRayEndOccupied});  // from the first origin: through (0, 11, 1), ends at (16, 3, 1)
+    // From the first origin: through (0, 11, 1) to (16, 3, 1), whose brick arithmetic names (0, 11, 1).
+    b.ends.push_back(RayEnd{1.65f, 0.35f, 0.15f, kRayEndOccupied});
     for (int i = 0; i < 20000; ++i) b.ends.push_back(RayEnd{u(rng), u(rng), uz(rng), uint32_t(i % 3 ? kRayEndOccupied : 0)});
+    for (bool rows : {false, true}) {
+    const BrickLayout layout(w, rows);
+    ASSERT_TRUE(layout.contains(b.origin_key));
     // Ray by ray (a union over many rays would hide one ray's early stop), then all at once.
-    std::vector<uint32_t> grid(BrickLayout::padded_voxels(w) / 16 + 2, 0), touched;
+    std::vector<uint32_t> grid(layout.voxels() / 16 + 2, 0), touched;
     int mismatches = 0;
     auto walk = [&](size_t begin, size_t end) {
       std::map<std::tuple<int, int, int>, uint32_t> expected, got;
@@ -203,7 +215,7 @@ TEST(CpuGridWalk, EndsOutsideTheWindowStopNoLaneInside) {
         grid[word] = 0;
       }
       if (got != expected && ++mismatches <= 3)
-        ADD_FAILURE() << "origin " << origin << " rays " << begin << "-" << end << ": " << got.size() << " voxels, OctoMap's walk "
+        ADD_FAILURE() << "origin " << origin << " rows " << rows << " rays " << begin << "-" << end << ": " << got.size() << " voxels, OctoMap's walk "
                       << expected.size();
       return expected.size();
     };
@@ -212,6 +224,7 @@ TEST(CpuGridWalk, EndsOutsideTheWindowStopNoLaneInside) {
     EXPECT_GT(inside, 1000u);
     EXPECT_GT(walk(0, b.ends.size()), 500u);
     EXPECT_EQ(mismatches, 0);
+    }
   }
 }
 
