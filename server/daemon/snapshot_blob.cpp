@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/clock.h"
 #include "daemon/map_store.h"
 #include "octomap_rt/map_chunk_t.hpp"
 #include "protocol/map_protocol.h"
@@ -14,10 +15,6 @@ namespace ort::daemon {
 namespace {
 
 using Chunk = octomap_rt::map_chunk_t;
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 std::string serialize(const octomap::OcTree& tree, int8_t format) {
   if (format == Chunk::FORMAT_OCTOMAP_FULL) return serialize_map(tree);

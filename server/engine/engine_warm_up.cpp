@@ -5,11 +5,10 @@
 #include <numbers>
 #include <vector>
 
+#include "core/clock.h"
+
 namespace ort {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 // Points spread evenly over a sphere (a Fibonacci lattice), x y z floats.
 std::vector<float> sphere_points(size_t n, double radius) {
@@ -35,13 +34,13 @@ WarmUpReport warm_up(MapEngine& engine, size_t points) {
   const std::vector<float> xyz = sphere_points(points, kWarmUpRadiusVoxels * engine.options().resolution);
   const octomap::pose6d identity;
   ShotScan shot;
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   engine.shoot_posed_xyz(identity, identity.trans(), xyz, engine.options().max_range, shot);
   report.shoot_ms = ms_since(t0);
   report.voxels = shot.voxels.size();
   report.refused = !shot.prepare.origin_ok || shot.refusal != ShotRefusal::kNone;
   const auto scratch = engine.make_tree();
-  const auto t1 = Clock::now();
+  const auto t1 = SteadyClock::now();
   engine.apply(shot, *scratch);
   report.apply_ms = ms_since(t1);
   return report;

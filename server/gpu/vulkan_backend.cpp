@@ -12,6 +12,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "core/clock.h"
 #include "core/ray_space.h"
 #include "gpu/gpu_prepare.h"
 #include "gpu/gpu_ray_space.h"
@@ -28,9 +29,6 @@ namespace {
 constexpr int kWindowMargin = 2;  // voxels around the key box: the walk may overstep by one
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
 
 std::shared_ptr<vk::Context> make_context(const BackendOptions& opts) {
   vk::ContextOptions co;

@@ -196,9 +196,10 @@ void run_real_scans(BackendKind backend, size_t warm_up_points = 0) {
   std::ostringstream log;
   daemon::MappingServer server(cfg, lc, log);
   server.start();
-  if (warm_up_points)
+  if (warm_up_points) {
     EXPECT_NE(log.str().find("warmed up on a scan of " + std::to_string(warm_up_points) + " points"), std::string::npos)
         << log.str();
+  }
   const char* robots[] = {"husky1", "husky2", "husky3"};
   std::vector<std::thread> producers;
   for (int r = 0; r < 3; ++r) {

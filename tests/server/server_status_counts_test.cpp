@@ -95,7 +95,9 @@ TEST(ServerStatusCounts, SlowestScansAreAppliedScansWithTheirParts) {
     EXPECT_NEAR(decode + queue + stage1 + handoff + stage2, e2e, 0.03) << line;  // 5 figures rounded to 0.005
     EXPECT_LE(lock + octree + deltas, stage2 + 0.02) << line;
     EXPECT_GT(voxels, 0) << line;
-    if (index == 1) EXPECT_GT(new_nodes, 0) << "the first scan builds the map: " << line;
+    if (index == 1) {
+      EXPECT_GT(new_nodes, 0) << "the first scan builds the map: " << line;
+    }
     EXPECT_GE(at, 0.0);
   }
   EXPECT_EQ(seqs.size(), std::min<size_t>(5, static_cast<size_t>(sent))) << summary.str();

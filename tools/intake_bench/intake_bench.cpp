@@ -20,6 +20,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/clock.h"
 #include "daemon/scan_to_map.h"
 #include "daemon/scan_validation.h"
 #include "scene/scan_set.h"
@@ -46,8 +47,6 @@ std::vector<uint8_t> encode_scan(const PosedScan& scan) {
   m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   return bytes;
 }
-
-double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
