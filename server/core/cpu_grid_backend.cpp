@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <limits>
 #include <new>
 #include <thread>
@@ -22,6 +23,7 @@
 #include "core/octomap_ray_walk.h"
 #include "core/prepare_scan.h"
 #include "core/ray_space.h"
+#include "core/walk_thread_choice.h"
 #include "core/window_walk_avx2.h"
 
 namespace ort {
@@ -97,6 +99,13 @@ struct WindowStepper {
 // a refusal leaves the thread as it was.
 void lower_own_priority() { (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19); }
 
+// CPU time the calling thread has run, in nanoseconds (0 where the clock is refused).
+int64_t thread_cpu_ns() {
+  timespec ts{};
+  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0;
+  return int64_t(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
 class CpuGridBackend final : public RayBackend {
  public:
   explicit CpuGridBackend(const CpuGridOptions& o)
@@ -105,6 +114,8 @@ class CpuGridBackend final : public RayBackend {
         words_((o.grid_budget_bytes ? o.grid_budget_bytes : (256ull << 20)) / 4),
         simd_(o.simd && cpu_has_avx2()),
         helpers_yield_(o.helpers_yield),
+        compact_alone_up_to_(o.compact_alone_up_to_words),
+        choice_(threads_),
         grid_(words_) {}
 
   BackendKind kind() const override { return BackendKind::kCpuGrid; }
@@ -119,40 +130,18 @@ class CpuGridBackend final : public RayBackend {
     stats.grid_allocations = 1;
     const std::vector<KeyBox> windows = plan_bricked_windows(batch.keys);
     stats.windows += windows.size();
-    const unsigned n_threads = unsigned(std::min<size_t>(threads_, std::max<size_t>(1, batch.ends.size() / 256)));
-    std::vector<std::vector<uint32_t>> touched(n_threads);
-    std::vector<VoxelList> partial(n_threads);
+    const unsigned most = unsigned(std::min<size_t>(threads_, std::max<size_t>(1, batch.ends.size() / 256)));
+    std::vector<std::vector<uint32_t>> touched(most);
     for (const KeyBox& w : windows) {
       const auto t_shoot = Clock::now();
       const BrickLayout layout(w);
-      // Rays are taken in chunks from a shared counter, so a helper thread that gets little
-      // CPU (helpers_yield) holds up the window by one chunk at most.
-      std::atomic<size_t> next{0};
-      constexpr size_t kChunk = 1024;
-      run_parallel(n_threads, [&](unsigned t) {
-        if (t > 0 && helpers_yield_) lower_own_priority();
-        touched[t].clear();
-        GridMarker marker{grid_.data(), touched[t], n_threads > 1};
-        for (size_t begin; (begin = next.fetch_add(kChunk)) < batch.ends.size();) {
-          const size_t end = std::min(batch.ends.size(), begin + kChunk);
-          if (mode == Traversal::kOctomap && simd_ && layout.contains(batch.origin_key)) {
-            walk_rays_avx2(batch, begin, end, layout, res_, marker);
-          } else {
-            for (size_t i = begin; i < end; ++i) shoot_ray(batch, batch.ends[i], mode, layout, marker);
-          }
-        }
-      });
-      stats.times.shoot_ms += ms_since(t_shoot);
+      const unsigned n_threads = helpers_yield_ ? std::min(most, choice_.next()) : most;
+      const double helper_cpu_ms = walk_window(batch, mode, layout, n_threads, touched);
+      const double walk_ms = ms_since(t_shoot);
+      stats.times.shoot_ms += walk_ms;
+      if (helpers_yield_) choice_.record(n_threads, batch.ends.size(), walk_ms, helper_cpu_ms);
       const auto t_compact = Clock::now();
-      run_parallel(n_threads, [&](unsigned t) {
-        partial[t].clear();
-        compact(layout, touched[t], partial[t]);
-      });
-      for (unsigned t = 0; t < n_threads; ++t) {
-        stats.words_touched += touched[t].size();
-        stats.words_read_back += touched[t].size();
-        out.insert(out.end(), partial[t].begin(), partial[t].end());
-      }
+      compact_window(layout, n_threads, touched, out, stats);
       stats.times.compact_ms += ms_since(t_compact);
     }
   }
@@ -209,8 +198,54 @@ class CpuGridBackend final : public RayBackend {
     walk_octomap_ray_steps(b.origin, end, b.origin_key, res_, s);
   }
 
+  // Walks every ray of the batch into the window with n threads (touched[t] lists the words
+  // thread t set first). Returns the CPU time the helper threads (all but the caller's) got.
+  double walk_window(const RayBatch& batch, Traversal mode, const BrickLayout& layout, unsigned n_threads,
+                     std::vector<std::vector<uint32_t>>& touched) {
+    // Rays are taken in chunks from a shared counter, so a helper thread that gets little
+    // CPU (helpers_yield) holds up the window by one chunk at most.
+    std::atomic<size_t> next{0};
+    std::atomic<int64_t> helper_cpu_ns{0};
+    constexpr size_t kChunk = 1024;
+    run_parallel(n_threads, [&](unsigned t) {
+      if (t > 0 && helpers_yield_) lower_own_priority();
+      touched[t].clear();
+      GridMarker marker{grid_.data(), touched[t], n_threads > 1};
+      for (size_t begin; (begin = next.fetch_add(kChunk)) < batch.ends.size();) {
+        const size_t end = std::min(batch.ends.size(), begin + kChunk);
+        if (mode == Traversal::kOctomap && simd_ && layout.contains(batch.origin_key)) {
+          walk_rays_avx2(batch, begin, end, layout, res_, marker);
+        } else {
+          for (size_t i = begin; i < end; ++i) shoot_ray(batch, batch.ends[i], mode, layout, marker);
+        }
+      }
+      if (t > 0) helper_cpu_ns += thread_cpu_ns();  // a helper's thread starts with the window
+    });
+    return double(helper_cpu_ns.load()) * 1e-6;
+  }
+
+  // The walk's touched words into `out`. On the caller's thread unless the window touched
+  // more than CpuGridOptions::compact_alone_up_to_words: measured on 2 cores, compacting
+  // fr079-real's ~30 K words a window on two threads took 85-115 ms over 66 windows against
+  // 31-42 ms on one (a thread started per window, half of the words last written on the other
+  // core, a helper at the lowest priority waited for).
+  void compact_window(const BrickLayout& layout, unsigned n_threads, const std::vector<std::vector<uint32_t>>& touched,
+                      VoxelList& out, ShootStats& stats) {
+    size_t words = 0;
+    for (unsigned t = 0; t < n_threads; ++t) words += touched[t].size();
+    stats.words_touched += words;
+    stats.words_read_back += words;
+    if (n_threads == 1 || words <= compact_alone_up_to_) {
+      for (unsigned t = 0; t < n_threads; ++t) compact(layout, touched[t], out);
+      return;
+    }
+    std::vector<VoxelList> partial(n_threads);
+    run_parallel(n_threads, [&](unsigned t) { compact(layout, touched[t], partial[t]); });
+    for (unsigned t = 0; t < n_threads; ++t) out.insert(out.end(), partial[t].begin(), partial[t].end());
+  }
+
   // Turns touched words into voxel updates (occupied wins) and clears them: the grid is
-  // cleared through the touched list only, never by a pass over the window.
+  // cleared through the touched list only, never by a pass over the window. Appends to `out`.
   void compact(const BrickLayout& layout, const std::vector<uint32_t>& touched, VoxelList& out) {
     uint32_t* grid = grid_.data();
     for (uint32_t word : touched) {
@@ -233,6 +268,8 @@ class CpuGridBackend final : public RayBackend {
   uint64_t words_;
   bool simd_;  // OctoMap walks in AVX2 lanes (window_walk_avx2.h) where the CPU has AVX2
   bool helpers_yield_;
+  uint64_t compact_alone_up_to_;
+  WalkThreadChoice choice_;  // used with helpers_yield_ only
   GridMemory grid_;
 };
 

@@ -19,6 +19,10 @@ struct CpuGridOptions {
   // The walk's threads other than the caller run at the lowest priority (nice 19): they take
   // the cores another stage leaves idle and give way when it runs (BackendOptions::helpers_yield).
   bool helpers_yield = false;
+  // A window whose walk touched at most this many grid words is compacted on the caller's
+  // thread alone (a thread started per window and words last written on another core cost
+  // more than they save there); larger ones on all the walk's threads.
+  uint64_t compact_alone_up_to_words = 1u << 20;
 };
 
 std::unique_ptr<RayBackend> make_cpu_grid_backend(const CpuGridOptions& opts);

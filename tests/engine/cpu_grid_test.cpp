@@ -82,10 +82,11 @@ std::vector<octomap::point3d> scan_points(const octomap::point3d& origin, float 
 }
 
 void expect_grid_equals_cpu(const octomap::point3d& origin, float reach, uint64_t grid_bytes, unsigned threads,
-                            bool expect_split, bool simd, bool helpers_yield = false) {
+                            bool expect_split, bool simd, bool helpers_yield = false,
+                            uint64_t compact_alone_up_to_words = CpuGridOptions{}.compact_alone_up_to_words) {
   const double res = 0.1;
   auto reference = make_cpu_backend(res);
-  auto grid = make_cpu_grid_backend({res, grid_bytes, threads, simd, helpers_yield});
+  auto grid = make_cpu_grid_backend({res, grid_bytes, threads, simd, helpers_yield, compact_alone_up_to_words});
   for (uint32_t seed = 1; seed <= 3; ++seed) {
     PrepareReport rep;
     const RayBatch b = prepare_scan(origin, scan_points(origin, reach, seed), seed == 2 ? reach * 0.5 : -1.0, res, rep);
@@ -129,6 +130,15 @@ TEST(CpuGridBackend, YieldingHelperThreadsGiveTheSameVoxels) {
   for (bool simd : {false, true}) {
     expect_grid_equals_cpu({0.8f, -1.6f, 0.4f}, 9.0f, 0, 3, false, simd, true);
     expect_grid_equals_cpu({0.05f, 0.05f, 0.05f}, 12.0f, 128u << 10, 3, true, simd, true);
+  }
+}
+
+// Compaction on every walk thread (windows that touched many words), each thread's touched
+// words into its own list, joined after: the same voxels, each once.
+TEST(CpuGridBackend, CompactionOnAllThreadsGivesTheSameVoxels) {
+  for (unsigned threads : {2u, 3u}) {
+    expect_grid_equals_cpu({0.8f, -1.6f, 0.4f}, 9.0f, 0, threads, false, true, false, 0);
+    expect_grid_equals_cpu({0.05f, 0.05f, 0.05f}, 12.0f, 128u << 10, threads, true, true, true, 0);
   }
 }
 
