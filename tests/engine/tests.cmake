@@ -8,7 +8,8 @@ octomap_rt_add_test(engine_prepare_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/prepar
 
 octomap_rt_add_test(engine_ray_walk_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/ray_walk_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/cpu_grid_test.cpp
-                    ${CMAKE_CURRENT_LIST_DIR}/walk_thread_choice_test.cpp)
+                    ${CMAKE_CURRENT_LIST_DIR}/walk_thread_choice_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/window_walk_stays_test.cpp)
 
 # Issue 13: far-flung scans (path-following tiles, bounded work, OctoMap's map).
 octomap_rt_add_test(engine_far_flung_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/far_flung_test.cpp TIMEOUT 600)
