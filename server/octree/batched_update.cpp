@@ -99,7 +99,7 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
     }
   };
   if (parallel)
-    pool_.run(work);
+    pool_.run_shared(work);
   else
     work(0);
   const auto t3 = Clock::now();

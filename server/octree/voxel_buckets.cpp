@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cstring>
 
@@ -13,16 +14,55 @@ constexpr size_t kAxisWords = 1024;     // 65536 bits: one per key coordinate
 constexpr size_t kInsertionMax = 32;
 constexpr unsigned kDirectMaxBits = 12;  // direct_sort: up to 4096 slots (32 KiB)
 
-// Runs body(worker) on the pool's workers, or once on this thread without a pool.
+// A list is cut into chunks that the pool's threads take from a counter (WorkerPool::run_shared:
+// a preempted thread's chunks go to the others). Passes 2 and 3 keep a row of per-cell counts
+// per chunk, so their chunks are few: kChunksPerWorker per thread, of at least kMinChunk voxels.
+constexpr size_t kChunksPerWorker = 3;
+constexpr size_t kMinChunk = 4096;
+constexpr size_t kMarkChunk = 8192;  // pass 1 keeps nothing per chunk
+
+// Runs body(k) for every k in [0, count), shared out over the pool's threads, or here.
 template <class F>
-void run_on(WorkerPool* pool, unsigned workers, F&& body) {
-  if (workers <= 1 || !pool) {
-    body(0u);
+void for_each_chunk(WorkerPool* pool, size_t count, F&& body) {
+  if (!pool || count <= 1) {
+    for (size_t k = 0; k < count; ++k) body(k);
     return;
   }
-  pool->run([&](unsigned w) {
-    if (w < workers) body(w);
+  std::atomic<size_t> next{0};
+  pool->run_shared([&](unsigned) {
+    for (size_t k; (k = next.fetch_add(1, std::memory_order_relaxed)) < count;) body(k);
   });
+}
+
+// Sets bit v of `bits` unless it is set: most voxels repeat their neighbour's coordinates, so
+// the threads mostly read the shared words and seldom take a cache line from each other.
+inline void mark(uint64_t* bits, uint16_t v) {
+  std::atomic_ref<uint64_t> word(bits[v >> 6]);
+  const uint64_t bit = uint64_t{1} << (v & 63);
+  if ((word.load(std::memory_order_relaxed) & bit) == 0) word.fetch_or(bit, std::memory_order_relaxed);
+}
+
+// Pass 1 on one thread: plain byte stores (consecutive voxels mostly repeat a coordinate, and
+// read-modify-writes of one word would chain them), then the bytes packed into bits: about a
+// quarter of mark()'s instructions a voxel, for a fixed 192 KiB to clear and pack a list.
+void mark_alone(std::span<const VoxelUpdate> updates, std::vector<uint8_t>& seen, uint64_t* bits) {
+  seen.assign(3 * 65536, 0);
+  uint8_t* const set = seen.data();  // not through the vector: a byte store may alias its pointer
+  for (const VoxelUpdate& u : updates) {
+    set[u.x] = 1;
+    set[65536 + u.y] = 1;
+    set[2 * 65536 + u.z] = 1;
+  }
+  for (size_t word = 0; word < 3 * kAxisWords; ++word) {
+    uint64_t packed = 0;
+    for (unsigned k = 0; k < 8; ++k) {
+      uint64_t bytes;  // eight 0/1 bytes
+      std::memcpy(&bytes, set + word * 64 + k * 8, 8);
+      // The multiplication moves byte j's bit to bit 56 + j, without carries.
+      packed |= ((bytes * 0x0102040810204080ull) >> 56) << (k * 8);
+    }
+    bits[word] = packed;
+  }
 }
 
 // Bit g * 2^shift of the result is set iff a bit of [g * 2^shift, (g + 1) * 2^shift) is
@@ -135,39 +175,28 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
   out.begin.clear();
   out.depth = 0;
   if (n == 0) return;
-  const unsigned workers = (pool && n >= kParallelMin) ? pool->size() : 1;
-  auto chunk_begin = [&](unsigned w) { return n * w / workers; };
+  if (pool && n < kParallelMin) pool = nullptr;
+  const size_t chunks =
+      pool ? std::clamp<size_t>(n / kMinChunk, 1, kChunksPerWorker * pool->size()) : 1;
+  auto chunk_begin = [&](size_t k) { return n * k / chunks; };
 
-  // Pass 1: which key coordinates occur, per axis. Plain byte stores (consecutive voxels
-  // mostly repeat a coordinate, and read-modify-writes of one word would chain them), then
-  // each worker packs its bytes into bits.
-  scratch.seen.resize(size_t{workers} * 3 * 65536);
-  scratch.occupied.resize(size_t{workers} * 3 * kAxisWords);
-  run_on(pool, workers, [&](unsigned w) {
-    uint8_t* seen = &scratch.seen[size_t{w} * 3 * 65536];
-    std::fill_n(seen, 3 * 65536, uint8_t{0});
-    const VoxelUpdate* u = updates.data();
-    for (size_t i = chunk_begin(w), e = chunk_begin(w + 1); i < e; ++i) {
-      seen[u[i].x] = 1;
-      seen[65536 + u[i].y] = 1;
-      seen[2 * 65536 + u[i].z] = 1;
-    }
-    uint64_t* bits = &scratch.occupied[size_t{w} * 3 * kAxisWords];
-    for (size_t word = 0; word < 3 * kAxisWords; ++word) {
-      uint64_t packed = 0;
-      for (unsigned k = 0; k < 8; ++k) {
-        uint64_t bytes;  // eight 0/1 bytes
-        std::memcpy(&bytes, seen + word * 64 + k * 8, 8);
-        // The multiplication moves byte j's bit to bit 56 + j, without carries.
-        packed |= ((bytes * 0x0102040810204080ull) >> 56) << (k * 8);
+  // Pass 1: which key coordinates occur, per axis, as bits shared by the threads.
+  scratch.occupied.assign(3 * kAxisWords, 0);
+  uint64_t* const axis_words = scratch.occupied.data();
+  if (pool) {
+    const size_t mark_chunks = (n + kMarkChunk - 1) / kMarkChunk;
+    for_each_chunk(pool, mark_chunks, [&](size_t k) {
+      const VoxelUpdate* u = updates.data();
+      for (size_t i = n * k / mark_chunks, e = n * (k + 1) / mark_chunks; i < e; ++i) {
+        mark(axis_words, u[i].x);
+        mark(axis_words + kAxisWords, u[i].y);
+        mark(axis_words + 2 * kAxisWords, u[i].z);
       }
-      bits[word] = packed;
-    }
-  });
-  for (unsigned w = 1; w < workers; ++w)
-    for (size_t i = 0; i < 3 * kAxisWords; ++i) scratch.occupied[i] |= scratch.occupied[size_t{w} * 3 * kAxisWords + i];
-  const uint64_t* axis_bits[3] = {&scratch.occupied[0], &scratch.occupied[kAxisWords],
-                                  &scratch.occupied[2 * kAxisWords]};
+    });
+  } else {
+    mark_alone(updates, scratch.seen, axis_words);
+  }
+  const uint64_t* axis_bits[3] = {axis_words, axis_words + kAxisWords, axis_words + 2 * kAxisWords};
 
   // The deepest depth whose cells fit the budget.
   const size_t budget = std::min(opts.max_cells, std::max<size_t>(64, n / std::max(1u, opts.voxels_per_cell)));
@@ -186,16 +215,16 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
   const CellOf cell_of{scratch.cell_of_axis[0].data(), scratch.cell_of_axis[1].data(),
                       scratch.cell_of_axis[2].data(), shift};
 
-  // Pass 2: voxels per cell, per worker (each worker clears its own row first).
-  scratch.counts.resize(size_t{workers} * cells);
-  run_on(pool, workers, [&, cell_of](unsigned w) {
-    uint32_t* count = &scratch.counts[size_t{w} * cells];
+  // Pass 2: voxels per cell, per chunk (each chunk's row cleared by its thread first).
+  scratch.counts.resize(chunks * cells);
+  for_each_chunk(pool, chunks, [&, cell_of](size_t k) {
+    uint32_t* count = &scratch.counts[k * cells];
     std::fill_n(count, cells, 0u);
     const VoxelUpdate* u = updates.data();
-    if (chunk_begin(w) == chunk_begin(w + 1)) return;
+    if (chunk_begin(k) == chunk_begin(k + 1)) return;
     // Runs of voxels in one cell (a ray's) are counted in a register, not through memory.
-    uint32_t cell = cell_of(u[chunk_begin(w)]), run = 0;
-    for (size_t i = chunk_begin(w), e = chunk_begin(w + 1); i < e; ++i) {
+    uint32_t cell = cell_of(u[chunk_begin(k)]), run = 0;
+    for (size_t i = chunk_begin(k), e = chunk_begin(k + 1); i < e; ++i) {
       const uint32_t c = cell_of(u[i]);
       if (c != cell) {
         count[cell] += run;
@@ -207,16 +236,16 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
     count[cell] += run;
   });
 
-  // Per cell, on the workers (a slice of the cells each): the cell's total, and each
-  // worker's count replaced by the sum of the workers' before it, so that each worker's part
-  // of a bucket comes after the parts of the workers before it (the buckets keep the list's
-  // order). Serially, this was a strided walk over every worker's row per cell.
+  // Per cell, on the threads (slices of cells): the cell's total, and each chunk's count
+  // replaced by the sum of the chunks' before it, so that each chunk's part of a bucket comes
+  // after the parts of the chunks before it (the buckets keep the list's order).
   scratch.totals.resize(cells);
-  run_on(pool, workers, [&](unsigned w) {
-    for (size_t c = cells * w / workers, e = cells * (w + 1) / workers; c < e; ++c) {
+  const size_t cell_slices = pool ? std::min<size_t>(chunks, (cells + 1023) / 1024) : 1;
+  for_each_chunk(pool, cell_slices, [&](size_t slice) {
+    for (size_t c = cells * slice / cell_slices, e = cells * (slice + 1) / cell_slices; c < e; ++c) {
       uint32_t sum = 0;
-      for (unsigned k = 0; k < workers; ++k) {
-        uint32_t& slot = scratch.counts[size_t{k} * cells + c];
+      for (size_t k = 0; k < chunks; ++k) {
+        uint32_t& slot = scratch.counts[k * cells + c];
         const uint32_t n_here = slot;
         slot = sum;
         sum += n_here;
@@ -246,14 +275,14 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
 
   // Pass 3: scatter.
   SortedVoxel* dst = out.voxels.data();
-  run_on(pool, workers, [&, cell_of, dst](unsigned w) {
-    uint32_t* next = &scratch.counts[size_t{w} * cells];
+  for_each_chunk(pool, chunks, [&, cell_of, dst](size_t k) {
+    uint32_t* next = &scratch.counts[k * cells];
     const VoxelUpdate* u = updates.data();
-    if (chunk_begin(w) == chunk_begin(w + 1)) return;
+    if (chunk_begin(k) == chunk_begin(k + 1)) return;
     const uint32_t* cell_begin = scratch.cell_begin.data();
     for (size_t c = 0; c < cells; ++c) next[c] += cell_begin[c];  // only nonempty cells are read
-    uint32_t cell = cell_of(u[chunk_begin(w)]), pos = next[cell];
-    for (size_t i = chunk_begin(w), e = chunk_begin(w + 1); i < e; ++i) {
+    uint32_t cell = cell_of(u[chunk_begin(k)]), pos = next[cell];
+    for (size_t i = chunk_begin(k), e = chunk_begin(k + 1); i < e; ++i) {
       const uint32_t c = cell_of(u[i]);
       if (c != cell) {
         next[cell] = pos;

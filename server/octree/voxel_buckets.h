@@ -68,11 +68,11 @@ struct VoxelBuckets {
   std::span<SortedVoxel> bucket(size_t b) { return {voxels.data() + begin[b], begin[b + 1] - begin[b]}; }
 };
 
-// Reused storage of bucket_voxels (per-thread counts, rank tables).
+// Reused storage of bucket_voxels (per-chunk counts, rank tables).
 struct BucketScratch {
-  std::vector<uint8_t> seen;       // [worker][axis][65536]: key coordinates that occur
-  std::vector<uint64_t> occupied;  // [worker][axis][1024 words]: the same as bits; worker 0's: all
-  std::vector<uint32_t> counts;    // [worker][cell]: voxels, then the workers' offsets
+  std::vector<uint64_t> occupied;  // [axis][1024 words]: key coordinates that occur, one bit each
+  std::vector<uint8_t> seen;       // [axis][65536]: the same as bytes, on one thread
+  std::vector<uint32_t> counts;    // [chunk][cell]: voxels, then the chunks' offsets
   std::vector<uint32_t> totals;    // [cell]: voxels
   std::vector<uint32_t> cell_begin;  // [cell]: first index of its bucket (nonempty cells)
   std::vector<uint32_t> cell_of_axis[3];
@@ -80,7 +80,8 @@ struct BucketScratch {
 };
 
 // Buckets `updates` (order within a bucket: the list's order). Keys may repeat.
-// With a pool the passes are spread over its workers (not from inside a run of the same pool).
+// With a pool the passes' chunks are shared out over its threads (WorkerPool::run_shared; not
+// from inside a run of the same pool).
 void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& opts, WorkerPool* pool,
                    VoxelBuckets& out, BucketScratch& scratch);
 

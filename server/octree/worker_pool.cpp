@@ -16,7 +16,8 @@ inline void cpu_relax() {
 }
 
 // Returns once `value` no longer holds `old` (acquire); spins first when `spin`.
-void wait_for_change(const std::atomic<uint32_t>& value, uint32_t old, bool spin) {
+template <class T>
+void wait_for_change(const std::atomic<T>& value, T old, bool spin) {
   const auto until = std::chrono::steady_clock::now() + kSpin;
   for (unsigned i = 1; spin; ++i) {
     if (value.load(std::memory_order_acquire) != old) return;
@@ -65,18 +66,62 @@ void WorkerPool::run(const std::function<void(unsigned)>& body) {
   if (error_) std::rethrow_exception(error_);
 }
 
+void WorkerPool::run_shared(const std::function<void(unsigned)>& body) {
+  error_ = nullptr;
+  job_ = &body;
+  const uint32_t gen = generation_.load(std::memory_order_relaxed) + 1;
+  // The job's state before its generation (release): a thread that sees the generation sees it.
+  job_state_.store(uint64_t{gen} << 32 | kShared, std::memory_order_relaxed);
+  generation_.store(gen, std::memory_order_release);
+  if (!threads_.empty()) generation_.notify_all();
+  std::exception_ptr own_error;
+  try {
+    body(0);
+  } catch (...) {
+    own_error = std::current_exception();
+  }
+  // Closed: no thread joins from now on; wait for those inside.
+  for (uint64_t s = job_state_.fetch_or(kClosed, std::memory_order_acq_rel) | kClosed; (s & kInside) != 0;
+       s = job_state_.load(std::memory_order_acquire))
+    wait_for_change(job_state_, s, spin_);
+  job_ = nullptr;
+  if (own_error) std::rethrow_exception(own_error);
+  if (error_) std::rethrow_exception(error_);
+}
+
+void WorkerPool::run_body(unsigned worker) {
+  try {
+    (*job_)(worker);
+  } catch (...) {
+    std::lock_guard lock(error_mutex_);
+    if (!error_) error_ = std::current_exception();
+  }
+}
+
+void WorkerPool::join_shared(unsigned worker, uint32_t gen) {
+  uint64_t s = job_state_.load(std::memory_order_acquire);
+  do {
+    if ((s >> 32) != gen || (s & kClosed)) return;  // over (or a later job's): not this thread's
+  } while (!job_state_.compare_exchange_weak(s, s + 1, std::memory_order_acquire, std::memory_order_acquire));
+  run_body(worker);
+  // acq_rel: the caller's acquire of "closed, none inside" sees this thread's writes.
+  const uint64_t left = job_state_.fetch_sub(1, std::memory_order_acq_rel) - 1;
+  if ((left & kClosed) && (left & kInside) == 0) job_state_.notify_one();
+}
+
 void WorkerPool::thread_main(unsigned worker) {
   uint32_t seen = 0;  // the generation this thread ran last (0: none yet)
   for (;;) {
     wait_for_change(generation_, seen, spin_);
     seen = generation_.load(std::memory_order_acquire);
     if (stopping_.load(std::memory_order_relaxed)) return;
-    try {
-      (*job_)(worker);
-    } catch (...) {
-      std::lock_guard lock(error_mutex_);
-      if (!error_) error_ = std::current_exception();
+    // A run() job waits for every thread, so a thread behind by a job can only be behind a
+    // run_shared() one: its state then carries another generation, or is closed.
+    if (job_state_.load(std::memory_order_acquire) >> 32 == seen) {
+      join_shared(worker, seen);
+      continue;
     }
+    run_body(worker);
     // acq_rel: the caller's acquire of 0 sees this thread's writes (and the error).
     if (running_.fetch_sub(1, std::memory_order_acq_rel) == 1) running_.notify_one();
   }

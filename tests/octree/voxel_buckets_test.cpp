@@ -134,7 +134,7 @@ TEST(VoxelBuckets, SortBucketIsTheStableMortonSort) {
 
 TEST(VoxelBuckets, ARepeatedKeyKeepsTheListsOrder) {
   std::mt19937 rng(8);
-  WorkerPool pool(2);
+  WorkerPool pool(2), five(5);  // the list in 6 and 9 chunks, taken by whichever thread comes
   // 40,000 updates of 3,000 keys: each key 13 times on average, in both states.
   std::uniform_int_distribution<int> key(32750, 32790);
   std::vector<octomap::OcTreeKey> keys;
@@ -147,7 +147,7 @@ TEST(VoxelBuckets, ARepeatedKeyKeepsTheListsOrder) {
     list.push_back(make_update(k, occupied));
     states_in_list_order[morton_code(k[0], k[1], k[2])].push_back(occupied);
   }
-  for (WorkerPool* p : {static_cast<WorkerPool*>(nullptr), &pool}) {
+  for (WorkerPool* p : {static_cast<WorkerPool*>(nullptr), &pool, &five}) {
     VoxelBuckets b;
     BucketScratch scratch;
     bucket_voxels(list, BucketOptions{}, p, b, scratch);

@@ -1,7 +1,11 @@
 // The octree stage's worker pool: every worker runs every job exactly once, the caller sees
 // the workers' plain writes when run() returns, errors come back to the caller, and the pool
 // works whether its threads catch the next job while spinning or must be woken from sleep.
+// A shared job (run_shared) has all its chunks done once, by whichever threads joined, no
+// thread runs it twice or after it returned, also between run() jobs.
+#include <algorithm>
 #include <atomic>
+#include <cstdio>
 #include <chrono>
 #include <stdexcept>
 #include <thread>
@@ -75,6 +79,74 @@ TEST_P(WorkerPoolTest, IsDestroyedWhileItsThreadsSleepOrSpin) {
     pool.run([](unsigned) {});
     std::this_thread::sleep_for(std::chrono::milliseconds(wait_ms));
   }  // the destructor joins: a hang here fails the test by its timeout
+}
+
+// A shared job of `chunks` chunks; counts each chunk's runs and each worker's bodies.
+void run_chunks(WorkerPool& pool, std::vector<int>& chunk_runs, std::vector<int>& bodies,
+                const std::atomic<bool>& returned, std::atomic<int>& late) {
+  std::atomic<size_t> next{0};
+  std::fill(bodies.begin(), bodies.end(), 0);
+  pool.run_shared([&](unsigned w) {
+    if (returned.load()) late.fetch_add(1);
+    ++bodies[w];
+    for (size_t k; (k = next.fetch_add(1)) < chunk_runs.size();) {
+      ++chunk_runs[k];  // plain: one thread a chunk
+      // A few microseconds of work a chunk, so that woken threads join the job.
+      const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(20);
+      while (std::chrono::steady_clock::now() < until) {
+      }
+    }
+  });
+}
+
+TEST_P(WorkerPoolTest, SharedJobsDoEveryChunkOnceWhoeverJoins) {
+  const PoolCase c = GetParam();
+  WorkerPool pool(c.workers, c.spin);
+  std::atomic<bool> returned{false};
+  std::atomic<int> late{0};
+  std::vector<int> bodies(c.workers);
+  unsigned most_joined = 0;
+  for (int job = 0; job < 300; ++job) {
+    std::vector<int> chunk_runs(job % 7 == 0 ? 1 : 40, 0);
+    returned = false;
+    run_chunks(pool, chunk_runs, bodies, returned, late);
+    returned = true;
+    for (size_t k = 0; k < chunk_runs.size(); ++k) ASSERT_EQ(chunk_runs[k], 1) << "chunk " << k << ", job " << job;
+    ASSERT_EQ(bodies[0], 1);
+    unsigned joined = 0;
+    for (unsigned w = 0; w < c.workers; ++w) {
+      ASSERT_LE(bodies[w], 1) << "worker " << w << " ran job " << job << " twice";
+      joined += static_cast<unsigned>(bodies[w]);
+    }
+    most_joined = std::max(most_joined, joined);
+    if (job % 3 == 0) {  // a job every thread runs, between shared ones
+      std::vector<int> runs(c.workers, 0);
+      pool.run([&](unsigned w) { ++runs[w]; });
+      for (unsigned w = 0; w < c.workers; ++w) ASSERT_EQ(runs[w], 1) << "worker " << w << ", job " << job;
+    }
+  }
+  EXPECT_EQ(late.load(), 0) << "a body ran after run_shared returned";
+  std::printf("at most %u of %u threads joined a shared job\n", most_joined, c.workers);
+}
+
+TEST_P(WorkerPoolTest, AnErrorInASharedJobReachesTheCallerAndThePoolGoesOn) {
+  const PoolCase c = GetParam();
+  WorkerPool pool(c.workers, c.spin);
+  for (size_t bad = 0; bad < 8; ++bad) {
+    std::atomic<size_t> next{0};
+    EXPECT_THROW(pool.run_shared([&](unsigned) {
+      for (size_t k; (k = next.fetch_add(1)) < 8;)
+        if (k == bad) throw std::runtime_error("chunk failed");
+    }),
+                 std::runtime_error)
+        << "chunk " << bad;
+    std::atomic<int> chunks{0};
+    std::atomic<size_t> again{0};
+    pool.run_shared([&](unsigned) {
+      while (again.fetch_add(1) < 8) chunks.fetch_add(1);
+    });
+    EXPECT_EQ(chunks.load(), 8);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Pools, WorkerPoolTest,
