@@ -183,6 +183,7 @@ RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::p
     report.cut_at_max_range += c.report.cut_at_max_range;
   }
   report.rays += batch.ends.size();
+  batch.keys_hold_ends = true;
   return batch;
 }
 

@@ -55,6 +55,10 @@ struct RayBatch {
   std::vector<RayEnd> ends;    // one ray per entry, from origin to end
   KeyBox keys;                 // box of the origin key and every end key
   double resolution = 0.1;
+  // True where `keys` is known to hold every end key (prepare_scan sets it); false where it may
+  // be narrower (a tile's box, MapEngine::shoot_tiled: its rays run on beyond it). Lets the
+  // cpu-grid walk know from the box alone that no ray leaves a window (rays_stay_inside).
+  bool keys_hold_ends = false;
 };
 
 }  // namespace ort

@@ -350,6 +350,11 @@ __attribute__((target("avx2"))) bool rays_stay_inside(const RayBatch& b, size_t 
     lo[i] = _mm256_set1_epi64x(int64_t(w.lo[i]) + kInsideBy - kTreeMaxVal);  // in floor(coord / res) units
     hi[i] = _mm256_set1_epi64x(int64_t(w.hi[i]) - kInsideBy - kTreeMaxVal);
   }
+  if (b.keys_hold_ends) {  // the batch's box decides without a pass over the rays
+    bool inside = true;
+    for (int i = 0; i < 3; ++i) inside = inside && b.keys.lo[i] >= w.lo[i] + kInsideBy && b.keys.hi[i] <= w.hi[i] - kInsideBy;
+    return inside;
+  }
   __m256i outside = _mm256_setzero_si256();
   for (size_t r = begin; r < end; r += 4) {
     const size_t n = std::min<size_t>(4, end - r);

@@ -30,13 +30,14 @@ void walk_rays_avx2(const RayBatch& b, size_t begin, size_t end, const BrickLayo
                     GridMarker& marker);
 
 // True when no walk of rays [begin, end) of `b` can leave the layout's window: the origin key
-// and every end key lie at least two keys inside each face. A walk visits only voxels its
-// segment passes through (it stops where the next border lies past the segment's length),
-// inside the box of its origin and end keys give or take a voxel of rounding at a border; so
-// one window holding a scan's whole ray space (widened by plan_windows' margin) passes, and a
-// window of a split ray space or a tile's (its rays run on beyond it) does not. Where it holds,
-// walk_rays_avx2 drops the per-step test for leaving a row-by-row window. Needs AVX2, as
-// walk_rays_avx2 does (false in a build for another architecture).
+// and every end key lie at least two keys inside each face (judged from b.keys where
+// b.keys_hold_ends, else ray by ray). A walk visits only voxels its segment passes through
+// (it stops where the next border lies past the segment's length), inside the box of its
+// origin and end keys give or take a voxel of rounding at a border; so one window holding a
+// scan's whole ray space (widened by plan_windows' margin) passes, and a window of a split
+// ray space or a tile's (its rays run on beyond it) does not. Where it holds, walk_rays_avx2
+// drops the per-step test for leaving a row-by-row window. Needs AVX2, as walk_rays_avx2
+// does (false in a build for another architecture).
 bool rays_stay_inside(const RayBatch& b, size_t begin, size_t end, const BrickLayout& layout, double resolution);
 
 }  // namespace ort

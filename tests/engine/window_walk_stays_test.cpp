@@ -103,19 +103,27 @@ TEST(WindowWalkStays, RefusedWhereARayMayLeaveTheWindow) {
   const std::vector<KeyBox> split = plan_windows(b.keys, 64u << 10);
   ASSERT_GT(split.size(), 1u);
   for (const KeyBox& w : split) EXPECT_FALSE(rays_stay_inside(b, 0, b.ends.size(), BrickLayout(w, true), kRes));
-  // A tile's window: the batch names a box that its rays run beyond (as MapEngine::shoot_tiled does).
+  // A tile's window: the batch names a box that its rays run beyond (as MapEngine::shoot_tiled
+  // does, in a batch that does not claim its box holds the ends).
   RayBatch tile = b;
+  tile.keys_hold_ends = false;
   for (int i = 0; i < 3; ++i) tile.keys.lo[i] = b.origin_key[i] - 8, tile.keys.hi[i] = b.origin_key[i] + 8;
   EXPECT_FALSE(rays_stay_inside(tile, 0, tile.ends.size(), BrickLayout(plan_windows(tile.keys, 1ull << 30)[0], true), kRes));
-  // The whole ray space without the margin: ends on the faces; and each margin key matters.
-  const KeyBox exact = b.keys;
-  EXPECT_FALSE(rays_stay_inside(b, 0, b.ends.size(), BrickLayout(exact, true), kRes));
-  for (int axis = 0; axis < 3; ++axis) {
-    for (int side = 0; side < 2; ++side) {
-      KeyBox w = plan_windows(b.keys, 1ull << 30)[0];
-      EXPECT_TRUE(rays_stay_inside(b, 0, b.ends.size(), BrickLayout(w, true), kRes));
-      (side ? w.hi[axis] : w.lo[axis]) += side ? -1 : 1;  // one key less of margin on one face
-      EXPECT_FALSE(rays_stay_inside(b, 0, b.ends.size(), BrickLayout(w, true), kRes)) << "axis " << axis << " side " << side;
+  // The whole ray space without the margin: ends on the faces; and each margin key matters,
+  // judged from the batch's box and ray by ray.
+  ASSERT_TRUE(b.keys_hold_ends);
+  RayBatch unknown_box = b;
+  unknown_box.keys_hold_ends = false;
+  for (const RayBatch* batch : std::initializer_list<const RayBatch*>{&b, &unknown_box}) {
+    EXPECT_FALSE(rays_stay_inside(*batch, 0, batch->ends.size(), BrickLayout(b.keys, true), kRes));
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int side = 0; side < 2; ++side) {
+        KeyBox w = plan_windows(b.keys, 1ull << 30)[0];
+        EXPECT_TRUE(rays_stay_inside(*batch, 0, batch->ends.size(), BrickLayout(w, true), kRes));
+        (side ? w.hi[axis] : w.lo[axis]) += side ? -1 : 1;  // one key less of margin on one face
+        EXPECT_FALSE(rays_stay_inside(*batch, 0, batch->ends.size(), BrickLayout(w, true), kRes))
+            << "axis " << axis << " side " << side << " box known " << batch->keys_hold_ends;
+      }
     }
   }
 }
