@@ -38,6 +38,21 @@ void apply_to_block(const octomap::OcTree& tree, octomap::OcTreeNode& leaf, floa
     for (const SortedVoxel v : block) log_leaf_change(*changes, sorted_voxel_code(v), just_created, before, leaf.getLogOdds());
 }
 
+// Whether two voxels' leaves have one parent (their codes differ in the last 3 bits at most).
+inline bool same_leaf_parent(SortedVoxel a, SortedVoxel b) { return (a >> 4) == (b >> 4); }
+
+// A finest leaf takes a voxel's update, as updateNode's search-then-update does: an existing
+// leaf at the clamping bound stays; a leaf just made (value 0) always takes it. Returns whether
+// the leaf was applied (its parent must then be settled).
+inline bool apply_to_leaf(const octomap::OcTree& tree, octomap::OcTreeNode& leaf, bool just_created, SortedVoxel v,
+                          float update, std::vector<LeafChange>* changes) {
+  if (!just_created && at_clamping_bound(tree, leaf, update)) return false;
+  const float before = leaf.getLogOdds();  // a created leaf's 0, or an expanded node's value
+  update_leaf_log_odds(tree, leaf, update);
+  if (changes) log_leaf_change(*changes, sorted_voxel_code(v), just_created, before, leaf.getLogOdds());
+  return true;
+}
+
 }  // namespace
 
 bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, const SubtreeRoot& root,
@@ -62,7 +77,7 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
   };
 
   for (size_t i = 0; i < voxels.size(); ++i) {
-    const SortedVoxel v = voxels[i];
+    SortedVoxel v = voxels[i];
     if (i > 0) leave_down_to(std::min(depth, shared_path_depth(voxels[i - 1], v)));
     const float update = sorted_voxel_occupied(v) ? hit : miss;
 
@@ -117,6 +132,20 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
             break;
           }
         }
+      }
+      if (depth + 1 == kTreeDepth) {
+        // The parent of leaves: this voxel's leaf and those of the voxels after it below the
+        // same parent, without going through the path (most voxels have a sibling next).
+        bool changed = apply_to_leaf(tree, *child, created, v, update, changes);
+        while (i + 1 < voxels.size() && same_leaf_parent(voxels[i + 1], v)) {
+          v = voxels[++i];
+          const unsigned leaf_pos = child_index_at(v, depth);
+          created = !node_ops.nodeChildExists(p.node, leaf_pos);  // p has its children array now
+          child = created ? node_ops.createNodeChild(p.node, leaf_pos) : node_ops.getNodeChild(p.node, leaf_pos);
+          changed |= apply_to_leaf(tree, *child, created, v, sorted_voxel_occupied(v) ? hit : miss, changes);
+        }
+        if (changed) p.changed = true;
+        break;
       }
       path[++depth] = PathNode{child, created, false};
     }

@@ -84,7 +84,8 @@ inline void settle_inner_node(octomap::OcTree& node_ops, octomap::OcTreeNode* no
     const float l = child->getLogOdds();
     if (l > max) max = l;
     if (i == 0) first = l;
-    if (node_ops.nodeHasChildren(child) || !(l == first)) collapsible = false;
+    // Once a child decides against the prune, only the max is left to find.
+    if (collapsible && (!(l == first) || node_ops.nodeHasChildren(child))) collapsible = false;
   }
   if (collapsible && node_ops.pruneNode(node)) return;
   node->setLogOdds(max);
