@@ -265,34 +265,54 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
   std::sort(scratch.nonempty.begin(), scratch.nonempty.end());
   out.begin.reserve(scratch.nonempty.size() + 1);
   scratch.cell_begin.resize(cells);
+  scratch.cell_code.resize(cells);
   size_t offset = 0;
   for (const auto& [code, c] : scratch.nonempty) {
     out.begin.push_back(offset);
     scratch.cell_begin[c] = static_cast<uint32_t>(offset);
+    scratch.cell_code[c] = SortedVoxel{code} << (3 * shift + 1);
     offset += scratch.totals[c];
   }
   out.begin.push_back(n);
 
-  // Pass 3: scatter.
+  // Pass 3: scatter. A voxel's code is its cell's node code (kept beside the cell's position,
+  // like it changed only between runs) and the Morton code of its key's low `shift` bits: one
+  // table lookup per axis where shift <= 8, not two.
   SortedVoxel* dst = out.voxels.data();
-  for_each_chunk(pool, chunks, [&, cell_of, dst](size_t k) {
+  const SortedVoxel* const cell_code = scratch.cell_code.data();
+  const uint16_t low = static_cast<uint16_t>((1u << shift) - 1);
+  auto scatter = [&, cell_of, dst, cell_code, low](size_t k, auto low_code) {
     uint32_t* next = &scratch.counts[k * cells];
     const VoxelUpdate* u = updates.data();
     if (chunk_begin(k) == chunk_begin(k + 1)) return;
     const uint32_t* cell_begin = scratch.cell_begin.data();
     for (size_t c = 0; c < cells; ++c) next[c] += cell_begin[c];  // only nonempty cells are read
     uint32_t cell = cell_of(u[chunk_begin(k)]), pos = next[cell];
+    SortedVoxel code = cell_code[cell];
     for (size_t i = chunk_begin(k), e = chunk_begin(k + 1); i < e; ++i) {
       const uint32_t c = cell_of(u[i]);
       if (c != cell) {
         next[cell] = pos;
         cell = c;
         pos = next[c];
+        code = cell_code[c];
       }
-      dst[pos++] = make_sorted_voxel(u[i]);
+      dst[pos++] = code | (low_code(u[i].x & low, u[i].y & low, u[i].z & low) << 1) | (u[i].occupied() ? 1u : 0u);
     }
     next[cell] = pos;
-  });
+  };
+  if (shift <= 8) {
+    for_each_chunk(pool, chunks, [&](size_t k) {
+      scatter(k, [](unsigned x, unsigned y, unsigned z) {
+        const auto& spread = detail::kSpreadByte;
+        return uint64_t{spread[x]} | (uint64_t{spread[y]} << 1) | (uint64_t{spread[z]} << 2);
+      });
+    });
+  } else {
+    for_each_chunk(pool, chunks, [&](size_t k) {
+      scatter(k, [](uint16_t x, uint16_t y, uint16_t z) { return morton_code(x, y, z); });
+    });
+  }
 }
 
 void sort_bucket(std::span<SortedVoxel> bucket, std::vector<SortedVoxel>& tmp) {

@@ -75,6 +75,7 @@ struct BucketScratch {
   std::vector<uint32_t> counts;    // [chunk][cell]: voxels, then the chunks' offsets
   std::vector<uint32_t> totals;    // [cell]: voxels
   std::vector<uint32_t> cell_begin;  // [cell]: first index of its bucket (nonempty cells)
+  std::vector<SortedVoxel> cell_code;  // [cell]: its node's code bits of every voxel in it (nonempty cells)
   std::vector<uint32_t> cell_of_axis[3];
   std::vector<std::pair<uint64_t, uint32_t>> nonempty;  // (node code, cell)
 };
