@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <array>
 
+#include "octree/node_access.h"
+#include "octree/node_count.h"
+
 namespace ort {
 namespace {
 
@@ -60,6 +63,7 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
   const float hit = tree.getProbHitLog();
   const float miss = tree.getProbMissLog();
 
+  int64_t made = 0;  // nodes made by make_child_node, counted into node_ops at the end
   std::array<PathNode, kTreeDepth + 1> path;
   path[root.depth] = PathNode{root.node, root.just_created, false};
   unsigned depth = root.depth;  // depth of the deepest node on the path
@@ -119,7 +123,8 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
         node_ops.expandNode(p.node);
         child = node_ops.getNodeChild(p.node, pos);
       } else {
-        child = node_ops.createNodeChild(p.node, pos);
+        child = make_child_node(*p.node, pos);
+        ++made;
         created = true;
         // A new node whose every voxel this list updates, all the same way: OctoMap's loop
         // creates its leaves, each 0 + update, and prunes them level by level back into this
@@ -141,7 +146,8 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
           v = voxels[++i];
           const unsigned leaf_pos = child_index_at(v, depth);
           created = !node_ops.nodeChildExists(p.node, leaf_pos);  // p has its children array now
-          child = created ? node_ops.createNodeChild(p.node, leaf_pos) : node_ops.getNodeChild(p.node, leaf_pos);
+          child = created ? make_child_node(*p.node, leaf_pos) : node_ops.getNodeChild(p.node, leaf_pos);
+          made += created;
           changed |= apply_to_leaf(tree, *child, created, v, sorted_voxel_occupied(v) ? hit : miss, changes);
         }
         if (changed) p.changed = true;
@@ -151,6 +157,7 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
     }
   }
   leave_down_to(root.depth);
+  if (made != 0) add_to_node_count(node_ops, made);
 
   // The root of the subtree is settled here too; its ancestors are the caller's.
   PathNode& top = path[root.depth];

@@ -32,7 +32,8 @@ struct SubtreeRoot {
 // i.e. whether root's ancestors must be settled too.
 //
 // Values and the sensor model come from `tree` (updateNodeLogOdds, read only). Nodes are
-// created, expanded and pruned through `node_ops`, which is `tree` itself or, when several
+// expanded and pruned through `node_ops`, and created as createNodeChild does (node_access.h)
+// and counted into it, `node_ops` being `tree` itself or, when several
 // threads update one tree, the thread's own OcTree that only counts the nodes (OctoMap's node
 // counter is a plain size_t; see node_count.h).
 //
