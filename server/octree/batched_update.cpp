@@ -80,6 +80,7 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
 
   std::atomic<size_t> next{0};
   std::vector<double> sort_ms(workers, 0.0);
+  const unsigned node_bits = 3 * (kTreeDepth - buckets_.depth);  // a bucket's voxels lie below one node at depth D
   auto work = [&](unsigned worker) {
     octomap::OcTree& node_ops = *counting_trees_[worker];
     for (size_t k; (k = next.fetch_add(1, std::memory_order_relaxed)) < order.size();) {
@@ -87,10 +88,10 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
       const std::span<SortedVoxel> voxels = buckets_.bucket(s.bucket);
       if (stats) {
         const auto ts = Clock::now();
-        sort_bucket(voxels, sort_tmp_[worker]);
+        sort_bucket(voxels, sort_tmp_[worker], node_bits);
         sort_ms[worker] += ms_between(ts, Clock::now());
       } else {
-        sort_bucket(voxels, sort_tmp_[worker]);
+        sort_bucket(voxels, sort_tmp_[worker], node_bits);
       }
       const bool changed =
           update_subtree(tree, node_ops, s.root, voxels, changes ? &changes->lane(worker) : nullptr);

@@ -315,13 +315,15 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
   }
 }
 
-void sort_bucket(std::span<SortedVoxel> bucket, std::vector<SortedVoxel>& tmp) {
+void sort_bucket(std::span<SortedVoxel> bucket, std::vector<SortedVoxel>& tmp, unsigned node_bits) {
   const size_t n = bucket.size();
   SortedVoxel* data = bucket.data();
   if (n <= kInsertionMax) {
     insertion_sort(data, n);
     return;
   }
+  // The usual bucket: a node of at most 4096 keys, each once (a repeated key goes on below).
+  if (node_bits <= kDirectMaxBits && direct_sort(data, n, node_bits, tmp)) return;
   uint64_t varying = 0;
   for (size_t i = 0; i < n; ++i) varying |= data[i] ^ data[0];
   varying >>= 1;  // the code's bits

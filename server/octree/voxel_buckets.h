@@ -87,7 +87,9 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
                    VoxelBuckets& out, BucketScratch& scratch);
 
 // Sorts one bucket into Morton order (stable: a repeated key keeps the list's order of its
-// updates). `tmp` is reused storage.
-void sort_bucket(std::span<SortedVoxel> bucket, std::vector<SortedVoxel>& tmp);
+// updates). `tmp` is reused storage. `node_bits`: the low code bits the bucket's voxels can
+// differ in (3 * (16 - VoxelBuckets::depth) for a bucket of bucket_voxels); where it is small,
+// the sort skips the pass that finds the bits that do differ.
+void sort_bucket(std::span<SortedVoxel> bucket, std::vector<SortedVoxel>& tmp, unsigned node_bits = 64);
 
 }  // namespace ort

@@ -45,7 +45,7 @@ std::vector<SortedVoxel> check_and_sort(VoxelBuckets& b, size_t n, const BucketO
     if (k > 0) {
       EXPECT_LT(b.bucket(k - 1).front() >> shift, node) << "buckets out of Morton order";
     }
-    sort_bucket(bucket, tmp);
+    sort_bucket(bucket, tmp, 3 * (kTreeDepth - b.depth));  // as the batched update sorts them
     all.insert(all.end(), bucket.begin(), bucket.end());
   }
   return all;
@@ -125,8 +125,11 @@ TEST(VoxelBuckets, SortBucketIsTheStableMortonSort) {
         }
         std::vector<SortedVoxel> expected = bucket;
         std::stable_sort(expected.begin(), expected.end(), [](SortedVoxel a, SortedVoxel b) { return (a >> 1) < (b >> 1); });
+        std::vector<SortedVoxel> told = bucket;  // sorted knowing its node's size, as bucket_voxels' buckets are
         sort_bucket(bucket, tmp);
         ASSERT_EQ(bucket, expected) << "side " << side << ", " << n << " voxels, repeat " << repeat;
+        sort_bucket(told, tmp, 3 * side_bits);
+        ASSERT_EQ(told, expected) << "side " << side << ", " << n << " voxels, repeat " << repeat << ", node bits given";
       }
     }
   }
