@@ -116,11 +116,15 @@ void WorkerPool::thread_main(unsigned worker) {
     seen = generation_.load(std::memory_order_acquire);
     if (stopping_.load(std::memory_order_relaxed)) return;
     // A run() job waits for every thread, so a thread behind by a job can only be behind a
-    // run_shared() one: its state then carries another generation, or is closed.
-    if (job_state_.load(std::memory_order_acquire) >> 32 == seen) {
+    // run_shared() one: its state then carries this generation, closed, or a later one (the
+    // caller has already started the next shared job: this one is over, and its body must not
+    // be run as a run() job's). Only a state older than `seen` means a run() job.
+    const uint32_t state_generation = static_cast<uint32_t>(job_state_.load(std::memory_order_acquire) >> 32);
+    if (state_generation == seen) {
       join_shared(worker, seen);
       continue;
     }
+    if (static_cast<int32_t>(state_generation - seen) > 0) continue;  // modulo 2^32, as generations count
     run_body(worker);
     // acq_rel: the caller's acquire of 0 sees this thread's writes (and the error).
     if (running_.fetch_sub(1, std::memory_order_acq_rel) == 1) running_.notify_one();
