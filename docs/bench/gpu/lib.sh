@@ -32,3 +32,7 @@ bench() { local name=$1 bin=$2; shift 2; log "bench-$name"; echo "### $name: $*"
 daemon() { local tag=$1 bin=$2 rep=$3 graph=$4; log "daemon-$tag"
   OCTOMAP_RT_BUILD_DIR=$bin/bin timeout 60 "$bin/server-bench" --graph "$graph" --repeat "$rep" --rounds 1 \
     --modes on --rate 100 -- -r 0.1 --backend vulkan > "$O/daemon-$tag.txt" 2>&1; }
+# loaded NAME BUNDLE ARGS...: bench beside 4 busy shell loops (a synthetic slow machine: 15 octree workers,
+# stage 1 and the loops share 16 cores), started before the process and killed by pid after it.
+loaded() { local pids=(); for _ in 1 2 3 4; do (while :; do :; done) & pids+=($!); done
+  bench "$@"; kill "${pids[@]}"; }
