@@ -1,9 +1,11 @@
-// The two clocks the code reads: steady time for durations (stage times, timeouts) and the
-// wall clock for LCM utimes. One spelling of each, so a stage time is always the same unit.
+// The clocks the code reads: steady time for durations (stage times, timeouts), the wall
+// clock for LCM utimes, and a thread's CPU time (what a helper thread got of a core). One
+// spelling of each, so a stage time is always the same unit.
 #pragma once
 
 #include <chrono>
 #include <cstdint>
+#include <ctime>
 
 namespace ort {
 
@@ -26,6 +28,13 @@ inline double seconds_since(SteadyClock::time_point t) {
 inline int64_t now_utime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
+}
+
+// CPU time the calling thread has run, in nanoseconds (0 where the clock is refused).
+inline int64_t thread_cpu_ns() {
+  timespec ts{};
+  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0;
+  return int64_t(ts.tv_sec) * 1000000000 + ts.tv_nsec;
 }
 
 }  // namespace ort

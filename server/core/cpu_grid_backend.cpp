@@ -10,7 +10,6 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
-#include <ctime>
 #include <limits>
 #include <new>
 #include <thread>
@@ -98,13 +97,6 @@ struct WindowStepper {
 // Nice 19 for the calling thread only (Linux: a thread's nice value is its own). Best effort:
 // a refusal leaves the thread as it was.
 void lower_own_priority() { (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19); }
-
-// CPU time the calling thread has run, in nanoseconds (0 where the clock is refused).
-int64_t thread_cpu_ns() {
-  timespec ts{};
-  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0;
-  return int64_t(ts.tv_sec) * 1000000000 + ts.tv_nsec;
-}
 
 class CpuGridBackend final : public RayBackend {
  public:

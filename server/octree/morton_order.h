@@ -37,6 +37,12 @@ inline uint64_t spread_bits(uint16_t v) {
 inline uint64_t morton_code(uint16_t x, uint16_t y, uint16_t z) {
   return detail::spread_bits(x) | (detail::spread_bits(y) << 1) | (detail::spread_bits(z) << 2);
 }
+// The same for coordinates below 256 (a key's low bits inside a node of at most 256 keys a
+// side): one table lookup per axis.
+inline uint64_t morton_code_low_byte(uint8_t x, uint8_t y, uint8_t z) {
+  const auto& spread = detail::kSpreadByte;
+  return uint64_t{spread[x]} | (uint64_t{spread[y]} << 1) | (uint64_t{spread[z]} << 2);
+}
 // The key back from a Morton code.
 void morton_decode(uint64_t code, uint16_t& x, uint16_t& y, uint16_t& z);
 

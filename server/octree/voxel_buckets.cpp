@@ -303,9 +303,8 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
   };
   if (shift <= 8) {
     for_each_chunk(pool, chunks, [&](size_t k) {
-      scatter(k, [](unsigned x, unsigned y, unsigned z) {
-        const auto& spread = detail::kSpreadByte;
-        return uint64_t{spread[x]} | (uint64_t{spread[y]} << 1) | (uint64_t{spread[z]} << 2);
+      scatter(k, [](uint16_t x, uint16_t y, uint16_t z) {
+        return morton_code_low_byte(uint8_t(x), uint8_t(y), uint8_t(z));
       });
     });
   } else {

@@ -71,7 +71,7 @@ void WorkerPool::run_shared(const std::function<void(unsigned)>& body) {
   job_ = &body;
   const uint32_t gen = generation_.load(std::memory_order_relaxed) + 1;
   // The job's state before its generation (release): a thread that sees the generation sees it.
-  job_state_.store(uint64_t{gen} << 32 | kShared, std::memory_order_relaxed);
+  job_state_.store(uint64_t{gen} << 32, std::memory_order_relaxed);
   generation_.store(gen, std::memory_order_release);
   if (!threads_.empty()) generation_.notify_all();
   std::exception_ptr own_error;

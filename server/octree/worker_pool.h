@@ -61,10 +61,9 @@ class WorkerPool {
   void join_shared(unsigned worker, uint32_t gen);
   void run_body(unsigned worker);
 
-  // run_shared's job: generation << 32 | kClosed | kShared | threads inside the job.
+  // run_shared's job: generation << 32 | kClosed | threads inside the job.
   static constexpr uint64_t kClosed = uint64_t{1} << 31;
-  static constexpr uint64_t kShared = uint64_t{1} << 30;
-  static constexpr uint64_t kInside = kShared - 1;
+  static constexpr uint64_t kInside = kClosed - 1;
   std::atomic<uint64_t> job_state_{0};
 
   // Bumped (release) once per job and once to stop: a thread runs each value once.
