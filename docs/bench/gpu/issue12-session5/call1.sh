@@ -4,9 +4,6 @@
 # refactors and docs) on fr079, alternating, idle and beside 4 busy loops (octree2's synthetic slow machine);
 # then new alone on skt-corridor 0.2 and the real sets.
 . docs/bench/gpu/lib.sh lead s4
-loops() { for _ in 1 2 3 4; do (while :; do :; done) & echo $! >> $T/loops; done; }
-unloop() { kill $(cat $T/loops); rm -f $T/loops; }
-loaded() { loops; bench "$@"; unloop; }
 timeout 60 $N/bin/octomap-rt bench $C --preset fr079 --scan-scale 0.1 > $O/throwaway.txt 2>&1
 bench fr079-new-idle-a $N --preset fr079
 bench fr079-old-idle-a $OLD --preset fr079

@@ -4,9 +4,6 @@
 # skt-corridor 0.2, the real sets (--repeat 3), and the daemon goal (skt-corridor 0.2, 3 producers x 100 Hz):
 # two new-space runs (--repeat 5, each a fresh daemon) and one steady (--repeat 20).
 . docs/bench/gpu/lib.sh lead s4
-loops() { for _ in 1 2 3 4; do (while :; do :; done) & echo $! >> $T/loops; done; }
-unloop() { kill $(cat $T/loops); rm -f $T/loops; }
-loaded() { loops; bench "$@"; unloop; }
 timeout 60 $N/bin/octomap-rt bench $C --preset fr079 --scan-scale 0.1 > $O/throwaway.txt 2>&1
 bench fr079-new-a $N --preset fr079
 bench fr079-old-a $OLD --preset fr079

@@ -3,9 +3,6 @@
 # machine), main ce16284 (new) and 202dc47 (old) alternating, three pairs, after one idle pair; every run records
 # the steal time across it (lib.sh). Calls 1 and 2 gave one and two loaded pairs with opposite outcomes.
 . docs/bench/gpu/lib.sh lead s4
-loops() { for _ in 1 2 3 4; do (while :; do :; done) & echo $! >> $T/loops; done; }
-unloop() { kill $(cat $T/loops); rm -f $T/loops; }
-loaded() { loops; bench "$@"; unloop; }
 timeout 60 $N/bin/octomap-rt bench $C --preset fr079 --scan-scale 0.1 > $O/throwaway.txt 2>&1
 bench fr079-new-idle $N --preset fr079
 bench fr079-old-idle $OLD --preset fr079
