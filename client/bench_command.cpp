@@ -168,12 +168,15 @@ void run_engine(const ScanSet& set, const EngineOptions& opts, const BenchArgs& 
     StageTimes st;
     const auto t0 = Clock::now();
     // Stage times are each stage's own sum; with the pipeline they overlap in the total.
-    insert_scans(engine, set.scans.size(), scan_input, *tree, [&](size_t, const ShotScan& shot) {
-      st.add(shot.shoot.times);
-      m.windows += shot.shoot.windows;
-      m.voxel_updates += shot.voxels.size();
-      m.gpu_grid_bytes = std::max<uint64_t>(m.gpu_grid_bytes, shot.shoot.grid_words * 4);
-    }, !a.no_pipeline);
+    insert_scans(
+        engine, set.scans.size(), scan_input, *tree,
+        [&](size_t, const ShotScan& shot) {
+          st.add(shot.shoot.times);
+          m.windows += shot.shoot.windows;
+          m.voxel_updates += shot.voxels.size();
+          m.gpu_grid_bytes = std::max<uint64_t>(m.gpu_grid_bytes, shot.shoot.grid_words * 4);
+        },
+        !a.no_pipeline);
     m.total_ms = ms_since(t0);
     m.prepare_ms = st.prepare_ms;  // transform included
     m.upload_ms = st.upload_ms;
@@ -189,7 +192,8 @@ void run_engine(const ScanSet& set, const EngineOptions& opts, const BenchArgs& 
   r.occupied_voxels = s.finest_occupied;
   r.free_diff_pct = diff_pct(s.finest_free, ref.summary.finest_free);
   r.occupied_diff_pct = diff_pct(s.finest_occupied, ref.summary.finest_occupied);
-  r.counts_equal = (s.finest_free == ref.summary.finest_free && s.finest_occupied == ref.summary.finest_occupied) ? "yes" : "no";
+  r.counts_equal =
+      (s.finest_free == ref.summary.finest_free && s.finest_occupied == ref.summary.finest_occupied) ? "yes" : "no";
   r.map_identical = same_leaves(*tree, *ref.tree) ? "yes" : "no";
   r.tree_bytes = tree->memoryUsage();
   r.rss_bytes = current_rss_bytes();
@@ -208,11 +212,14 @@ std::vector<std::pair<std::string, std::string>> datasets(const BenchArgs& a) {
   if (!a.data_dir.empty()) {
     for (const char* rel : {"3dtk_dat/3dtk_3scans.graph", "octomap_share/scan_dat.graph"}) {
       const std::string path = a.data_dir + "/" + rel;
-      if (std::filesystem::exists(path)) d.push_back({std::filesystem::path(rel).filename().string(), path});
-      else std::cerr << "octomap-rt bench: " << path << " not found, skipped\n";
+      if (std::filesystem::exists(path))
+        d.push_back({std::filesystem::path(rel).filename().string(), path});
+      else
+        std::cerr << "octomap-rt bench: " << path << " not found, skipped\n";
     }
     const bool listed = std::find(a.presets.begin(), a.presets.end(), "fr079-real") != a.presets.end();
-    if (!listed && std::filesystem::exists(a.data_dir + "/octomap_share/geb079.bt")) d.push_back({"fr079-real", "preset"});
+    if (!listed && std::filesystem::exists(a.data_dir + "/octomap_share/geb079.bt"))
+      d.push_back({"fr079-real", "preset"});
   }
   return d;
 }
@@ -269,8 +276,9 @@ int run_bench(const BenchArgs& a) {
       rows.push_back(r);
       continue;
     }
-    std::fprintf(stderr, "octomap-rt bench: %s: %zu scans, %zu points (%.1f s to %s)\n", name.c_str(), set->scans.size(),
-                 set->total_points(), ms_since(tg) / 1000.0, source == "preset" ? "generate" : "load");
+    std::fprintf(stderr, "octomap-rt bench: %s: %zu scans, %zu points (%.1f s to %s)\n", name.c_str(),
+                 set->scans.size(), set->total_points(), ms_since(tg) / 1000.0,
+                 source == "preset" ? "generate" : "load");
     for (double res : a.resolutions) {
       BenchRow base;
       base.dataset = name;
@@ -329,7 +337,8 @@ int run_bench(const BenchArgs& a) {
   if (a.markdown.empty()) bench::write_markdown(rows, std::cout);
   int mismatches = 0;
   for (const BenchRow& r : rows)
-    if (r.status == "ok" && r.backend != "octomap" && r.traversal == "octomap" && r.map_identical != "yes") ++mismatches;
+    if (r.status == "ok" && r.backend != "octomap" && r.traversal == "octomap" && r.map_identical != "yes")
+      ++mismatches;
   if (mismatches) {
     std::fprintf(stderr, "octomap-rt bench: %d octomap-mode run(s) did NOT reproduce OctoMap's map\n", mismatches);
     return 3;
@@ -366,7 +375,8 @@ void register_bench_command(CLI::App& app) {
       ->delimiter(',')
       ->check(CLI::IsMember({"sequential", "batched"}))
       ->capture_default_str();
-  cmd->add_option("--threads", a->threads, "threads of the CPU stages (0: all hardware threads)")->capture_default_str();
+  cmd->add_option("--threads", a->threads, "threads of the CPU stages (0: all hardware threads)")
+      ->capture_default_str();
   cmd->add_option("--max-range", a->max_range, "cut rays longer than this [m]; < 0: no limit")->capture_default_str();
   cmd->add_option("--device", a->device, "Vulkan device: name substring or index");
   cmd->add_option("--warmup", a->warmup, "scans inserted into a throw-away map before timing")->capture_default_str();

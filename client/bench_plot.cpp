@@ -102,8 +102,8 @@ bool plot_stage_charts(const std::vector<BenchRow>& rows, const std::string& dir
       const int lo = 3 + 2 * k, hi = lo + 1;
       // the bottom stage starts at the axis (log scale has no zero)
       s << (k ? ", \\\n    " : " ") << "'" << base << ".dat' using 1:(column(" << hi << ")):($1-0.4):($1+0.4):"
-        << "(bottom(column(" << lo << "))):(column(" << hi << "))" << (k == 0 ? ":xtic(2)" : "") << " with boxxyerror title '" << kStages[k] << "' lc rgb '"
-        << kColours[k] << "'";
+        << "(bottom(column(" << lo << "))):(column(" << hi << "))" << (k == 0 ? ":xtic(2)" : "")
+        << " with boxxyerror title '" << kStages[k] << "' lc rgb '" << kColours[k] << "'";
     }
     s << "\n";
     s.close();

@@ -42,9 +42,12 @@ std::vector<std::string> split_csv_line(const std::string& line) {
   for (size_t i = 0; i < line.size(); ++i) {
     const char c = line[i];
     if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') out.back() += '"', ++i;
-      else if (c == '"') quoted = false;
-      else out.back() += c;
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"')
+        out.back() += '"', ++i;
+      else if (c == '"')
+        quoted = false;
+      else
+        out.back() += c;
     } else if (c == '"') {
       quoted = true;
     } else if (c == ',') {
@@ -56,30 +59,58 @@ std::vector<std::string> split_csv_line(const std::string& line) {
   return out;
 }
 
-#define ORT_TEXT(field) \
-  Column { #field, [](const BenchRow& r) { return quote(r.field); }, [](BenchRow& r, const std::string& v) { r.field = v; } }
-#define ORT_REAL(field) \
-  Column { #field, [](const BenchRow& r) { return num(r.field); }, [](BenchRow& r, const std::string& v) { r.field = std::stod(v); } }
-#define ORT_UINT(field)                                                                       \
-  Column {                                                                                     \
-    #field, [](const BenchRow& r) { return std::to_string(r.field); },                         \
+#define ORT_TEXT(field)                                                                                               \
+  Column {                                                                                                            \
+#field, [](const BenchRow& r) { return quote(r.field); }, [](BenchRow & r, const std::string& v) { r.field = v; } \
+  }
+#define ORT_REAL(field)                                                                                          \
+  Column {                                                                                                       \
+#field, [](const BenchRow& r) { return num(r.field); }, [](BenchRow & r,                                     \
+                                                               const std::string& v) { r.field = std::stod(v); } \
+  }
+#define ORT_UINT(field)                                                                      \
+  Column {                                                                                   \
+#field, [](const BenchRow& r) { return std::to_string(r.field); },                         \
         [](BenchRow& r, const std::string& v) { r.field = static_cast<decltype(r.field)>(std::stoull(v)); } \
   }
 
 const std::vector<Column>& columns() {
   static const std::vector<Column> cols = {
-      ORT_TEXT(dataset),         ORT_UINT(scans),          ORT_UINT(points),
-      ORT_REAL(resolution),      ORT_REAL(max_range),      ORT_TEXT(backend),
-      ORT_TEXT(device),          ORT_TEXT(traversal),      ORT_TEXT(octree),
-      ORT_TEXT(status),          ORT_REAL(prepare_ms),     ORT_REAL(upload_ms),
-      ORT_REAL(shoot_ms),        ORT_REAL(compact_ms),     ORT_REAL(octree_ms),
-      ORT_REAL(total_ms),        ORT_REAL(octomap_total_ms), ORT_REAL(speedup),
-      ORT_REAL(points_per_s),    ORT_UINT(free_voxels),    ORT_UINT(occupied_voxels),
-      ORT_UINT(octomap_free),    ORT_UINT(octomap_occupied), ORT_REAL(free_diff_pct),
-      ORT_REAL(occupied_diff_pct), ORT_TEXT(counts_equal), ORT_TEXT(map_identical),
-      ORT_UINT(tree_bytes),      ORT_UINT(rss_bytes),      ORT_UINT(peak_rss_bytes),
-      ORT_UINT(gpu_grid_bytes),  ORT_UINT(windows),        ORT_UINT(voxel_updates),
-      ORT_UINT(warmup_scans),    ORT_UINT(repeats),
+      ORT_TEXT(dataset),
+      ORT_UINT(scans),
+      ORT_UINT(points),
+      ORT_REAL(resolution),
+      ORT_REAL(max_range),
+      ORT_TEXT(backend),
+      ORT_TEXT(device),
+      ORT_TEXT(traversal),
+      ORT_TEXT(octree),
+      ORT_TEXT(status),
+      ORT_REAL(prepare_ms),
+      ORT_REAL(upload_ms),
+      ORT_REAL(shoot_ms),
+      ORT_REAL(compact_ms),
+      ORT_REAL(octree_ms),
+      ORT_REAL(total_ms),
+      ORT_REAL(octomap_total_ms),
+      ORT_REAL(speedup),
+      ORT_REAL(points_per_s),
+      ORT_UINT(free_voxels),
+      ORT_UINT(occupied_voxels),
+      ORT_UINT(octomap_free),
+      ORT_UINT(octomap_occupied),
+      ORT_REAL(free_diff_pct),
+      ORT_REAL(occupied_diff_pct),
+      ORT_TEXT(counts_equal),
+      ORT_TEXT(map_identical),
+      ORT_UINT(tree_bytes),
+      ORT_UINT(rss_bytes),
+      ORT_UINT(peak_rss_bytes),
+      ORT_UINT(gpu_grid_bytes),
+      ORT_UINT(windows),
+      ORT_UINT(voxel_updates),
+      ORT_UINT(warmup_scans),
+      ORT_UINT(repeats),
   };
   return cols;
 }
@@ -155,8 +186,8 @@ std::vector<BenchRow> read_csv(const std::string& path) {
     if (line.empty()) continue;
     const std::vector<std::string> f = split_csv_line(line);
     if (f.size() != header.size())
-      throw std::runtime_error(path + ":" + std::to_string(n) + ": " + std::to_string(f.size()) + " fields, header has " +
-                               std::to_string(header.size()));
+      throw std::runtime_error(path + ":" + std::to_string(n) + ": " + std::to_string(f.size()) +
+                               " fields, header has " + std::to_string(header.size()));
     BenchRow r;
     for (size_t i = 0; i < f.size(); ++i) {
       if (!by_position[i]) continue;
@@ -199,11 +230,16 @@ void write_markdown(const std::vector<BenchRow>& rows, std::ostream& out) {
       const BenchRow* hit = nullptr;
       for (const BenchRow* r : grp)
         if (r->backend != "octomap" && r->traversal == "octomap" && label(*r) == m) hit = r;
-      if (!hit) out << " - |";
-      else if (hit->status != "ok") out << " n/a |";
+      if (!hit)
+        out << " - |";
+      else if (hit->status != "ok")
+        out << " n/a |";
       else
         out << " " << fixed(hit->total_ms / 1000.0, 2) << " (**" << fixed(hit->speedup, 1) << "x**"
-            << (hit->map_identical == "yes" ? ", =" : hit->counts_equal == "yes" ? ", counts =" : ", DIFFERENT") << ") |";
+            << (hit->map_identical == "yes"  ? ", ="
+                : hit->counts_equal == "yes" ? ", counts ="
+                                             : ", DIFFERENT")
+            << ") |";
     }
     out << "\n";
   }
@@ -241,9 +277,10 @@ void write_markdown(const std::vector<BenchRow>& rows, std::ostream& out) {
   for (const auto& grp : g)
     for (const BenchRow* r : grp) {
       if (r->status != "ok" || (r->backend != "octomap" && r->traversal != "octomap")) continue;
-      out << "| " << r->dataset << " | " << num(r->resolution) << " | " << label(*r) << " | " << fixed(mib(r->tree_bytes), 1)
-          << " | " << fixed(mib(r->rss_bytes), 0) << " | " << fixed(mib(r->peak_rss_bytes), 0) << " | "
-          << fixed(mib(r->gpu_grid_bytes), 1) << " | " << r->windows << " |\n";
+      out << "| " << r->dataset << " | " << num(r->resolution) << " | " << label(*r) << " | "
+          << fixed(mib(r->tree_bytes), 1) << " | " << fixed(mib(r->rss_bytes), 0) << " | "
+          << fixed(mib(r->peak_rss_bytes), 0) << " | " << fixed(mib(r->gpu_grid_bytes), 1) << " | " << r->windows
+          << " |\n";
     }
   bool any_failed = false;
   for (const BenchRow& r : rows) any_failed = any_failed || r.status != "ok";

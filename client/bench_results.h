@@ -21,20 +21,20 @@ struct BenchRow {
   // into the map frame, shoot = computeUpdate (ray keys + KeySets, timed in a separate pass),
   // octree = insertPointCloud minus that.
   double prepare_ms = 0, upload_ms = 0, shoot_ms = 0, compact_ms = 0, octree_ms = 0;
-  double total_ms = 0;           // wall clock of the whole run, transform included
-  double octomap_total_ms = 0;   // OctoMap's total in the same process, same data
-  double speedup = 0;            // octomap_total_ms / total_ms
+  double total_ms = 0;          // wall clock of the whole run, transform included
+  double octomap_total_ms = 0;  // OctoMap's total in the same process, same data
+  double speedup = 0;           // octomap_total_ms / total_ms
   double points_per_s = 0;
   // Leaf counts at the finest level (paper Fig. 10), ours and OctoMap's.
   uint64_t free_voxels = 0, occupied_voxels = 0, octomap_free = 0, octomap_occupied = 0;
   double free_diff_pct = 0, occupied_diff_pct = 0;
-  std::string counts_equal;      // "yes" / "no" (finest-level free and occupied counts)
-  std::string map_identical;     // "yes" / "no": same leaves, depths and log-odds as OctoMap's tree
+  std::string counts_equal;   // "yes" / "no" (finest-level free and occupied counts)
+  std::string map_identical;  // "yes" / "no": same leaves, depths and log-odds as OctoMap's tree
   // Memory.
-  uint64_t tree_bytes = 0;       // OcTree::memoryUsage()
-  uint64_t rss_bytes = 0;        // process resident set after the run (tree alive)
-  uint64_t peak_rss_bytes = 0;   // process peak so far (monotonic over the whole bench)
-  uint64_t gpu_grid_bytes = 0;   // the shared ray space: ShootStats::grid_words * 4
+  uint64_t tree_bytes = 0;      // OcTree::memoryUsage()
+  uint64_t rss_bytes = 0;       // process resident set after the run (tree alive)
+  uint64_t peak_rss_bytes = 0;  // process peak so far (monotonic over the whole bench)
+  uint64_t gpu_grid_bytes = 0;  // the shared ray space: ShootStats::grid_words * 4
   uint64_t windows = 0, voxel_updates = 0;
   int warmup_scans = 0, repeats = 1;
 };

@@ -1,7 +1,7 @@
 // `octomap-rt build INPUT -r RES -o OUT.bt|OUT.ot`: builds a map from a ScanGraph file or
 // the built-in synthetic scene, with progress, stage times and leaf counts.
-#include <chrono>
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -32,7 +32,8 @@ struct BuildArgs {
 void write_map(const octomap::OcTree& tree, const std::string& path) {
   const bool bt = path.size() > 3 && path.compare(path.size() - 3, 3, ".bt") == 0;
   const bool ot = path.size() > 3 && path.compare(path.size() - 3, 3, ".ot") == 0;
-  if (!bt && !ot) throw std::runtime_error("output must end in .bt (OctoMap binary) or .ot (full, with log-odds): " + path);
+  if (!bt && !ot)
+    throw std::runtime_error("output must end in .bt (OctoMap binary) or .ot (full, with log-odds): " + path);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw std::runtime_error("cannot create " + path + ": " + std::strerror(errno));
   const bool written = bt ? tree.writeBinaryConst(out) : tree.write(out);
@@ -51,15 +52,14 @@ int run_build(const BuildArgs& a) {
   opts.stage1_helpers_yield = true;
   const auto t_load = std::chrono::steady_clock::now();
   const ScanSet set = a.input == "synthetic" ? make_synthetic_rooms() : load_scan_graph(a.input);
-  const double load_ms =
-      ms_since(t_load);
+  const double load_ms = ms_since(t_load);
 
   MapEngine engine(opts, log_to(std::cerr));
   std::cerr << "octomap-rt build: " << set.scans.size() << " scans, " << set.total_points() << " points from "
             << set.name << " (" << load_ms << " ms)\n"
             << "  back end " << to_string(engine.backend().kind()) << " on " << engine.backend().device_name()
-            << ", traversal " << to_string(opts.traversal) << ", resolution " << opts.resolution
-            << " m, max range " << opts.max_range << ", octree threads " << engine.octree_threads() << "\n";
+            << ", traversal " << to_string(opts.traversal) << ", resolution " << opts.resolution << " m, max range "
+            << opts.max_range << ", octree threads " << engine.octree_threads() << "\n";
 
   auto tree = engine.make_tree();
   StageTimes total;
@@ -76,8 +76,8 @@ int run_build(const BuildArgs& a) {
   const auto account = [&](size_t i, const ShotScan& shot) {
     if (!shot.prepare.origin_ok || shot.refusal != ShotRefusal::kNone) {
       ++rejected;
-      std::cerr << "  scan " << i << " rejected: "
-                << (shot.prepare.origin_ok ? shot.refusal_detail : shot.prepare.error) << "\n";
+      std::cerr << "  scan " << i
+                << " rejected: " << (shot.prepare.origin_ok ? shot.refusal_detail : shot.prepare.error) << "\n";
       return;
     }
     total.add(shot.shoot.times);
@@ -90,15 +90,16 @@ int run_build(const BuildArgs& a) {
     windows += shot.shoot.windows;
     if (!a.quiet) {
       const StageTimes& t = shot.shoot.times;
-      std::fprintf(stderr, "  [%zu/%zu] %zu points, %zu voxels (%llu occupied), %.1f ms (stage 1 %.1f, of which "
-                   "compact+readback %.1f; octree %.1f)\n", i + 1, set.scans.size(), set.scans[i].points.size(),
-                   shot.voxels.size(), (unsigned long long)shot.occupied_voxels, t.total_ms(), t.total_ms() - t.octree_ms,
-                   t.compact_ms, t.octree_ms);
+      std::fprintf(stderr,
+                   "  [%zu/%zu] %zu points, %zu voxels (%llu occupied), %.1f ms (stage 1 %.1f, of which "
+                   "compact+readback %.1f; octree %.1f)\n",
+                   i + 1, set.scans.size(), set.scans[i].points.size(), shot.voxels.size(),
+                   (unsigned long long)shot.occupied_voxels, t.total_ms(), t.total_ms() - t.octree_ms, t.compact_ms,
+                   t.octree_ms);
     }
   };
   insert_scans(engine, set.scans.size(), scan_input, *tree, account, !a.no_pipeline);
-  const double wall_ms =
-      ms_since(t0);
+  const double wall_ms = ms_since(t0);
   write_map(*tree, a.output);
 
   const MapSummary s = summarize(*tree);
@@ -119,13 +120,16 @@ int run_build(const BuildArgs& a) {
                  "is empty; is the resolution right?\n",
                  32768 * opts.resolution, opts.resolution);
   else if (prep_total.out_of_range)
-    std::fprintf(stderr, "octomap-rt build: warning: %llu points lie outside the map's key range (+-%.1f m) and were skipped\n",
+    std::fprintf(stderr,
+                 "octomap-rt build: warning: %llu points lie outside the map's key range (+-%.1f m) and were skipped\n",
                  (unsigned long long)prep_total.out_of_range, 32768 * opts.resolution);
-  std::printf("  stage times:     prepare %.1f ms, upload %.1f ms, shoot %.1f ms, compact+readback %.1f ms, octree %.1f ms\n",
-              total.prepare_ms, total.upload_ms, total.shoot_ms, total.compact_ms, total.octree_ms);
+  std::printf(
+      "  stage times:     prepare %.1f ms, upload %.1f ms, shoot %.1f ms, compact+readback %.1f ms, octree %.1f ms\n",
+      total.prepare_ms, total.upload_ms, total.shoot_ms, total.compact_ms, total.octree_ms);
   if (total.compact_gpu_ms + total.readback_copy_ms + total.unpack_ms > 0)
-    std::printf("  compact+readback: GPU compaction %.1f ms, copy to host memory %.1f ms, into the voxel list %.1f ms\n",
-                total.compact_gpu_ms, total.readback_copy_ms, total.unpack_ms);
+    std::printf(
+        "  compact+readback: GPU compaction %.1f ms, copy to host memory %.1f ms, into the voxel list %.1f ms\n",
+        total.compact_gpu_ms, total.readback_copy_ms, total.unpack_ms);
   std::printf("  total:           %.1f ms, %.0f points/s, %llu voxel updates, %llu windows\n", wall_ms,
               wall_ms > 0 ? prep_total.points_in / (wall_ms / 1000.0) : 0.0, (unsigned long long)voxels,
               (unsigned long long)windows);

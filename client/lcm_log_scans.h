@@ -11,10 +11,10 @@ namespace ort::cli {
 bool is_lcm_log(const std::string& path);
 
 struct LogScanEvent {
-  size_t index = 0;           // among the log's scan events (channels with the prefix)
-  int64_t timestamp = 0;      // when lcm-logger received it [us since the epoch]
+  size_t index = 0;       // among the log's scan events (channels with the prefix)
+  int64_t timestamp = 0;  // when lcm-logger received it [us since the epoch]
   std::string channel;
-  const void* data = nullptr; // valid only during the callback
+  const void* data = nullptr;  // valid only during the callback
   uint32_t size = 0;
 };
 

@@ -142,7 +142,8 @@ void publish_for(const std::string& url, int index, const LoadTestConfig& cfg, c
   const std::string robot = "load" + std::to_string(index);
   const std::string channel = scan_channel("OCTOMAP_RT_SCAN_", robot);
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / cfg.rate_hz));
-  const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.duration_s));
+  const auto end =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.duration_s));
   auto next = Clock::now() + period * index / std::max(1, cfg.producers);  // spread the producers over one period
   std::vector<uint8_t> buf;
   for (int64_t seq = 0; next < end; ++seq) {
@@ -201,7 +202,8 @@ LoadReport run_load_test(const LoadTestConfig& cfg) {
   const std::vector<PosedScan> scans = load_scans(cfg.points);
   StatusTracker status(url);
   const pid_t server = spawn(argv, cfg.log_path);
-  for (int i = 0; i < 600 && status.latest().utime == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  for (int i = 0; i < 600 && status.latest().utime == 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
   if (status.latest().utime == 0) {
     ::kill(server, SIGKILL);
     ::waitpid(server, nullptr, 0);
@@ -218,7 +220,8 @@ LoadReport run_load_test(const LoadTestConfig& cfg) {
   r.published = published;
   r.publish_errors = errors;
   // Settle: until every received scan is applied, rejected or dropped (or the time is up).
-  const auto settle_end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.settle_s));
+  const auto settle_end =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.settle_s));
   do {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     count_totals(status.latest(), r);
@@ -253,8 +256,8 @@ void print_load_report(std::ostream& out, const LoadTestConfig& cfg, const LoadR
                 (long long)r.dropped, r.in_flight ? (" + in flight " + std::to_string(r.in_flight)).c_str() : "",
                 (long long)r.missed);
   out << line;
-  out << "  accounted:   " << (r.accounted() ? "yes" : "NO") << " (lost before the server: "
-      << r.published - r.received << ", kernel drops on the server's socket: " << r.kernel_drops << ")\n";
+  out << "  accounted:   " << (r.accounted() ? "yes" : "NO") << " (lost before the server: " << r.published - r.received
+      << ", kernel drops on the server's socket: " << r.kernel_drops << ")\n";
   std::string drops;
   for (const auto& [k, v] : r.drop_reasons) drops += k + " " + std::to_string(v) + "; ";
   for (const auto& [k, v] : r.reject_reasons) drops += "rejected: " + k + " " + std::to_string(v) + "; ";

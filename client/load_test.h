@@ -13,14 +13,14 @@
 namespace ort::cli {
 
 struct LoadTestConfig {
-  std::string server;                 // octomap-rt-server program
+  std::string server;                                    // octomap-rt-server program
   std::vector<std::string> server_args = {"-r", "0.1"};  // besides --lcm-url
   int producers = 4;
-  double rate_hz = 5;                 // per producer
+  double rate_hz = 5;  // per producer
   double duration_s = 20;
-  int points = 20'000;                // per scan (a ring of range readings from the synthetic scene's poses)
-  int port = 7667;                    // udpm port inside the namespace
-  double settle_s = 120;              // after publishing stops, wait this long for the queue to empty
+  int points = 20'000;    // per scan (a ring of range readings from the synthetic scene's poses)
+  int port = 7667;        // udpm port inside the namespace
+  double settle_s = 120;  // after publishing stops, wait this long for the queue to empty
   std::string log_path = "loadtest-server.log";
 };
 
@@ -28,11 +28,11 @@ struct LoadReport {
   int64_t published = 0, publish_errors = 0;
   int64_t received = 0, applied = 0, rejected = 0, dropped = 0, in_flight = 0, missed = 0;
   std::map<std::string, int64_t> drop_reasons, reject_reasons;
-  int64_t kernel_drops = -1;          // the server's own socket (RcvbufErrors), -1: unknown
-  double peak_rss_mib = 0;            // the server's VmHWM
-  double e2e_p99_ms_max = 0;          // largest p99 over the status messages of the run
+  int64_t kernel_drops = -1;  // the server's own socket (RcvbufErrors), -1: unknown
+  double peak_rss_mib = 0;    // the server's VmHWM
+  double e2e_p99_ms_max = 0;  // largest p99 over the status messages of the run
   double e2e_p99_ms_last = 0;
-  double scans_per_s = 0;             // applied / duration
+  double scans_per_s = 0;  // applied / duration
   int64_t degraded_statuses = 0, statuses = 0;
   std::string last_message;
   int server_exit = -1;

@@ -9,9 +9,9 @@
 
 #include "commands.h"
 #include "lcm_url.h"
-#include "octomap_rt/wire_contract.hpp"
 #include "map_client/map_client.h"
 #include "map_commands.h"
+#include "octomap_rt/wire_contract.hpp"
 #include "progress_bar.h"
 
 namespace ort::cli {
@@ -55,7 +55,8 @@ void run_get(const MapArgs& a, const std::string& out_path) {
 void run_info(const MapArgs& a) {
   client::MapClient c(client_lcm_url(a.lcm_url));
   const auto m = c.wait_info(a.timeout_s);
-  if (!m) throw std::runtime_error("no map_info_t within " + std::to_string(a.timeout_s) + " s (is the server running?)");
+  if (!m)
+    throw std::runtime_error("no map_info_t within " + std::to_string(a.timeout_s) + " s (is the server running?)");
   if (a.json) {
     std::cout << "{\"server_id\": \"" << m->server_id << "\", \"map_version\": " << m->map_version
               << ", \"snapshot_id\": " << m->snapshot_id << ", \"num_scans\": " << m->num_scans
@@ -80,7 +81,8 @@ void run_info(const MapArgs& a) {
 }
 
 void add_common(CLI::App* cmd, MapArgs& a) {
-  cmd->add_option("--lcm-url", a.lcm_url, std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + octomap_rt::wire::kDefaultLcmUrl + ")");
+  cmd->add_option("--lcm-url", a.lcm_url,
+                  std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + octomap_rt::wire::kDefaultLcmUrl + ")");
   cmd->add_option("--timeout", a.timeout_s, "seconds to wait for the server")->capture_default_str();
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   cmd->add_flag("-q,--quiet", a.quiet, "no progress output");
@@ -101,13 +103,15 @@ void register_map_command(CLI::App& app) {
   CLI::App* info = map->add_subcommand("info", "print the server's next map_info_t");
   add_common(info, *args);
   info->callback([args] { run_info(*args); });
-  CLI::App* watch = map->add_subcommand("watch", "mirror the map (snapshot + deltas); print delta rate, bandwidth, classes");
+  CLI::App* watch =
+      map->add_subcommand("watch", "mirror the map (snapshot + deltas); print delta rate, bandwidth, classes");
   add_common(watch, *args);
   watch->add_option("--seconds", args->seconds, "stop after this long; 0: at Ctrl-C")->capture_default_str();
   watch->add_option("--save", args->save, "write the mirror to this .ot file at the end");
   watch->callback([args] { run_map_watch(*args); });
   auto files = std::make_shared<std::vector<std::string>>();
-  CLI::App* diff = map->add_subcommand("diff", "compare two maps (.ot/.bt) voxel by voxel: class, and log-odds; exit 1 if classes differ");
+  CLI::App* diff = map->add_subcommand(
+      "diff", "compare two maps (.ot/.bt) voxel by voxel: class, and log-odds; exit 1 if classes differ");
   diff->add_option("A B", *files, "two map files")->required()->expected(2);
   diff->callback([files] {
     if (run_map_diff((*files)[0], (*files)[1]) != 0) throw CLI::RuntimeError(1);

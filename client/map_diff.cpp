@@ -46,8 +46,7 @@ int run_map_diff(const std::string& a_path, const std::string& b_path) {
   for (auto it = b->begin_leafs(), end = b->end_leafs(); it != end; ++it)
     if (!a->search(it.getKey())) ++known_in_one;
   std::printf("%zu voxels: %zu known in one map only, %zu of another class, %zu of other log-odds -> %s\n", voxels,
-              known_in_one, other_class, other_logodds,
-              known_in_one + other_class == 0 ? "same classes" : "DIFFERENT");
+              known_in_one, other_class, other_logodds, known_in_one + other_class == 0 ? "same classes" : "DIFFERENT");
   return known_in_one + other_class == 0 ? 0 : 1;
 }
 

@@ -9,8 +9,8 @@
 namespace ort {
 
 struct MapSummary {
-  uint64_t stored_free = 0, stored_occupied = 0;    // leaves as stored (pruned)
-  uint64_t finest_free = 0, finest_occupied = 0;    // voxels at the finest level
+  uint64_t stored_free = 0, stored_occupied = 0;  // leaves as stored (pruned)
+  uint64_t finest_free = 0, finest_occupied = 0;  // voxels at the finest level
   uint64_t nodes = 0;
   uint64_t memory_bytes = 0;
 };

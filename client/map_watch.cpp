@@ -54,15 +54,17 @@ void run_map_watch(const MapArgs& a) {
     const client::MirrorStats& s = m.stats();
     const ClassCounts k = count_classes(m.tree());
     if (a.json)
-      std::printf("{\"t\": %.1f, \"version\": %lld, \"deltas_per_s\": %lld, \"bytes_per_s\": %lld, \"occupied\": %zu, "
-                  "\"free\": %zu, \"gaps\": %lld, \"snapshots\": %lld}\n",
-                  elapsed(), (long long)m.version(), (long long)(s.deltas_applied - last_deltas),
-                  (long long)(s.delta_bytes - last_bytes), k.occupied, k.free, (long long)s.gaps, (long long)s.snapshots);
+      std::printf(
+          "{\"t\": %.1f, \"version\": %lld, \"deltas_per_s\": %lld, \"bytes_per_s\": %lld, \"occupied\": %zu, "
+          "\"free\": %zu, \"gaps\": %lld, \"snapshots\": %lld}\n",
+          elapsed(), (long long)m.version(), (long long)(s.deltas_applied - last_deltas),
+          (long long)(s.delta_bytes - last_bytes), k.occupied, k.free, (long long)s.gaps, (long long)s.snapshots);
     else
-      std::printf("%6.1f s  version %lld  %lld deltas/s  %.1f KB/s  occupied %zu  free %zu voxels  gaps %lld  "
-                  "snapshots %lld\n",
-                  elapsed(), (long long)m.version(), (long long)(s.deltas_applied - last_deltas),
-                  (s.delta_bytes - last_bytes) / 1000.0, k.occupied, k.free, (long long)s.gaps, (long long)s.snapshots);
+      std::printf(
+          "%6.1f s  version %lld  %lld deltas/s  %.1f KB/s  occupied %zu  free %zu voxels  gaps %lld  "
+          "snapshots %lld\n",
+          elapsed(), (long long)m.version(), (long long)(s.deltas_applied - last_deltas),
+          (s.delta_bytes - last_bytes) / 1000.0, k.occupied, k.free, (long long)s.gaps, (long long)s.snapshots);
     std::fflush(stdout);
     last_deltas = s.deltas_applied;
     last_bytes = s.delta_bytes;

@@ -118,7 +118,8 @@ void register_box(CLI::App& parent) {
   auto* cmd = parent.add_subcommand("box", "finest-voxel counts of boxes (or a region's nodes with --region)");
   auto a = std::make_shared<CommonArgs>();
   auto boxes = std::make_shared<std::vector<std::string>>();
-  auto any = std::make_shared<bool>(false), region = std::make_shared<bool>(false), free = std::make_shared<bool>(false);
+  auto any = std::make_shared<bool>(false), region = std::make_shared<bool>(false),
+       free = std::make_shared<bool>(false);
   auto depth = std::make_shared<int>(0);
   add_common(cmd, *a);
   cmd->add_option("boxes", *boxes, "MINX,MINY,MINZ:MAXX,MAXY,MAXZ [m]")->required();
@@ -156,7 +157,8 @@ void register_box(CLI::App& parent) {
 void register_grid(CLI::App& parent) {
   auto* cmd = parent.add_subcommand("grid", "2D grid of a z band (occupied if any voxel is): PNG and/or JSON");
   auto a = std::make_shared<CommonArgs>();
-  auto z = std::make_shared<std::string>(), window = std::make_shared<std::string>(), out = std::make_shared<std::string>();
+  auto z = std::make_shared<std::string>(), window = std::make_shared<std::string>(),
+       out = std::make_shared<std::string>();
   auto cell = std::make_shared<double>(0);
   add_common(cmd, *a);
   cmd->add_option("--z", *z, "z band MIN:MAX [m]")->required();
@@ -178,7 +180,8 @@ void register_grid(CLI::App& parent) {
       std::exit(2);
     }
     if (!out->empty()) write_grid_png(g, *out);
-    if (a->json) write_grid_json(std::cout, g, *out);
+    if (a->json)
+      write_grid_json(std::cout, g, *out);
     else
       std::cout << "grid " << g.header.width << " x " << g.header.height << " cells of " << g.header.cell_size
                 << " m from (" << g.header.origin_x << ", " << g.header.origin_y << "), map state "

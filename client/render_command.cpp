@@ -27,7 +27,8 @@ std::optional<double> parse_limit(const std::string& text, const std::string& wh
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used != text.size()) throw CLI::ValidationError("--z", "expected MIN:MAX in metres (either may be empty), got " + whole);
+  if (used != text.size())
+    throw CLI::ValidationError("--z", "expected MIN:MAX in metres (either may be empty), got " + whole);
   return v;
 }
 

@@ -103,8 +103,9 @@ int replay_scan_set(const ReplayArgs& a, lcm::LCM& lc) {
   const ScanSet set = a.input == "synthetic" ? make_synthetic_rooms() : load_scan_graph(a.input);
   const std::vector<size_t> order = select_scans(set.scans.size(), a.sel);
   const std::string channel = scan_channel(a.channel_prefix, a.robot);
-  if (order.empty()) throw std::runtime_error("the selection holds no scans (" + std::to_string(set.scans.size()) +
-                                              " in " + set.name + ")");
+  if (order.empty())
+    throw std::runtime_error("the selection holds no scans (" + std::to_string(set.scans.size()) + " in " + set.name +
+                             ")");
 
   ScanMessageFields f;
   f.robot_id = a.robot;
@@ -133,8 +134,8 @@ int replay_scan_set(const ReplayArgs& a, lcm::LCM& lc) {
     bar.update(t.scans, t.detail());
   }
   bar.finish();
-  print_totals(("robot " + a.robot + ", " + std::to_string(order.size()) + " of " +
-                std::to_string(set.scans.size()) + " scans of " + set.name)
+  print_totals(("robot " + a.robot + ", " + std::to_string(order.size()) + " of " + std::to_string(set.scans.size()) +
+                " scans of " + set.name)
                    .c_str(),
                channel, t);
   return t.publish_errors ? 1 : 0;
@@ -178,8 +179,7 @@ int replay_log(const ReplayArgs& a, lcm::LCM& lc) {
       bool decoded = false;
       try {  // the log may hold anything on these channels; decode() throws on bad lengths
         decoded = msg.decode(e.data, 0, static_cast<int>(e.size)) >= 0;
-      } catch (const std::exception&) {
-      }
+      } catch (const std::exception&) {}
       if (decoded) points = msg.xyz.size() / 3;
       if (!out_channel.empty()) {
         if (!decoded) {
@@ -202,8 +202,8 @@ int replay_log(const ReplayArgs& a, lcm::LCM& lc) {
           pass_start = Clock::now();
         }
         const double offset_s = (e.timestamp - first_ts) / 1e6 / a.speed;
-        std::this_thread::sleep_until(pass_start + std::chrono::duration_cast<Clock::duration>(
-                                                       std::chrono::duration<double>(offset_s)));
+        std::this_thread::sleep_until(
+            pass_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(offset_s)));
       }
       if (t.scans == 0) t.first_publish = Clock::now();
       if (lc.publish(channel, data, size) != 0) ++t.publish_errors;
@@ -248,8 +248,10 @@ int run_replay(ReplayArgs a) {
 
   const std::string url = client_lcm_url(a.lcm_url);
   lcm::LCM lc(url);
-  if (!lc.good()) throw std::runtime_error("cannot open LCM at " + url + " (for udpm on one host: "
-                                           "ip route add 224.0.0.0/4 dev lo)");
+  if (!lc.good())
+    throw std::runtime_error("cannot open LCM at " + url +
+                             " (for udpm on one host: "
+                             "ip route add 224.0.0.0/4 dev lo)");
   if (a.wait_for_server_s > 0) {
     // A separate instance, closed before publishing: a subscribed udpm instance keeps a
     // receive socket that would take in every robot's multi-MB scans with a small buffer
@@ -293,7 +295,8 @@ void register_replay_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--first", args->sel.first, "first scan index")->capture_default_str();
   cmd->add_option("--count", args->sel.count, "number of scans from --first (0: all)")->capture_default_str();
-  cmd->add_option("--part", args->part, "i/n: only scans whose index (from --first) % n == i, to split a set among n producers");
+  cmd->add_option("--part", args->part,
+                  "i/n: only scans whose index (from --first) % n == i, to split a set among n producers");
   cmd->add_option("--repeat", args->sel.repeat, "publish the selection this many times")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();

@@ -17,7 +17,7 @@ struct ScanMessageFields {
   int64_t utime = 0;
   float max_range = -1.0f;  // <= 0: the server's --max-range applies
   PointsFrame frame = PointsFrame::kSensor;
-  size_t stride = 1;        // every stride-th point only (smaller messages; 1: all)
+  size_t stride = 1;  // every stride-th point only (smaller messages; 1: all)
 };
 
 // Sensor frame: the points as stored plus the pose (float components carried in doubles

@@ -11,10 +11,10 @@ namespace ort::cli {
 
 struct ScanSelection {
   size_t first = 0;
-  size_t count = 0;        // 0: all from `first`
-  size_t part = 0;         // this producer's share ...
-  size_t parts = 1;        // ... of this many
-  size_t repeat = 1;       // the whole selection this many times
+  size_t count = 0;   // 0: all from `first`
+  size_t part = 0;    // this producer's share ...
+  size_t parts = 1;   // ... of this many
+  size_t repeat = 1;  // the whole selection this many times
 };
 
 // Parses "i/n" (0 <= i < n). Returns "" or the reason.

@@ -86,9 +86,10 @@ int run_once(const StatusArgs& a, lcm::LCM& lc, const std::string& url, Inbox& i
   while (!in.fresh && std::chrono::steady_clock::now() < deadline)
     if (lc.handleTimeout(100) < 0) throw std::runtime_error("LCM receive failed on " + url);
   if (!in.fresh)
-    throw std::runtime_error("no status on " + a.channel + " within " + std::to_string(int(a.timeout_s)) + " s at " +
-                             url + ": is octomap-rt-server running with this LCM URL?" +
-                             (in.undecodable ? " (" + std::to_string(in.undecodable) + " messages did not decode)" : ""));
+    throw std::runtime_error(
+        "no status on " + a.channel + " within " + std::to_string(int(a.timeout_s)) + " s at " + url +
+        ": is octomap-rt-server running with this LCM URL?" +
+        (in.undecodable ? " (" + std::to_string(in.undecodable) + " messages did not decode)" : ""));
   std::cout << (a.json ? status::status_json(*in.latest) + "\n" : status::format_status(*in.latest, now_utime()));
   return 0;
 }
@@ -136,7 +137,8 @@ void register_status_command(CLI::App& app) {
   cmd->add_option("--timeout", args->timeout_s, "Without --watch: seconds to wait for a status")
       ->check(CLI::Range(0.1, 3600.0))
       ->capture_default_str();
-  cmd->add_option("--count", args->count, "With --watch: stop after N statuses (0: never)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--count", args->count, "With --watch: stop after N statuses (0: never)")
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([args] {
     if (run_status(*args) != 0) throw std::runtime_error("status failed");
   });

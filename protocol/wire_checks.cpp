@@ -41,7 +41,8 @@ std::string check_chunk(const void* data, size_t size, octomap_rt::map_chunk_t& 
 }
 std::string check_delta(const void* data, size_t size, octomap_rt::map_delta_t& out) {
   return checked_decode(
-      data, size, {wire_fixed(kDeltaDataSizeOffset - 8), wire_count(kMaxMessageBytes), wire_array(1), wire_string(kAnyString)},
+      data, size,
+      {wire_fixed(kDeltaDataSizeOffset - 8), wire_count(kMaxMessageBytes), wire_array(1), wire_string(kAnyString)},
       out);
 }
 std::string check_info(const void* data, size_t size, octomap_rt::map_info_t& out) {

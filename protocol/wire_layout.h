@@ -31,19 +31,21 @@ constexpr WireSegment wire_fixed(int64_t bytes) { return {WireSegment::kFixed, b
 constexpr WireSegment wire_count(int64_t max) { return {WireSegment::kCount, max}; }
 constexpr WireSegment wire_array(int64_t elem_bytes) { return {WireSegment::kArray, elem_bytes}; }
 constexpr WireSegment wire_string(int64_t max_bytes) { return {WireSegment::kString, max_bytes}; }
-constexpr WireSegment wire_strings(int64_t per_elem, int64_t max_bytes) { return {WireSegment::kStrings, max_bytes, per_elem}; }
+constexpr WireSegment wire_strings(int64_t per_elem, int64_t max_bytes) {
+  return {WireSegment::kStrings, max_bytes, per_elem};
+}
 
 // Why a message's bytes are not one message of its layout (kNone: they are).
 enum class WireFault {
   kNone,
-  kTruncated,           // the bytes end inside a field
-  kWrongFingerprint,    // the first 8 bytes are not the type's hash
-  kNegativeCount,       // an array count below zero
-  kCountTooLarge,       // an array count above its bound (WireCheck::limit)
-  kCountExceedsData,    // an array count with fewer bytes behind it than it needs
-  kBadStringLength,     // a string length below 1 (the NUL counts) or above its bound
-  kStringNotTerminated, // a string's last byte is not NUL
-  kTrailingBytes,       // bytes after the message's end
+  kTruncated,            // the bytes end inside a field
+  kWrongFingerprint,     // the first 8 bytes are not the type's hash
+  kNegativeCount,        // an array count below zero
+  kCountTooLarge,        // an array count above its bound (WireCheck::limit)
+  kCountExceedsData,     // an array count with fewer bytes behind it than it needs
+  kBadStringLength,      // a string length below 1 (the NUL counts) or above its bound
+  kStringNotTerminated,  // a string's last byte is not NUL
+  kTrailingBytes,        // bytes after the message's end
 };
 
 struct WireCheck {

@@ -30,7 +30,9 @@ struct Cell {
 std::vector<Cell> astar(const Grid& g, const std::vector<bool>& blocked, Cell from, Cell to) {
   const int w = g.header.width, h = g.header.height;
   auto idx = [w](int i, int j) { return size_t(j) * w + i; };
-  auto ok = [&](int i, int j) { return i >= 0 && j >= 0 && i < w && j < h && g.cells[idx(i, j)] == 1 && !blocked[idx(i, j)]; };
+  auto ok = [&](int i, int j) {
+    return i >= 0 && j >= 0 && i < w && j < h && g.cells[idx(i, j)] == 1 && !blocked[idx(i, j)];
+  };
   std::vector<double> cost(size_t(w) * h, INFINITY);
   std::vector<size_t> parent(size_t(w) * h, SIZE_MAX);
   using Item = std::pair<double, size_t>;
@@ -89,8 +91,12 @@ int main(int argc, char** argv) {
     const Grid g = client.grid(z0, z1, cell, nullptr);
     if (g.header.status != 0) throw std::runtime_error("grid refused: " + g.header.error);
     const double cs = g.header.cell_size;
-    auto cell_of = [&](double x, double y) { return Cell{int(std::floor((x - g.header.origin_x) / cs)), int(std::floor((y - g.header.origin_y) / cs))}; };
-    auto centre = [&](Cell c, int k) { return (k ? g.header.origin_y + (c.j + 0.5) * cs : g.header.origin_x + (c.i + 0.5) * cs); };
+    auto cell_of = [&](double x, double y) {
+      return Cell{int(std::floor((x - g.header.origin_x) / cs)), int(std::floor((y - g.header.origin_y) / cs))};
+    };
+    auto centre = [&](Cell c, int k) {
+      return (k ? g.header.origin_y + (c.j + 0.5) * cs : g.header.origin_x + (c.i + 0.5) * cs);
+    };
     std::printf("grid: %d x %d cells of %g m, map state %lld\n", g.header.width, g.header.height, cs,
                 (long long)g.header.snapshot_id);
     std::vector<bool> blocked(g.cells.size(), false);
@@ -102,10 +108,12 @@ int main(int argc, char** argv) {
       }
       std::vector<ort::client::Box> boxes;
       for (const Cell& c : path)
-        boxes.push_back({{centre(c, 0) - radius, centre(c, 1) - radius, z0}, {centre(c, 0) + radius, centre(c, 1) + radius, z1}});
+        boxes.push_back(
+            {{centre(c, 0) - radius, centre(c, 1) - radius, z0}, {centre(c, 0) + radius, centre(c, 1) + radius, z1}});
       int failed = 0;
       for (size_t first = 0; first < boxes.size(); first += 1000) {
-        const std::vector<ort::client::Box> part(boxes.begin() + first, boxes.begin() + std::min(boxes.size(), first + 1000));
+        const std::vector<ort::client::Box> part(boxes.begin() + first,
+                                                 boxes.begin() + std::min(boxes.size(), first + 1000));
         const auto r = client.boxes(part, octomap_rt::box_query_t::MODE_ANY_OCCUPIED);
         if (r.status != 0) throw std::runtime_error("box query refused: " + r.error);
         for (int k = 0; k < r.num_boxes; ++k)
@@ -116,12 +124,15 @@ int main(int argc, char** argv) {
           }
       }
       if (failed) {
-        std::printf("attempt %d: %zu cells, %d fail the %g m footprint check; replanning\n", attempt, path.size(), failed, radius);
+        std::printf("attempt %d: %zu cells, %d fail the %g m footprint check; replanning\n", attempt, path.size(),
+                    failed, radius);
         continue;
       }
       double length = 0;
-      for (size_t k = 1; k < path.size(); ++k) length += cs * std::hypot(path[k].i - path[k - 1].i, path[k].j - path[k - 1].j);
-      std::printf("path: %zu cells, %.2f m, footprint %g m clear (%d box queries)\n", path.size(), length, radius, attempt);
+      for (size_t k = 1; k < path.size(); ++k)
+        length += cs * std::hypot(path[k].i - path[k - 1].i, path[k].j - path[k - 1].j);
+      std::printf("path: %zu cells, %.2f m, footprint %g m clear (%d box queries)\n", path.size(), length, radius,
+                  attempt);
       for (const Cell& c : path) std::printf("  %.3f %.3f\n", centre(c, 0), centre(c, 1));
       return 0;
     }

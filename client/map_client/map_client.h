@@ -15,8 +15,8 @@
 #include <stdexcept>
 #include <string>
 
-#include <lcm/lcm-cpp.hpp>
 #include <octomap/OcTree.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include "octomap_rt/map_chunk_t.hpp"
 #include "octomap_rt/map_delta_t.hpp"
@@ -48,7 +48,7 @@ struct ClientOptions {
 struct FetchedSnapshot {
   int64_t snapshot_id = 0, num_scans = 0;
   int8_t format = 0;
-  std::string bytes;                 // decompressed: the .bt or .ot file's content
+  std::string bytes;  // decompressed: the .bt or .ot file's content
   int64_t compressed_size = 0;
   int32_t num_chunks = 0, requests = 0, chunks_dropped = 0;
   double seconds = 0;

@@ -116,8 +116,8 @@ void MapMirror::apply(const Delta& d) {
   }
   const float occ = tree_->getClampingThresMaxLog(), free = tree_->getClampingThresMinLog();
   for (const protocol::VoxelChange& c : changes) {
-    const float value = d.mode == Delta::MODE_LOG_ODDS ? c.value
-                        : (static_cast<int8_t>(c.value) == Delta::CLASS_OCCUPIED ? occ : free);
+    const float value =
+        d.mode == Delta::MODE_LOG_ODDS ? c.value : (static_cast<int8_t>(c.value) == Delta::CLASS_OCCUPIED ? occ : free);
     tree_->setNodeValue(protocol::unpack_key(c.key), value);
   }
   last_seq_ = d.delta_seq;

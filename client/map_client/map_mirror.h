@@ -29,7 +29,7 @@ struct AppliedDelta {
 };
 
 struct MirrorOptions {
-  bool resync = true;        // false: a gap is only counted (tests show what resync buys)
+  bool resync = true;  // false: a gap is only counted (tests show what resync buys)
   int8_t snapshot_format = octomap_rt::map_chunk_t::FORMAT_OCTOMAP_FULL;
   double fetch_timeout_s = 30;
   std::function<void(const AppliedDelta&)> on_delta;
@@ -63,11 +63,11 @@ class MapMirror {
   MirrorOptions opts_;
   std::unique_ptr<octomap::OcTree> tree_;
   int64_t version_ = -1;
-  int64_t last_seq_ = -1;   // last delta applied or skipped as contained
-  int64_t highest_seq_ = -1;       // highest delta_seq received, or known to be in the snapshot
-  int64_t latest_info_seq_ = -1;   // delta_seq of the latest map_info_t
+  int64_t last_seq_ = -1;         // last delta applied or skipped as contained
+  int64_t highest_seq_ = -1;      // highest delta_seq received, or known to be in the snapshot
+  int64_t latest_info_seq_ = -1;  // delta_seq of the latest map_info_t
   bool info_seen_ = false;
-  bool started_ = false;    // a change set was applied from its first part since the snapshot
+  bool started_ = false;  // a change set was applied from its first part since the snapshot
   bool syncing_ = false, need_sync_ = false;
   std::vector<octomap_rt::map_delta_t> buffered_;
   MirrorStats stats_;

@@ -12,7 +12,8 @@ namespace ort::client {
 namespace {
 
 using render::Rgb;
-constexpr Rgb kFree{235, 235, 235}, kOccupied{30, 30, 30}, kUnknown{120, 150, 200}, kText{0, 0, 0}, kPaper{255, 255, 255};
+constexpr Rgb kFree{235, 235, 235}, kOccupied{30, 30, 30}, kUnknown{120, 150, 200}, kText{0, 0, 0},
+    kPaper{255, 255, 255};
 
 Rgb colour(int8_t state) { return state == 2 ? kOccupied : state == 1 ? kFree : kUnknown; }
 

@@ -18,7 +18,8 @@ std::vector<double> parse_numbers(const std::string& text, size_t count, char se
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used == 0 || used != part.size()) throw std::invalid_argument("'" + text + "' is not " + std::to_string(count) + " numbers");
+    if (used == 0 || used != part.size())
+      throw std::invalid_argument("'" + text + "' is not " + std::to_string(count) + " numbers");
     v.push_back(x);
   }
   if (v.size() != count) throw std::invalid_argument("'" + text + "' is not " + std::to_string(count) + " numbers");

@@ -72,7 +72,8 @@ std::vector<Reply> QueryClient::exchange(const std::string& channel, Request& re
   lcm_->publish(channel, &request);
   const auto deadline = std::chrono::steady_clock::now() + timeout_;
   while (!done(replies)) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) {
       lcm_->unsubscribe(sub);
       throw QueryTimeout("no complete reply on " + reply_channel_ + " within " + std::to_string(timeout_.count()) +
@@ -86,7 +87,9 @@ std::vector<Reply> QueryClient::exchange(const std::string& channel, Request& re
 
 namespace {
 template <class Reply>
-bool one(const std::vector<Reply>& r) { return !r.empty(); }
+bool one(const std::vector<Reply>& r) {
+  return !r.empty();
+}
 }  // namespace
 
 octomap_rt::occupancy_reply_t QueryClient::points(const std::vector<float>& xyz, int depth, const WaitFor& w) {
@@ -114,7 +117,8 @@ octomap_rt::box_reply_t QueryClient::boxes(const std::vector<Box>& boxes, int8_t
   octomap_rt::box_query_t q{};
   address(q, w);
   q.mode = mode;
-  for (const Box& b : boxes) q.boxes.insert(q.boxes.end(), {b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]});
+  for (const Box& b : boxes)
+    q.boxes.insert(q.boxes.end(), {b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]});
   q.num_values = static_cast<int32_t>(q.boxes.size());
   return exchange<octomap_rt::box_reply_t>(wire::kQueryBoxesChannel, q, one<octomap_rt::box_reply_t>).front();
 }

@@ -29,9 +29,9 @@ class QueryTimeout : public std::runtime_error {
 // Read-your-writes and map-state conditions every query may carry.
 struct WaitFor {
   int64_t min_snapshot_id = 0;
-  std::string robot_id;          // "": do not wait for a scan
+  std::string robot_id;  // "": do not wait for a scan
   int64_t seq = -1;
-  int timeout_ms = 0;            // how long the server may wait
+  int timeout_ms = 0;  // how long the server may wait
 };
 
 struct Box {
@@ -40,8 +40,8 @@ struct Box {
 
 // A whole 2D grid, reassembled from its grid_t rows.
 struct Grid {
-  octomap_rt::grid_t header;     // the first chunk (cells cleared)
-  std::vector<int8_t> cells;     // width * height, row-major, OCC_*
+  octomap_rt::grid_t header;  // the first chunk (cells cleared)
+  std::vector<int8_t> cells;  // width * height, row-major, OCC_*
 };
 
 class QueryClient {
@@ -51,8 +51,8 @@ class QueryClient {
   ~QueryClient();
 
   octomap_rt::occupancy_reply_t points(const std::vector<float>& xyz, int depth = 0, const WaitFor& w = {});
-  octomap_rt::ray_reply_t rays(const std::vector<float>& origins, const std::vector<float>& directions,
-                               float max_range, bool ignore_unknown, const WaitFor& w = {});
+  octomap_rt::ray_reply_t rays(const std::vector<float>& origins, const std::vector<float>& directions, float max_range,
+                               bool ignore_unknown, const WaitFor& w = {});
   // mode: box_query_t.MODE_COUNTS or MODE_ANY_OCCUPIED.
   octomap_rt::box_reply_t boxes(const std::vector<Box>& boxes, int8_t mode, const WaitFor& w = {});
   std::vector<octomap_rt::region_chunk_t> region(const Box& box, int depth, bool include_free, const WaitFor& w = {});

@@ -10,17 +10,21 @@ std::string quoted(const std::string& s) {
   std::ostringstream o;
   o << '"';
   for (char c : s) {
-    if (c == '"' || c == '\\') o << '\\' << c;
-    else if (static_cast<unsigned char>(c) < 0x20) o << "\\u" << std::hex << std::setw(4) << std::setfill('0') << int(c) << std::dec;
-    else o << c;
+    if (c == '"' || c == '\\')
+      o << '\\' << c;
+    else if (static_cast<unsigned char>(c) < 0x20)
+      o << "\\u" << std::hex << std::setw(4) << std::setfill('0') << int(c) << std::dec;
+    else
+      o << c;
   }
   return o.str() + '"';
 }
 
 template <class R>
 void head(std::ostream& out, const R& r) {
-  out << "{\"request_id\": " << r.request_id << ", \"snapshot_id\": " << r.snapshot_id << ", \"map_utime\": "
-      << r.map_utime << ", \"status\": " << quoted(status_name(r.status)) << ", \"error\": " << quoted(r.error);
+  out << "{\"request_id\": " << r.request_id << ", \"snapshot_id\": " << r.snapshot_id
+      << ", \"map_utime\": " << r.map_utime << ", \"status\": " << quoted(status_name(r.status))
+      << ", \"error\": " << quoted(r.error);
 }
 
 }  // namespace
@@ -52,9 +56,9 @@ void write_rays_json(std::ostream& out, const octomap_rt::ray_reply_t& r) {
   head(out, r);
   out << ", \"results\": [";
   for (int i = 0; i < r.num_rays; ++i)
-    out << (i ? ", " : "") << "{\"hit\": " << (r.hit[i] ? "true" : "false") << ", \"end\": [" << r.end_xyz[3 * i] << ", "
-        << r.end_xyz[3 * i + 1] << ", " << r.end_xyz[3 * i + 2] << "], \"end_state\": \"" << state_name(r.end_state[i])
-        << "\"}";
+    out << (i ? ", " : "") << "{\"hit\": " << (r.hit[i] ? "true" : "false") << ", \"end\": [" << r.end_xyz[3 * i]
+        << ", " << r.end_xyz[3 * i + 1] << ", " << r.end_xyz[3 * i + 2] << "], \"end_state\": \""
+        << state_name(r.end_state[i]) << "\"}";
   out << "]}\n";
 }
 
@@ -75,8 +79,8 @@ void write_region_json(std::ostream& out, const std::vector<octomap_rt::region_c
   for (const auto& c : chunks)
     for (int i = 0; i < c.num_voxels; ++i, first = false)
       out << (first ? "" : ", ") << "{\"center\": [" << c.center_xyz[3 * i] << ", " << c.center_xyz[3 * i + 1] << ", "
-          << c.center_xyz[3 * i + 2] << "], \"depth\": " << int(c.depth[i]) << ", \"state\": \"" << state_name(c.state[i])
-          << "\"}";
+          << c.center_xyz[3 * i + 2] << "], \"depth\": " << int(c.depth[i]) << ", \"state\": \""
+          << state_name(c.state[i]) << "\"}";
   out << "]}\n";
 }
 
@@ -85,10 +89,10 @@ void write_grid_json(std::ostream& out, const Grid& g, const std::string& png_pa
   head(out, g.header);
   int counts[3] = {0, 0, 0};
   for (int8_t c : g.cells) counts[c >= 0 && c <= 2 ? c : 0]++;
-  out << ", \"width\": " << g.header.width << ", \"height\": " << g.header.height << ", \"cell_size\": "
-      << g.header.cell_size << ", \"origin\": [" << g.header.origin_x << ", " << g.header.origin_y
-      << "], \"cells\": {\"unknown\": " << counts[0] << ", \"free\": " << counts[1] << ", \"occupied\": " << counts[2]
-      << "}, \"png\": " << quoted(png_path) << "}\n";
+  out << ", \"width\": " << g.header.width << ", \"height\": " << g.header.height
+      << ", \"cell_size\": " << g.header.cell_size << ", \"origin\": [" << g.header.origin_x << ", "
+      << g.header.origin_y << "], \"cells\": {\"unknown\": " << counts[0] << ", \"free\": " << counts[1]
+      << ", \"occupied\": " << counts[2] << "}, \"png\": " << quoted(png_path) << "}\n";
 }
 
 void write_edit_json(std::ostream& out, const octomap_rt::map_edit_ack_t& a) {

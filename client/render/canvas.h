@@ -26,7 +26,7 @@ class Canvas {
   int height() const { return height_; }
   Rgb at(int x, int y) const { return pixels_[index(x, y)]; }
   const std::vector<Rgb>& pixels() const { return pixels_; }
-  void set(int x, int y, Rgb c);  // ignores pixels outside
+  void set(int x, int y, Rgb c);                          // ignores pixels outside
   void fill_rect(int x0, int y0, int x1, int y1, Rgb c);  // [x0, x1) x [y0, y1)
 
   // The parallelogram v0 v1 v2 v3 (v2 = v1 + v3 - v0), filled where it is nearer than what

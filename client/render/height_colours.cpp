@@ -9,8 +9,8 @@ namespace {
 
 // Stops of Google's "turbo" map, sampled evenly (inner stops only: its near-black ends are
 // hard to tell from the outlines).
-constexpr std::array<Rgb, 7> kStops{{{48, 18, 59}, {70, 107, 227}, {41, 187, 236}, {49, 241, 150},
-                                     {164, 252, 60}, {250, 186, 57}, {213, 53, 7}}};
+constexpr std::array<Rgb, 7> kStops{
+    {{48, 18, 59}, {70, 107, 227}, {41, 187, 236}, {49, 241, 150}, {164, 252, 60}, {250, 186, 57}, {213, 53, 7}}};
 
 uint8_t mix(uint8_t a, uint8_t b, double f) { return uint8_t(std::lround(a + (b - a) * f)); }
 

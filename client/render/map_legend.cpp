@@ -53,8 +53,8 @@ double scale_bar_metres(double max_metres) {
   return decade;
 }
 
-void draw_legend(Canvas& canvas, int top, const ViewCamera& camera, const HeightColours& colours,
-                 const Box3& extent, double resolution) {
+void draw_legend(Canvas& canvas, int top, const ViewCamera& camera, const HeightColours& colours, const Box3& extent,
+                 double resolution) {
   canvas.fill_rect(0, top, canvas.width(), top + 1, Rgb{200, 200, 200});
   const int row1 = top + 10, row2 = top + 36;
   const int after_bar = draw_scale_bar(canvas, kLeft, row1, camera);

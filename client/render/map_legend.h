@@ -16,7 +16,7 @@ constexpr int kLegendHeight = 64;  // pixels under the map area
 double scale_bar_metres(double max_metres);
 
 // Draws the legend into rows [top, top + kLegendHeight) of the canvas.
-void draw_legend(Canvas& canvas, int top, const ViewCamera& camera, const HeightColours& colours,
-                 const Box3& extent, double resolution);
+void draw_legend(Canvas& canvas, int top, const ViewCamera& camera, const HeightColours& colours, const Box3& extent,
+                 double resolution);
 
 }  // namespace ort::render

@@ -24,8 +24,8 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 std::array<ScreenPoint, 4> face(const ViewCamera& cam, const VoxelBox& box, int axis, bool high_side) {
   const int i = (axis + 1) % 3, j = (axis + 2) % 3;
   std::array<ScreenPoint, 4> out;
-  const double corner[4][2] = {{box.lo[i], box.lo[j]}, {box.hi[i], box.lo[j]}, {box.hi[i], box.hi[j]},
-                               {box.lo[i], box.hi[j]}};
+  const double corner[4][2] = {
+      {box.lo[i], box.lo[j]}, {box.hi[i], box.lo[j]}, {box.hi[i], box.hi[j]}, {box.lo[i], box.hi[j]}};
   for (int c = 0; c < 4; ++c) {
     double p[3];
     p[axis] = high_side ? box.hi[axis] : box.lo[axis];
@@ -77,7 +77,8 @@ Box3 drawn_extent(const MapBoxes& boxes) {
 PlaneExtent plane_extent(const ViewCamera& cam, const MapBoxes& boxes, float floor_z) {
   PlaneExtent e = PlaneExtent::none();
   for (const VoxelBox& b : boxes.occupied)
-    for (int c = 0; c < 8; ++c) cam.extend(e, (c & 1) ? b.hi[0] : b.lo[0], (c & 2) ? b.hi[1] : b.lo[1], (c & 4) ? b.hi[2] : b.lo[2]);
+    for (int c = 0; c < 8; ++c)
+      cam.extend(e, (c & 1) ? b.hi[0] : b.lo[0], (c & 2) ? b.hi[1] : b.lo[1], (c & 4) ? b.hi[2] : b.lo[2]);
   for (const VoxelBox& b : boxes.free)
     for (int c = 0; c < 4; ++c) cam.extend(e, (c & 1) ? b.hi[0] : b.lo[0], (c & 2) ? b.hi[1] : b.lo[1], floor_z);
   return e;

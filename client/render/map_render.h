@@ -12,8 +12,8 @@ enum class FreeSpace { faint, hidden };
 
 struct RenderOptions {
   View view = View::top;
-  int width = 1200;         // pixels; the height follows from the map's shape
-  HeightRange heights;      // voxels outside are cut away; also the colour ramp's range
+  int width = 1200;     // pixels; the height follows from the map's shape
+  HeightRange heights;  // voxels outside are cut away; also the colour ramp's range
   FreeSpace free = FreeSpace::faint;
   double azimuth_deg = -125, elevation_deg = 35;  // oblique only
 };

@@ -14,6 +14,6 @@ class PngError : public std::runtime_error {
 };
 
 void write_png(const Canvas& canvas, const std::string& path);  // 8-bit RGB
-Canvas read_png(const std::string& path);                        // any PNG, as 8-bit RGB
+Canvas read_png(const std::string& path);                       // any PNG, as 8-bit RGB
 
 }  // namespace ort::render

@@ -27,7 +27,8 @@ struct Rng {
 };
 
 Box box(double x0, double y0, double z0, double x1, double y1, double z1) {
-  return Box{{std::min(x0, x1), std::min(y0, y1), std::min(z0, z1)}, {std::max(x0, x1), std::max(y0, y1), std::max(z0, z1)}};
+  return Box{{std::min(x0, x1), std::min(y0, y1), std::min(z0, z1)},
+             {std::max(x0, x1), std::max(y0, y1), std::max(z0, z1)}};
 }
 
 // 2D rectangle, for keeping furniture, trees and cars off paths and out of each other.
@@ -51,26 +52,26 @@ World finish(std::vector<Box> boxes, Path path, double cell) {
 // ---- indoor building ---------------------------------------------------------------------
 
 struct Door {
-  double x0, x1;     // gap along the wall
+  double x0, x1;  // gap along the wall
   bool open;
 };
 
 struct Room {
-  double x0, y0, x1, y1;     // interior
-  double door_x;             // door centre
-  double door_wall_y;        // y of the wall face on the corridor side
-  int corridor = -1;         // index of the corridor the door opens on
+  double x0, y0, x1, y1;  // interior
+  double door_x;          // door centre
+  double door_wall_y;     // y of the wall face on the corridor side
+  int corridor = -1;      // index of the corridor the door opens on
   bool door_open = true;
 };
 
 // A wall along x at y in [y0, y1] (thickness) from xa to xb, with door gaps.
-void wall_along_x(std::vector<Box>& out, double xa, double xb, double y0, double y1, double h,
-                  std::vector<Door> doors, double door_h) {
+void wall_along_x(std::vector<Box>& out, double xa, double xb, double y0, double y1, double h, std::vector<Door> doors,
+                  double door_h) {
   std::sort(doors.begin(), doors.end(), [](const Door& a, const Door& b) { return a.x0 < b.x0; });
   double x = xa;
   for (const Door& d : doors) {
     if (d.x0 > x) out.push_back(box(x, y0, 0, d.x0, y1, h));
-    out.push_back(box(d.x0, y0, door_h, d.x1, y1, h));  // lintel
+    out.push_back(box(d.x0, y0, door_h, d.x1, y1, h));                      // lintel
     if (!d.open) out.push_back(box(d.x0, y0, 0, d.x1, y0 + 0.05, door_h));  // closed door leaf
     x = d.x1;
   }
@@ -90,10 +91,26 @@ void furnish_room(std::vector<Box>& out, Rng& rng, const Room& r, double sensor_
     const int kind = rng.integer(0, 3);  // 0 shelf, 1 desk, 2 cabinet, 3 free-standing table
     double len, depth, height;
     switch (kind) {
-      case 0: len = rng.uniform(0.8, 2.0); depth = 0.4; height = rng.uniform(1.6, 2.2); break;
-      case 1: len = rng.uniform(1.2, 1.8); depth = 0.8; height = 0.75; break;
-      case 2: len = rng.uniform(0.5, 1.0); depth = 0.6; height = rng.uniform(0.8, 1.3); break;
-      default: len = rng.uniform(1.2, 2.4); depth = rng.uniform(0.8, 1.2); height = 0.74; break;
+      case 0:
+        len = rng.uniform(0.8, 2.0);
+        depth = 0.4;
+        height = rng.uniform(1.6, 2.2);
+        break;
+      case 1:
+        len = rng.uniform(1.2, 1.8);
+        depth = 0.8;
+        height = 0.75;
+        break;
+      case 2:
+        len = rng.uniform(0.5, 1.0);
+        depth = 0.6;
+        height = rng.uniform(0.8, 1.3);
+        break;
+      default:
+        len = rng.uniform(1.2, 2.4);
+        depth = rng.uniform(0.8, 1.2);
+        height = 0.74;
+        break;
     }
     Rect f;
     if (kind == 3) {
@@ -134,9 +151,9 @@ World make_indoor_building(uint64_t seed, const IndoorParams& p) {
   Rng rng{seed * 0x2545f4914f6cdd1dull + 1};
   const double L = p.length, D = p.width, H = p.height, t = p.wall, cw = p.corridor_width;
   std::vector<Box> boxes;
-  boxes.push_back(box(-t, -t, -0.2, L + t, D + t, 0));      // floor
-  boxes.push_back(box(-t, -t, H, L + t, D + t, H + 0.2));   // ceiling
-  boxes.push_back(box(-t, -t, 0, L + t, 0, H));             // outer walls
+  boxes.push_back(box(-t, -t, -0.2, L + t, D + t, 0));     // floor
+  boxes.push_back(box(-t, -t, H, L + t, D + t, H + 0.2));  // ceiling
+  boxes.push_back(box(-t, -t, 0, L + t, 0, H));            // outer walls
   boxes.push_back(box(-t, D, 0, L + t, D + t, H));
   boxes.push_back(box(-t, 0, 0, 0, D, H));
   boxes.push_back(box(L, 0, 0, L + t, D, H));
@@ -144,16 +161,23 @@ World make_indoor_building(uint64_t seed, const IndoorParams& p) {
   std::vector<double> cy;  // corridor centres (along x)
   for (int k = 0; k < p.corridors_x; ++k) cy.push_back(D * (k + 1) / (p.corridors_x + 1) + rng.uniform(-1.0, 1.0));
   std::vector<double> cx;  // cross corridor centres (along y)
-  for (int j = 0; j < p.corridors_y; ++j) cx.push_back(L * (j + 1) / (p.corridors_y + 1) + rng.uniform(-L / 10, L / 10));
+  for (int j = 0; j < p.corridors_y; ++j)
+    cx.push_back(L * (j + 1) / (p.corridors_y + 1) + rng.uniform(-L / 10, L / 10));
 
   // Bands between x-corridors, segments between y-corridors: each (band, segment) is a block of rooms.
   std::vector<std::pair<double, double>> bands, segments;
   {
     double y = 0;
-    for (double c : cy) { bands.push_back({y, c - cw / 2}); y = c + cw / 2; }
+    for (double c : cy) {
+      bands.push_back({y, c - cw / 2});
+      y = c + cw / 2;
+    }
     bands.push_back({y, D});
     double x = 0;
-    for (double c : cx) { segments.push_back({x, c - cw / 2}); x = c + cw / 2; }
+    for (double c : cx) {
+      segments.push_back({x, c - cw / 2});
+      x = c + cw / 2;
+    }
     segments.push_back({x, L});
   }
   std::vector<Room> rooms;
@@ -184,7 +208,10 @@ World make_indoor_building(uint64_t seed, const IndoorParams& p) {
         if (r == 0 && x0 == 0) room.x0 = rx0;
         if (r + 2 == cuts.size() && x1 == L) room.x1 = rx1;
         const bool use_below = corr_below && (!corr_above || rng.chance(0.5));
-        if (!corr_below && !corr_above) { rooms.push_back(room); continue; }
+        if (!corr_below && !corr_above) {
+          rooms.push_back(room);
+          continue;
+        }
         const double dx = rng.uniform(room.x0 + 0.3, room.x1 - 0.3 - p.door_width);
         room.door_x = dx + p.door_width / 2;
         room.door_open = !rng.chance(p.closed_door_share);
@@ -225,7 +252,8 @@ World make_indoor_building(uint64_t seed, const IndoorParams& p) {
   auto walk = [&](int k, double xa, double xb) {
     std::vector<int> on;
     for (size_t i = 0; i < rooms.size(); ++i)
-      if (visit[i] && rooms[i].corridor == k && std::min(xa, xb) < rooms[i].door_x && rooms[i].door_x < std::max(xa, xb))
+      if (visit[i] && rooms[i].corridor == k && std::min(xa, xb) < rooms[i].door_x &&
+          rooms[i].door_x < std::max(xa, xb))
         on.push_back(int(i));
     std::sort(on.begin(), on.end(), [&](int a, int b) {
       return xa < xb ? rooms[a].door_x < rooms[b].door_x : rooms[a].door_x > rooms[b].door_x;
@@ -249,7 +277,8 @@ World make_indoor_building(uint64_t seed, const IndoorParams& p) {
       // from the end of corridor k-1 back to the nearest cross corridor, across, then both ways
       const double end = east ? xw : xe;
       double j = cx.empty() ? end : cx[0];
-      for (double c : cx) if (std::abs(c - end) < std::abs(j - end)) j = c;
+      for (double c : cx)
+        if (std::abs(c - end) < std::abs(j - end)) j = c;
       path.push_back({j, cy[k - 1], z});
       path.push_back({j, cy[k], z});
       walk(k, j, east ? xw : xe);
@@ -266,11 +295,12 @@ World make_outdoor_campus(uint64_t seed, const CampusParams& p) {
   const double L = p.length, D = p.width, rw = p.road_width;
   std::vector<Box> boxes;
   boxes.push_back(box(-20, -20, -0.3, L + 20, D + 20, 0));  // ground
-  std::vector<double> ry, rx;                                 // road centre lines
+  std::vector<double> ry, rx;                               // road centre lines
   for (int k = 0; k < p.roads_x; ++k) ry.push_back(6 + (D - 12) * k / std::max(1, p.roads_x - 1));
   for (int j = 0; j < p.roads_y; ++j) rx.push_back(6 + (L - 12) * j / std::max(1, p.roads_y - 1));
   auto near_crossing = [&](double v, const std::vector<double>& crossing) {
-    for (double c : crossing) if (std::abs(v - c) < rw / 2 + 3) return true;
+    for (double c : crossing)
+      if (std::abs(v - c) < rw / 2 + 3) return true;
     return false;
   };
   std::vector<Rect> taken;  // building footprints, for placing trees
@@ -287,7 +317,8 @@ World make_outdoor_campus(uint64_t seed, const CampusParams& p) {
       for (int i = 0; i < n; ++i) {
         const double a0 = (along_x ? x0 : y0) + i * (part + gap);
         const double la = part * rng.uniform(0.6, 1.0), lb = (along_x ? y1 - y0 : x1 - x0) * rng.uniform(0.4, 0.9);
-        const double oa = a0 + rng.uniform(0, part - la), ob = (along_x ? y0 : x0) + rng.uniform(0, (along_x ? y1 - y0 : x1 - x0) - lb);
+        const double oa = a0 + rng.uniform(0, part - la),
+                     ob = (along_x ? y0 : x0) + rng.uniform(0, (along_x ? y1 - y0 : x1 - x0) - lb);
         Rect f = along_x ? Rect{oa, ob, oa + la, ob + lb} : Rect{ob, oa, ob + lb, oa + la};
         const double h = rng.uniform(p.min_building_height, p.max_building_height);
         boxes.push_back(box(f.x0, f.y0, 0, f.x1, f.y1, h));
@@ -336,8 +367,10 @@ World make_outdoor_campus(uint64_t seed, const CampusParams& p) {
       // Body on four wheels (free space under it), 4.5 m x 1.8 m, at the road edge.
       const double o0 = side * (rw / 2 - 2.1), o1 = side * (rw / 2 - 0.3);
       auto car_box = [&](double a_lo, double a_hi, double off_lo, double off_hi, double z0, double z1) {
-        if (along_x) boxes.push_back(box(a_lo, c + off_lo, z0, a_hi, c + off_hi, z1));
-        else boxes.push_back(box(c + off_lo, a_lo, z0, c + off_hi, a_hi, z1));
+        if (along_x)
+          boxes.push_back(box(a_lo, c + off_lo, z0, a_hi, c + off_hi, z1));
+        else
+          boxes.push_back(box(c + off_lo, a_lo, z0, c + off_hi, a_hi, z1));
       };
       car_box(a, a + 4.5, o0, o1, 0.3, 1.5);
       for (double f : {0.5, 3.4})

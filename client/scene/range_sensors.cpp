@@ -23,8 +23,8 @@ double gaussian(uint64_t seed, uint64_t index) {
 }
 
 // Casts one sensor-frame unit direction and appends the noisy return, if any.
-void cast_beam(const Scene& scene, const SensorPose& pose, const Vec3& dir_sensor, double min_range,
-               double max_range, double sigma, uint64_t seed, uint64_t index, std::vector<Vec3>& out) {
+void cast_beam(const Scene& scene, const SensorPose& pose, const Vec3& dir_sensor, double min_range, double max_range,
+               double sigma, uint64_t seed, uint64_t index, std::vector<Vec3>& out) {
   const Vec3 d = sensor_to_map(pose, dir_sensor);
   const double t = cast_ray(scene, pose.position, d, max_range);
   if (!(t >= min_range && t <= max_range)) return;
@@ -46,9 +46,9 @@ void simulate_lidar(const Scene& scene, const SensorPose& pose, const LidarModel
                     std::vector<Vec3>& out) {
   const double deg = M_PI / 180.0;
   for (int b = 0; b < m.beams; ++b) {
-    const double elev =
-        (m.beams == 1 ? 0.5 * (m.elev_min_deg + m.elev_max_deg)
-                      : m.elev_min_deg + (m.elev_max_deg - m.elev_min_deg) * b / (m.beams - 1)) * deg;
+    const double elev = (m.beams == 1 ? 0.5 * (m.elev_min_deg + m.elev_max_deg)
+                                      : m.elev_min_deg + (m.elev_max_deg - m.elev_min_deg) * b / (m.beams - 1)) *
+                        deg;
     const double ce = std::cos(elev), se = std::sin(elev);
     for (int c = 0; c < m.columns; ++c) {
       const double az = 2.0 * M_PI * (c + 0.5) / m.columns;

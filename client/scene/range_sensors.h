@@ -21,11 +21,11 @@ struct SensorPose {
 
 // Spinning multi-beam LiDAR (or a tilting 2D scanner seen as one sweep).
 struct LidarModel {
-  int beams = 32;                 // rows, spread evenly over [elev_min, elev_max]
-  int columns = 1024;             // azimuth steps over 360 degrees
+  int beams = 32;      // rows, spread evenly over [elev_min, elev_max]
+  int columns = 1024;  // azimuth steps over 360 degrees
   double elev_min_deg = -30.0, elev_max_deg = 30.0;
   double min_range = 0.3, max_range = 30.0;
-  double noise_sigma = 0.01;      // [m]
+  double noise_sigma = 0.01;  // [m]
 };
 
 // Structured-light / time-of-flight RGB-D camera (PrimeSense-like by default).

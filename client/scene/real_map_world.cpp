@@ -73,7 +73,8 @@ World make_world_from_octomap(const std::string& map_path, double sensor_height)
   for (auto it = tree->begin_leafs(), end = tree->end_leafs(); it != end; ++it) {
     const double half = 0.5 * it.getSize();
     const int span = std::max(1, int(std::lround(it.getSize() / res)));
-    const int cx = int(std::lround((it.getX() - half - x0) / res)), cy = int(std::lround((it.getY() - half - y0) / res)),
+    const int cx = int(std::lround((it.getX() - half - x0) / res)),
+              cy = int(std::lround((it.getY() - half - y0) / res)),
               cz = int(std::lround((it.getZ() - half - z0) / res));
     if (tree->isNodeOccupied(*it)) {
       for (int z = cz; z < cz + span; ++z)
@@ -82,8 +83,10 @@ World make_world_from_octomap(const std::string& map_path, double sensor_height)
             if (x >= 0 && y >= 0 && z >= 0 && x < g.dims[0] && y < g.dims[1] && z < g.dims[2]) g.set(x, y, z);
     } else if (std::abs(it.getZ() - zs) <= half + 0.3) {
       // a large (pruned) free leaf votes for every lattice cell under it
-      const int lx0 = std::max(0, int((it.getX() - half - x0) / lattice)), lx1 = std::min(nx - 1, int((it.getX() + half - x0) / lattice));
-      const int ly0 = std::max(0, int((it.getY() - half - y0) / lattice)), ly1 = std::min(ny - 1, int((it.getY() + half - y0) / lattice));
+      const int lx0 = std::max(0, int((it.getX() - half - x0) / lattice)),
+                lx1 = std::min(nx - 1, int((it.getX() + half - x0) / lattice));
+      const int ly0 = std::max(0, int((it.getY() - half - y0) / lattice)),
+                ly1 = std::min(ny - 1, int((it.getY() + half - y0) / lattice));
       for (int ly = ly0; ly <= ly1; ++ly)
         for (int lx = lx0; lx <= lx1; ++lx) free_votes[size_t(ly) * nx + lx] += 1;
     }

@@ -12,8 +12,8 @@
 namespace ort {
 
 struct PosedScan {
-  octomap::pose6d pose;         // sensor -> map
-  octomap::Pointcloud points;   // sensor frame
+  octomap::pose6d pose;        // sensor -> map
+  octomap::Pointcloud points;  // sensor frame
 };
 
 struct ScanSet {

@@ -27,10 +27,10 @@ struct Box {
 // crosses, front to back, and stops at the first cell that holds a hit nearer than its exit.
 struct BoxGrid {
   std::vector<Box> boxes;
-  Vec3 lo, hi;                      // grid bounds (the boxes' bounds, padded)
-  double cell = 1.0;                // cell edge length [m]
+  Vec3 lo, hi;        // grid bounds (the boxes' bounds, padded)
+  double cell = 1.0;  // cell edge length [m]
   int dims[3] = {0, 0, 0};
-  std::vector<uint32_t> cell_start; // CSR: boxes of cell c are box_index[cell_start[c] .. cell_start[c+1])
+  std::vector<uint32_t> cell_start;  // CSR: boxes of cell c are box_index[cell_start[c] .. cell_start[c+1])
   std::vector<uint32_t> box_index;
 };
 
@@ -39,8 +39,8 @@ BoxGrid build_box_grid(std::vector<Box> boxes, double cell = 1.0);
 
 // A dense grid of occupied cubes (a real map rasterised at its resolution).
 struct OccupancyGrid {
-  Vec3 lo;                 // corner of cell (0,0,0)
-  double voxel = 0.1;      // cube edge length [m]
+  Vec3 lo;             // corner of cell (0,0,0)
+  double voxel = 0.1;  // cube edge length [m]
   int dims[3] = {0, 0, 0};
   std::vector<uint64_t> bits;  // 1 bit a cell, x fastest
   bool occupied(int x, int y, int z) const {

@@ -140,8 +140,8 @@ ScanSet make_preset(const std::string& name, const PresetOptions& o) {
   const Recipe r = recipe(name, o);
   // Robots share the tour: robot k drives the k-th stretch of it, and their scans arrive
   // interleaved, as a mapping server receiving from a team would see them.
-  const std::vector<SensorPose> along = scene::sample_path(r.world.path, {r.scans, r.sampling.yaw_sweep_rad,
-                                                                          r.sampling.sweep_period_m, r.sampling.pitch_rad});
+  const std::vector<SensorPose> along = scene::sample_path(
+      r.world.path, {r.scans, r.sampling.yaw_sweep_rad, r.sampling.sweep_period_m, r.sampling.pitch_rad});
   std::vector<size_t> order;
   {
     std::vector<std::vector<size_t>> per_robot(r.robots);
@@ -159,8 +159,10 @@ ScanSet make_preset(const std::string& name, const PresetOptions& o) {
     for (size_t i; (i = next++) < order.size();) {
       const SensorPose& pose = along[order[i]];
       pts.clear();
-      if (r.sensor.rgbd) scene::simulate_rgbd(r.world.scene, pose, r.sensor.camera, scan_seed(o.seed, order[i]), pts);
-      else scene::simulate_lidar(r.world.scene, pose, r.sensor.lidar, scan_seed(o.seed, order[i]), pts);
+      if (r.sensor.rgbd)
+        scene::simulate_rgbd(r.world.scene, pose, r.sensor.camera, scan_seed(o.seed, order[i]), pts);
+      else
+        scene::simulate_lidar(r.world.scene, pose, r.sensor.lidar, scan_seed(o.seed, order[i]), pts);
       PosedScan& s = set.scans[i];
       s.pose = octomap::pose6d(pose.position.x, pose.position.y, pose.position.z, 0.0, pose.pitch, pose.yaw);
       s.points.reserve(pts.size());

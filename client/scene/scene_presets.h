@@ -23,16 +23,16 @@ struct PresetOptions {
   double scan_scale = 1.0;   // share of the preset's scans (at least one scan)
   double point_scale = 1.0;  // share of the points per scan (the sensor's rows and columns shrink)
   uint64_t seed = 1;
-  int robots = 0;            // 0: the preset's own number of robots
-  unsigned threads = 0;      // generation threads; 0: all hardware threads
-  std::string data_dir;      // where fr079-real finds octomap_share/geb079.bt
+  int robots = 0;        // 0: the preset's own number of robots
+  unsigned threads = 0;  // generation threads; 0: all hardware threads
+  std::string data_dir;  // where fr079-real finds octomap_share/geb079.bt
 };
 
 struct PresetInfo {
   std::string name;
   std::string description;
-  int scans;                 // at scale 1
-  double points_per_scan;    // the paper's figure it aims at
+  int scans;               // at scale 1
+  double points_per_scan;  // the paper's figure it aims at
 };
 
 const std::vector<PresetInfo>& preset_catalog();

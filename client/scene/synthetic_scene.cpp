@@ -31,9 +31,9 @@ float hit_box(const octomap::point3d& o, const octomap::point3d& d, const Box& b
 // Three rooms off a corridor: 18 m x 10 m x 3 m, walls 0.2 m thick, doors 1 m wide.
 std::vector<Box> rooms() {
   std::vector<Box> b;
-  b.push_back({{-1, -1, -0.2f}, {19, 11, 0}});     // floor
-  b.push_back({{-1, -1, 3}, {19, 11, 3.2f}});      // ceiling
-  b.push_back({{-1, -1, 0}, {19, -0.8f, 3}});      // outer walls
+  b.push_back({{-1, -1, -0.2f}, {19, 11, 0}});  // floor
+  b.push_back({{-1, -1, 3}, {19, 11, 3.2f}});   // ceiling
+  b.push_back({{-1, -1, 0}, {19, -0.8f, 3}});   // outer walls
   b.push_back({{-1, 10.8f, 0}, {19, 11, 3}});
   b.push_back({{-1, -1, 0}, {-0.8f, 11, 3}});
   b.push_back({{18.8f, -1, 0}, {19, 11, 3}});
@@ -42,9 +42,9 @@ std::vector<Box> rooms() {
   b.push_back({{3, 3, 0}, {8, 3.2f, 3}});
   b.push_back({{9, 3, 0}, {14, 3.2f, 3}});
   b.push_back({{15, 3, 0}, {19, 3.2f, 3}});
-  b.push_back({{6, 3.2f, 0}, {6.2f, 11, 3}});      // walls between the rooms
+  b.push_back({{6, 3.2f, 0}, {6.2f, 11, 3}});  // walls between the rooms
   b.push_back({{12, 3.2f, 0}, {12.2f, 11, 3}});
-  b.push_back({{1, 7, 0}, {3, 8, 0.8f}});          // furniture
+  b.push_back({{1, 7, 0}, {3, 8, 0.8f}});  // furniture
   b.push_back({{8, 8, 0}, {9.5f, 10, 1.2f}});
   b.push_back({{14, 5, 0}, {15, 6, 2.0f}});
   b.push_back({{10, 0.5f, 0}, {10.6f, 1.1f, 1.0f}});
@@ -59,7 +59,7 @@ ScanSet make_synthetic_rooms() {
   set.name = "synthetic rooms (built-in)";
   // A 32-beam spinning range sensor, 720 columns, 30 m range, along the corridor and
   // into each room.
-  const float poses[][3] = {{1.0f, 1.5f, 1.2f}, {5.5f, 1.4f, 1.2f}, {2.5f, 6.0f, 1.3f},
+  const float poses[][3] = {{1.0f, 1.5f, 1.2f}, {5.5f, 1.4f, 1.2f},  {2.5f, 6.0f, 1.3f},
                             {9.0f, 6.0f, 1.1f}, {12.5f, 1.6f, 1.2f}, {16.0f, 7.0f, 1.2f}};
   const int beams = 32, columns = 720;
   for (const auto& p : poses) {

@@ -22,15 +22,14 @@ std::string age_text(int64_t then_utime, int64_t now_utime) {
 }
 
 void header(std::ostringstream& o, const Status& s, int64_t now) {
-  o << fmt("%s (pid %d on %s)   state %s   up %s   status #%lld, %s\n", s.server_id.c_str(), s.pid,
-           s.host.c_str(), state_name(s.state).c_str(), duration_text(s.uptime_s).c_str(), (long long)s.seq,
+  o << fmt("%s (pid %d on %s)   state %s   up %s   status #%lld, %s\n", s.server_id.c_str(), s.pid, s.host.c_str(),
+           state_name(s.state).c_str(), duration_text(s.uptime_s).c_str(), (long long)s.seq,
            age_text(s.utime, now).c_str());
   if (!s.message.empty()) o << "  message   " << s.message << "\n";
 }
 
 void engine_and_map(std::ostringstream& o, const Status& s, int64_t now) {
-  o << "  back end  " << s.backend << " on " << s.device
-    << (s.pipelined ? ", pipelined" : ", not pipelined") << "\n";
+  o << "  back end  " << s.backend << " on " << s.device << (s.pipelined ? ", pipelined" : ", not pipelined") << "\n";
   o << fmt("  map       %.3g m, %s nodes, %s leaves, %s; %lld saves, last %s\n", s.resolution,
            with_commas(s.num_nodes).c_str(), with_commas(s.num_leaf_nodes).c_str(), bytes_text(s.memory_bytes).c_str(),
            (long long)s.map_saves, age_text(s.last_save_utime, now).c_str());
@@ -42,8 +41,7 @@ void rates_and_latencies(std::ostringstream& o, const Status& s) {
            rate_text(s.points_per_s).c_str(), with_commas(s.scans_applied).c_str(),
            with_commas(s.points_applied).c_str());
   o << fmt("  latency   p50 / p99 ms: shoot %.1f / %.1f   octree %.1f / %.1f   end to end %.1f / %.1f\n",
-           s.shoot_ms_p50, s.shoot_ms_p99, s.octree_ms_p50, s.octree_ms_p99, s.end_to_end_ms_p50,
-           s.end_to_end_ms_p99);
+           s.shoot_ms_p50, s.shoot_ms_p99, s.octree_ms_p50, s.octree_ms_p99, s.end_to_end_ms_p50, s.end_to_end_ms_p99);
   o << fmt("  overlap   busy: stage 1 %.1f s, stage 2 %.1f s, both %.1f s (%s scans overlapped)\n", s.stage1_busy_s,
            s.stage2_busy_s, s.overlap_busy_s, with_commas(s.overlapped_scans).c_str());
 }
@@ -83,8 +81,7 @@ void robots(std::ostringstream& o, const Status& s, int64_t now) {
     const size_t n = std::min(r.reject_reason.size(), r.reject_count.size());
     if (n == 0) continue;
     o << "    rejected:";
-    for (size_t i = 0; i < n; ++i)
-      o << (i ? ", " : " ") << r.reject_reason[i] << " " << with_commas(r.reject_count[i]);
+    for (size_t i = 0; i < n; ++i) o << (i ? ", " : " ") << r.reject_reason[i] << " " << with_commas(r.reject_count[i]);
     o << "\n";
   }
 }
@@ -94,13 +91,13 @@ void queries(std::ostringstream& o, const Status& s, int64_t now) {
     o << "  queries   none yet (OCTOMAP_RT_QUERY...)\n";
     return;
   }
-  o << fmt("  queries   received %s: answered %s, bad %s, busy %s, not ready %s; dropped %s; edits %s applied, %s "
-           "refused; grids published %s\n",
-           with_commas(s.queries_received).c_str(), with_commas(s.queries_answered).c_str(),
-           with_commas(s.queries_bad).c_str(), with_commas(s.queries_busy).c_str(),
-           with_commas(s.queries_not_ready).c_str(), with_commas(s.queries_dropped).c_str(),
-           with_commas(s.edits_applied).c_str(), with_commas(s.edits_refused).c_str(),
-           with_commas(s.grids_published).c_str());
+  o << fmt(
+      "  queries   received %s: answered %s, bad %s, busy %s, not ready %s; dropped %s; edits %s applied, %s "
+      "refused; grids published %s\n",
+      with_commas(s.queries_received).c_str(), with_commas(s.queries_answered).c_str(),
+      with_commas(s.queries_bad).c_str(), with_commas(s.queries_busy).c_str(), with_commas(s.queries_not_ready).c_str(),
+      with_commas(s.queries_dropped).c_str(), with_commas(s.edits_applied).c_str(),
+      with_commas(s.edits_refused).c_str(), with_commas(s.grids_published).c_str());
   const size_t n = std::min(s.query_refusal_reason.size(), s.query_refusal_count.size());
   if (n) {
     o << "    refused:";

@@ -28,9 +28,12 @@ const char* to_string(BackendKind b) {
 }
 
 bool parse_traversal(const std::string& s, Traversal& out) {
-  if (s == "octomap") out = Traversal::kOctomap;
-  else if (s == "exact") out = Traversal::kExact;
-  else return false;
+  if (s == "octomap")
+    out = Traversal::kOctomap;
+  else if (s == "exact")
+    out = Traversal::kExact;
+  else
+    return false;
   return true;
 }
 

@@ -26,13 +26,13 @@ std::vector<std::string> backend_names();
 
 struct BackendOptions {
   BackendKind kind = BackendKind::kAuto;
-  std::string device;              // Vulkan device: name substring or index; empty = automatic
+  std::string device;  // Vulkan device: name substring or index; empty = automatic
   double resolution = 0.1;
-  double max_range = -1.0;         // sizes the persistent grid; < 0: no limit
-  uint64_t grid_budget_bytes = 0;  // 0: automatic (capped by maxStorageBufferRange)
+  double max_range = -1.0;                    // sizes the persistent grid; < 0: no limit
+  uint64_t grid_budget_bytes = 0;             // 0: automatic (capped by maxStorageBufferRange)
   Traversal traversal = Traversal::kOctomap;  // rt refuses octomap mode at creation, so auto moves on
-  unsigned threads = 0;            // cpu-grid: ray threads, 0 = hardware threads
-  bool gpu_prepare = true;         // vulkan: transform, max-range cut and keys in a shader (gpu/gpu_prepare.h)
+  unsigned threads = 0;                       // cpu-grid: ray threads, 0 = hardware threads
+  bool gpu_prepare = true;  // vulkan: transform, max-range cut and keys in a shader (gpu/gpu_prepare.h)
   // vulkan on a discrete GPU: compaction writes the voxel list straight into host memory,
   // instead of device memory copied back in a submission of its own (one fence wait less a
   // scan: the daemon's choice, whose scans' lists are small; gpu/gpu_ray_space.h).

@@ -86,7 +86,7 @@ class BrickLayout {
   // The key of a word's slot 0, from which its other slots follow by bit operations (the
   // brick's place takes divisions: once a word, not once a voxel).
   struct WordKey {
-    int x, y, z;  // slot 0's key
+    int x, y, z;       // slot 0's key
     bool row = false;  // 16 x 1 x 1 (row by row), else 8 x 2 x 1
     octomap::OcTreeKey voxel(uint32_t slot) const {
       if (row) return octomap::OcTreeKey(octomap::key_type(x + int(slot)), octomap::key_type(y), octomap::key_type(z));
@@ -97,7 +97,8 @@ class BrickLayout {
   WordKey word_key(uint32_t word) const {
     if (rows_) {
       const uint32_t voxel = word * kVoxelsPerWord, in_layer = voxel % layer_;
-      return WordKey{int(in_layer % row_) + w_.lo[0], int(in_layer / row_) + w_.lo[1], int(voxel / layer_) + w_.lo[2], true};
+      return WordKey{int(in_layer % row_) + w_.lo[0], int(in_layer / row_) + w_.lo[1], int(voxel / layer_) + w_.lo[2],
+                     true};
     }
     const uint32_t brick = word >> 4, in_brick = word & 15u;
     const uint32_t bx = brick % nbx_, by = (brick / nbx_) % nby_, bz = brick / (nbx_ * nby_);
@@ -109,7 +110,9 @@ class BrickLayout {
   static uint64_t brick_voxels(const KeyBox& w) {
     return uint64_t(bricks(w, 0)) * bricks(w, 1) * bricks(w, 2) * kVoxelsPerBrick;
   }
-  static uint64_t words_a_row(const KeyBox& w) { return (uint64_t(w.hi[0] - w.lo[0]) + kVoxelsPerWord) / kVoxelsPerWord; }
+  static uint64_t words_a_row(const KeyBox& w) {
+    return (uint64_t(w.hi[0] - w.lo[0]) + kVoxelsPerWord) / kVoxelsPerWord;
+  }
   static uint64_t row_voxels(const KeyBox& w) {
     return words_a_row(w) * kVoxelsPerWord * uint64_t(w.hi[1] - w.lo[1] + 1) * uint64_t(w.hi[2] - w.lo[2] + 1);
   }

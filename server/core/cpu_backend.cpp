@@ -53,8 +53,6 @@ class CpuBackend final : public RayBackend {
 
 }  // namespace
 
-std::unique_ptr<RayBackend> make_cpu_backend(double resolution) {
-  return std::make_unique<CpuBackend>(resolution);
-}
+std::unique_ptr<RayBackend> make_cpu_backend(double resolution) { return std::make_unique<CpuBackend>(resolution); }
 
 }  // namespace ort

@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "core/brick_layout.h"
-#include "core/grid_marker.h"
 #include "core/clock.h"
 #include "core/exact_traversal.h"
+#include "core/grid_marker.h"
 #include "core/octomap_ray_walk.h"
 #include "core/prepare_scan.h"
 #include "core/ray_space.h"
@@ -67,19 +67,43 @@ class GridMemory {
 struct WindowStepper {
   WindowStepper(const BrickLayout& layout, const octomap::OcTreeKey& origin, const octomap::OcTreeKey& end,
                 GridMarker& m)
-      : marker(m), ox(layout.x_offsets()), oy(layout.y_offsets()), oz(layout.z_offsets()),
-        x(origin[0] - layout.window().lo[0]), y(origin[1] - layout.window().lo[1]), z(origin[2] - layout.window().lo[2]),
-        nx(layout.extent(0)), ny(layout.extent(1)), nz(layout.extent(2)),
-        ix(ox[x]), iy(oy[y]), iz(oz[z]),
+      : marker(m),
+        ox(layout.x_offsets()),
+        oy(layout.y_offsets()),
+        oz(layout.z_offsets()),
+        x(origin[0] - layout.window().lo[0]),
+        y(origin[1] - layout.window().lo[1]),
+        z(origin[2] - layout.window().lo[2]),
+        nx(layout.extent(0)),
+        ny(layout.extent(1)),
+        nz(layout.extent(2)),
+        ix(ox[x]),
+        iy(oy[y]),
+        iz(oz[z]),
         end_index(layout.contains(end) ? layout.index(end) : kNoIndex) {}
 
   void start(int a, int b, int c) {
     sx = a, sy = b, sz = c;
     x_out = a > 0 ? nx : -1, y_out = b > 0 ? ny : -1, z_out = c > 0 ? nz : -1;
   }
-  bool step_x() { x += sx; if (x == x_out) return false; ix = ox[x]; return true; }
-  bool step_y() { y += sy; if (y == y_out) return false; iy = oy[y]; return true; }
-  bool step_z() { z += sz; if (z == z_out) return false; iz = oz[z]; return true; }
+  bool step_x() {
+    x += sx;
+    if (x == x_out) return false;
+    ix = ox[x];
+    return true;
+  }
+  bool step_y() {
+    y += sy;
+    if (y == y_out) return false;
+    iy = oy[y];
+    return true;
+  }
+  bool step_z() {
+    z += sz;
+    if (z == z_out) return false;
+    iz = oz[z];
+    return true;
+  }
   bool at_end() const { return index() == end_index; }
   void visit() { marker.mark(index(), kStateFree); }
   uint32_t index() const { return ix + iy + iz; }

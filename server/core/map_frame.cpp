@@ -41,20 +41,22 @@ __attribute__((target("avx2"))) void load4(const float* f, __m128& x, __m128& y,
 }
 __attribute__((target("avx2"))) void store4(float* f, __m128 x, __m128 y, __m128 z) {
   const __m128 xy_lo = _mm_unpacklo_ps(x, y), xy_hi = _mm_unpackhi_ps(x, y);  // x0 y0 x1 y1, x2 y2 x3 y3
-  const __m128 z0x1 = _mm_shuffle_ps(z, xy_lo, _MM_SHUFFLE(2, 2, 0, 0));       // z0 z0 x1 x1
-  const __m128 y1z1 = _mm_shuffle_ps(xy_lo, z, _MM_SHUFFLE(1, 1, 3, 3));       // y1 y1 z1 z1
-  const __m128 z2x3 = _mm_shuffle_ps(z, xy_hi, _MM_SHUFFLE(2, 2, 2, 2));       // z2 z2 x3 x3
-  const __m128 y3z3 = _mm_shuffle_ps(xy_hi, z, _MM_SHUFFLE(3, 3, 3, 3));       // y3 y3 z3 z3
+  const __m128 z0x1 = _mm_shuffle_ps(z, xy_lo, _MM_SHUFFLE(2, 2, 0, 0));      // z0 z0 x1 x1
+  const __m128 y1z1 = _mm_shuffle_ps(xy_lo, z, _MM_SHUFFLE(1, 1, 3, 3));      // y1 y1 z1 z1
+  const __m128 z2x3 = _mm_shuffle_ps(z, xy_hi, _MM_SHUFFLE(2, 2, 2, 2));      // z2 z2 x3 x3
+  const __m128 y3z3 = _mm_shuffle_ps(xy_hi, z, _MM_SHUFFLE(3, 3, 3, 3));      // y3 y3 z3 z3
   _mm_storeu_ps(f, _mm_shuffle_ps(xy_lo, z0x1, _MM_SHUFFLE(2, 0, 1, 0)));
   _mm_storeu_ps(f + 4, _mm_shuffle_ps(y1z1, xy_hi, _MM_SHUFFLE(1, 0, 2, 0)));
   _mm_storeu_ps(f + 8, _mm_shuffle_ps(z2x3, y3z3, _MM_SHUFFLE(2, 0, 2, 0)));
 }
 
 // Points [0, 8 * groups) of xyz into dst: (q * (0, v)) * inv + t, eight points a group.
-__attribute__((target("avx2"))) void apply_avx2(const float* xyz, float* dst, size_t groups, const MapFrameTransform::Quat& q,
-                                                const MapFrameTransform::Quat& inv, const float* t) {
+__attribute__((target("avx2"))) void apply_avx2(const float* xyz, float* dst, size_t groups,
+                                                const MapFrameTransform::Quat& q, const MapFrameTransform::Quat& inv,
+                                                const float* t) {
   const QuatLanes ql = broadcast(q), il = broadcast(inv);
-  const __m256 zero = _mm256_setzero_ps(), tx = _mm256_set1_ps(t[0]), ty = _mm256_set1_ps(t[1]), tz = _mm256_set1_ps(t[2]);
+  const __m256 zero = _mm256_setzero_ps(), tx = _mm256_set1_ps(t[0]), ty = _mm256_set1_ps(t[1]),
+               tz = _mm256_set1_ps(t[2]);
   for (size_t g = 0; g < groups; ++g) {
     const float* f = xyz + 24 * g;
     float* out = dst + 24 * g;

@@ -32,9 +32,12 @@ inline OctomapRayStart octomap_ray_start(const octomap::point3d& origin, const o
   r.length = (float)direction.norm();
   direction /= r.length;
   for (unsigned i = 0; i < 3; ++i) {
-    if (direction(i) > 0.0) r.step[i] = 1;
-    else if (direction(i) < 0.0) r.step[i] = -1;
-    else r.step[i] = 0;
+    if (direction(i) > 0.0)
+      r.step[i] = 1;
+    else if (direction(i) < 0.0)
+      r.step[i] = -1;
+    else
+      r.step[i] = 0;
     if (r.step[i] != 0) {
       double voxel_border = (double((int)key_origin[i] - kTreeMaxVal) + 0.5) * resolution;  // keyToCoord
       voxel_border += (float)(r.step[i] * resolution * 0.5);
@@ -94,20 +97,27 @@ inline void walk_octomap_ray_steps(const octomap::point3d& origin, const octomap
 // but excluding, the end voxel; nothing when both lie in the same voxel.
 template <class FreeVoxel>
 inline void walk_octomap_ray(const octomap::point3d& origin, const octomap::point3d& end,
-                             const octomap::OcTreeKey& key_origin, const octomap::OcTreeKey& key_end,
-                             double resolution, FreeVoxel&& free_voxel) {
+                             const octomap::OcTreeKey& key_origin, const octomap::OcTreeKey& key_end, double resolution,
+                             FreeVoxel&& free_voxel) {
   if (key_origin == key_end) return;
   free_voxel(key_origin);
   struct KeyStepper {
     octomap::OcTreeKey current, end;
     FreeVoxel& f;
     octomap::key_type sx = 0, sy = 0, sz = 0;
-    void start(int x, int y, int z) {
-      sx = octomap::key_type(x), sy = octomap::key_type(y), sz = octomap::key_type(z);
+    void start(int x, int y, int z) { sx = octomap::key_type(x), sy = octomap::key_type(y), sz = octomap::key_type(z); }
+    bool step_x() {
+      current[0] = octomap::key_type(current[0] + sx);
+      return true;
     }
-    bool step_x() { current[0] = octomap::key_type(current[0] + sx); return true; }
-    bool step_y() { current[1] = octomap::key_type(current[1] + sy); return true; }
-    bool step_z() { current[2] = octomap::key_type(current[2] + sz); return true; }
+    bool step_y() {
+      current[1] = octomap::key_type(current[1] + sy);
+      return true;
+    }
+    bool step_z() {
+      current[2] = octomap::key_type(current[2] + sz);
+      return true;
+    }
     bool at_end() const { return current == end; }
     void visit() { f(current); }
   } s{key_origin, key_end, free_voxel};

@@ -4,8 +4,8 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <istream>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -163,7 +163,7 @@ OctreeFileCheck check_octree_file(std::string_view bytes, bool inner_is_max) {
   // OctoMap reads no data for a header size of 0 (.ot and .bt alike).
   if (size > 0) {
     const std::string why = c.format == OctreeFileFormat::kFull ? walk_full(bytes, pos, c.nodes, inner_is_max)
-                                                                  : walk_binary(bytes, pos, c.nodes);
+                                                                : walk_binary(bytes, pos, c.nodes);
     if (!why.empty()) return fail(c, why);
   }
   if (pos != bytes.size())
@@ -193,9 +193,9 @@ std::unique_ptr<octomap::OcTree> read_octree_file_bytes(std::string_view bytes, 
   }
   s.clear();
   if (static_cast<size_t>(s.tellg()) != bytes.size() || tree->size() != c.nodes)
-    throw std::runtime_error(name + ": OctoMap's reader stopped at byte " + std::to_string(static_cast<long long>(s.tellg())) +
-                             " of " + std::to_string(bytes.size()) + " with " + std::to_string(tree->size()) + " of " +
-                             std::to_string(c.nodes) + " nodes");
+    throw std::runtime_error(name + ": OctoMap's reader stopped at byte " +
+                             std::to_string(static_cast<long long>(s.tellg())) + " of " + std::to_string(bytes.size()) +
+                             " with " + std::to_string(tree->size()) + " of " + std::to_string(c.nodes) + " nodes");
   return tree;
 }
 

@@ -25,13 +25,13 @@ enum class OctreeFileFormat { kFull, kBinary };  // .ot, .bt
 
 struct OctreeFileCheck {
   bool ok = false;
-  std::string error;                  // why not (names the byte offset where it helps)
+  std::string error;  // why not (names the byte offset where it helps)
   OctreeFileFormat format = OctreeFileFormat::kFull;
-  std::string tree_type;              // header id ("OcTree")
+  std::string tree_type;  // header id ("OcTree")
   double resolution = 0;
-  uint64_t header_nodes = 0;          // the header's "size"
-  uint64_t nodes = 0;                 // nodes the data holds
-  size_t data_offset = 0;             // first byte after the header
+  uint64_t header_nodes = 0;  // the header's "size"
+  uint64_t nodes = 0;         // nodes the data holds
+  size_t data_offset = 0;     // first byte after the header
 };
 
 // Checks a whole file held in memory. Never throws on any input. With `inner_is_max` (.ot

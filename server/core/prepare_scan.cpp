@@ -11,9 +11,7 @@
 
 namespace ort {
 namespace {
-bool finite(const octomap::point3d& p) {
-  return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z());
-}
+bool finite(const octomap::point3d& p) { return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()); }
 }  // namespace
 
 namespace {
@@ -72,7 +70,8 @@ __attribute__((target("avx2"))) void prepare_points_avx2(const octomap::point3d&
                                                          double resolution, PreparedChunk& out) {
   static_assert(sizeof(octomap::point3d) == 12);
   const size_t groups = max_range < 0.0 ? points.size() / 4 : 0;
-  const __m256d factor = _mm256_set1_pd(1.0 / resolution), low = _mm256_set1_pd(-32768.0), high = _mm256_set1_pd(32768.0);
+  const __m256d factor = _mm256_set1_pd(1.0 / resolution), low = _mm256_set1_pd(-32768.0),
+                high = _mm256_set1_pd(32768.0);
   const __m128i max_val = _mm_set1_epi32(32768);
   __m128i lo[3], hi[3];
   for (int i = 0; i < 3; ++i) lo[i] = _mm_set1_epi32(65536), hi[i] = _mm_set1_epi32(-1);
@@ -82,25 +81,28 @@ __attribute__((target("avx2"))) void prepare_points_avx2(const octomap::point3d&
     const float* f = &points[4 * g](0);
     const __m128 a = _mm_loadu_ps(f), b = _mm_loadu_ps(f + 4), c = _mm_loadu_ps(f + 8);
     // a = x0 y0 z0 x1, b = y1 z1 x2 y2, c = z2 x3 y3 z3
-    const __m128 x = _mm_shuffle_ps(_mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 3, 0, 0)), _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2)),
-                                    _MM_SHUFFLE(2, 0, 2, 0));
-    const __m128 y = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1)), _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3)),
-                                    _MM_SHUFFLE(2, 0, 2, 0));
-    const __m128 z = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)), _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0)),
-                                    _MM_SHUFFLE(2, 0, 2, 0));
+    const __m128 x = _mm_shuffle_ps(_mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 3, 0, 0)),
+                                    _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2)), _MM_SHUFFLE(2, 0, 2, 0));
+    const __m128 y = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1)),
+                                    _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3)), _MM_SHUFFLE(2, 0, 2, 0));
+    const __m128 z = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)),
+                                    _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0)), _MM_SHUFFLE(2, 0, 2, 0));
     const __m128 v[3] = {x, y, z};
     __m128i key[3];
     __m256d ok = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
     for (int i = 0; i < 3; ++i) {
       const __m256d scaled = _mm256_mul_pd(factor, _mm256_cvtps_pd(v[i]));
       // scaled >= -32768 and < 32768 (false for NaN and inf: the finiteness test too).
-      ok = _mm256_and_pd(ok, _mm256_and_pd(_mm256_cmp_pd(scaled, low, _CMP_GE_OQ), _mm256_cmp_pd(scaled, high, _CMP_LT_OQ)));
-      key[i] = _mm_add_epi32(_mm256_cvttpd_epi32(_mm256_round_pd(scaled, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)), max_val);
+      ok = _mm256_and_pd(
+          ok, _mm256_and_pd(_mm256_cmp_pd(scaled, low, _CMP_GE_OQ), _mm256_cmp_pd(scaled, high, _CMP_LT_OQ)));
+      key[i] = _mm_add_epi32(_mm256_cvttpd_epi32(_mm256_round_pd(scaled, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)),
+                             max_val);
     }
     if (_mm256_movemask_pd(ok) != 15) {
       octomap::OcTreeKey k;
       for (size_t j = 4 * g; j < 4 * g + 4; ++j)
-        if (prepare_point(origin, points[j], max_range, resolution, out.report, out.ends[n], k)) out.keys.include(k), ++n;
+        if (prepare_point(origin, points[j], max_range, resolution, out.report, out.ends[n], k))
+          out.keys.include(k), ++n;
       continue;
     }
     for (int i = 0; i < 3; ++i) lo[i] = _mm_min_epi32(lo[i], key[i]), hi[i] = _mm_max_epi32(hi[i], key[i]);
@@ -145,8 +147,8 @@ bool prepare_origin(const octomap::point3d& origin, double resolution, RayBatch&
   return true;
 }
 
-RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::point3d> points,
-                      double max_range, double resolution, PrepareReport& report, unsigned threads, bool simd) {
+RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range,
+                      double resolution, PrepareReport& report, unsigned threads, bool simd) {
   RayBatch batch;
   report.points_in += points.size();
   if (!prepare_origin(origin, resolution, batch, report)) return batch;

@@ -15,22 +15,21 @@ namespace ort {
 // Counts of what preparation did with a scan's points; nothing is dropped uncounted.
 struct PrepareReport {
   uint64_t points_in = 0;
-  uint64_t rays = 0;            // rays handed to the back end
-  uint64_t nonfinite = 0;       // NaN or inf coordinates: skipped
-  uint64_t out_of_range = 0;    // ray end outside the map's key range: skipped (OctoMap does too)
-  uint64_t cut_at_max_range = 0;// longer than max range: cut, free space only
-  bool origin_ok = true;        // false: origin not finite or outside the key range; no rays
-  std::string error;            // set when origin_ok is false
-  bool device_declined = false; // shoot_posed: over PosedPoints' bounds, the device shot nothing (CPU-prepared)
+  uint64_t rays = 0;              // rays handed to the back end
+  uint64_t nonfinite = 0;         // NaN or inf coordinates: skipped
+  uint64_t out_of_range = 0;      // ray end outside the map's key range: skipped (OctoMap does too)
+  uint64_t cut_at_max_range = 0;  // longer than max range: cut, free space only
+  bool origin_ok = true;          // false: origin not finite or outside the key range; no rays
+  std::string error;              // set when origin_ok is false
+  bool device_declined = false;   // shoot_posed: over PosedPoints' bounds, the device shot nothing (CPU-prepared)
 };
 
 // Builds the rays of one scan. Points are in the map frame, as OctoMap's insertPointCloud
 // takes them. max_range < 0 means no limit. Large scans are prepared on `threads` threads
 // (0: hardware threads); the result is the same as on one thread, ray for ray. `simd`: four
 // points at a time in AVX2 lanes where the CPU has it (false: point by point; the same batch).
-RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::point3d> points,
-                      double max_range, double resolution, PrepareReport& report, unsigned threads = 0,
-                      bool simd = true);
+RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range,
+                      double resolution, PrepareReport& report, unsigned threads = 0, bool simd = true);
 
 // The origin's part of prepare_scan: batch.origin, origin_key and the key box's first key,
 // or report.origin_ok = false (with the reason) when the origin is not finite or outside

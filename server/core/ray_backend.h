@@ -20,11 +20,11 @@ namespace ort {
 
 // Wall-clock times of one scan's stages, milliseconds (paper Fig. 6 naming).
 struct StageTimes {
-  double prepare_ms = 0;   // CPU: validate, cut at max range, key box (prepare_scan)
-  double upload_ms = 0;    // CPU -> GPU copy of the rays
-  double shoot_ms = 0;     // ray shooting + 2-bit consistent states
-  double compact_ms = 0;   // compaction of touched words + readback of the voxel list
-  double octree_ms = 0;    // CPU octree update
+  double prepare_ms = 0;  // CPU: validate, cut at max range, key box (prepare_scan)
+  double upload_ms = 0;   // CPU -> GPU copy of the rays
+  double shoot_ms = 0;    // ray shooting + 2-bit consistent states
+  double compact_ms = 0;  // compaction of touched words + readback of the voxel list
+  double octree_ms = 0;   // CPU octree update
   // Parts of compact_ms on the GPU back ends (not added again by total_ms): the compaction
   // pass on the device's clock, the copy of the voxel list into host memory (a submission of
   // its own on discrete GPUs), and the host's copy of it into the scan's VoxelList.
@@ -35,9 +35,14 @@ struct StageTimes {
   // of shoot_ms is the submission and the wait for its fence).
   double shoot_gpu_ms = 0;
   void add(const StageTimes& o) {
-    prepare_ms += o.prepare_ms; upload_ms += o.upload_ms; shoot_ms += o.shoot_ms;
-    compact_ms += o.compact_ms; octree_ms += o.octree_ms;
-    compact_gpu_ms += o.compact_gpu_ms; readback_copy_ms += o.readback_copy_ms; unpack_ms += o.unpack_ms;
+    prepare_ms += o.prepare_ms;
+    upload_ms += o.upload_ms;
+    shoot_ms += o.shoot_ms;
+    compact_ms += o.compact_ms;
+    octree_ms += o.octree_ms;
+    compact_gpu_ms += o.compact_gpu_ms;
+    readback_copy_ms += o.readback_copy_ms;
+    unpack_ms += o.unpack_ms;
     shoot_gpu_ms += o.shoot_gpu_ms;
   }
   double total_ms() const { return prepare_ms + upload_ms + shoot_ms + compact_ms + octree_ms; }
@@ -46,12 +51,12 @@ struct StageTimes {
 // What one shoot() did, for progress output, status and the no-waste tests.
 struct ShootStats {
   StageTimes times;
-  uint64_t windows = 0;          // key-aligned windows the scan needed (>1: ray space > grid)
-  uint64_t words_touched = 0;    // grid words listed as touched (= words read back and cleared)
-  uint64_t words_read_back = 0;  // must equal words_touched: the window is never read whole
-  uint64_t grid_words = 0;       // capacity of the persistent grid, in 32-bit words
-  uint64_t grid_allocations = 0; // grid (re)allocations so far; stays 1 after start-up
-  uint64_t walk_overruns = 0;    // rays stopped by a GPU shader's step guard: 0 on every valid input
+  uint64_t windows = 0;           // key-aligned windows the scan needed (>1: ray space > grid)
+  uint64_t words_touched = 0;     // grid words listed as touched (= words read back and cleared)
+  uint64_t words_read_back = 0;   // must equal words_touched: the window is never read whole
+  uint64_t grid_words = 0;        // capacity of the persistent grid, in 32-bit words
+  uint64_t grid_allocations = 0;  // grid (re)allocations so far; stays 1 after start-up
+  uint64_t walk_overruns = 0;     // rays stopped by a GPU shader's step guard: 0 on every valid input
 };
 
 // One scan as a sensor delivers it: points in the sensor frame, the pose that takes them

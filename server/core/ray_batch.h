@@ -50,10 +50,10 @@ struct KeyBox {
 };
 
 struct RayBatch {
-  octomap::point3d origin;     // sensor origin, map frame (float, as OctoMap keeps it)
+  octomap::point3d origin;  // sensor origin, map frame (float, as OctoMap keeps it)
   octomap::OcTreeKey origin_key;
-  std::vector<RayEnd> ends;    // one ray per entry, from origin to end
-  KeyBox keys;                 // box of the origin key and every end key
+  std::vector<RayEnd> ends;  // one ray per entry, from origin to end
+  KeyBox keys;               // box of the origin key and every end key
   double resolution = 0.1;
   // True where `keys` is known to hold every end key (prepare_scan sets it); false where it may
   // be narrower (a tile's box, MapEngine::shoot_tiled: its rays run on beyond it). Lets the

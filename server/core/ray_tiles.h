@@ -43,7 +43,7 @@ struct RayTile {
 
 struct TilePlan {
   std::vector<RayTile> tiles;
-  uint64_t walk_keys = 0;      // sum over tiles of the walks of their rays: the scan's cost
+  uint64_t walk_keys = 0;  // sum over tiles of the walks of their rays: the scan's cost
 };
 
 // Tiles of `side` keys a side (aligned to multiples of side), each with the rays that may

@@ -44,7 +44,8 @@ std::string check_vector(Reader& r, int32_t marker, const char* what) {
   for (int32_t i = 0; i < marker; ++i) {
     double v = 0;
     if (!r.get(v)) return std::string("the data ends inside a ") + what + at(r);
-    if (std::isfinite(v) && std::abs(v) > FLT_MAX) return std::string("a ") + what + " value exceeds float's range" + at(r);
+    if (std::isfinite(v) && std::abs(v) > FLT_MAX)
+      return std::string("a ") + what + " value exceeds float's range" + at(r);
   }
   return "";
 }
@@ -59,8 +60,8 @@ std::string check_scan(Reader& r, uint64_t index, uint64_t& points, std::unorder
   uint32_t n = 0;
   if (!r.get(n)) return which + ": the data ends before its point count" + at(r);
   if (n > (r.left() - std::min(r.left(), kPoseBytes + 4)) / kVector3Bytes)
-    return which + " claims " + std::to_string(n) + " points but only " + std::to_string(r.left()) +
-           " bytes remain" + at(r) + " (file truncated?)";
+    return which + " claims " + std::to_string(n) + " points but only " + std::to_string(r.left()) + " bytes remain" +
+           at(r) + " (file truncated?)";
   for (uint32_t i = 0; i < n; ++i)
     if (std::string why = check_vector(r, 3, "point"); !why.empty()) return which + ": " + why;
   points += n;
@@ -86,7 +87,8 @@ ScanGraphCheck check_scan_graph(std::string_view bytes) {
   if (!r.get(scans)) return fail(c, "too short for a ScanGraph (" + std::to_string(bytes.size()) + " bytes)");
   if (scans > r.left() / kMinScanBytes)
     return fail(c, "the header claims " + std::to_string(scans) + " scans but " + std::to_string(r.left()) +
-                       " bytes hold at most " + std::to_string(r.left() / kMinScanBytes) + " (file truncated or not a ScanGraph?)");
+                       " bytes hold at most " + std::to_string(r.left() / kMinScanBytes) +
+                       " (file truncated or not a ScanGraph?)");
   std::unordered_set<uint32_t> ids;
   for (uint32_t i = 0; i < scans; ++i) {
     if (std::string why = check_scan(r, i, c.points, ids); !why.empty()) return fail(c, why);

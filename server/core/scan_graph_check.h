@@ -18,7 +18,7 @@ namespace ort {
 
 struct ScanGraphCheck {
   bool ok = false;
-  std::string error;          // why not (names the scan and byte offset)
+  std::string error;  // why not (names the scan and byte offset)
   uint64_t scans = 0, points = 0, edges = 0;
 };
 

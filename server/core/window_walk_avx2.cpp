@@ -37,14 +37,14 @@ constexpr PackTable kPackLanes = [] {
 // BrickLayout::index in lanes: (key - window.lo) per axis -> the voxel's index in the grid
 // (bits 0-2 x & 7, 3-5 y & 7, 6-7 z & 3, then whole bricks).
 __attribute__((target("avx2"))) inline __m256i brick_index(__m256i x, __m256i y, __m256i z, __m256i brick_row,
-                                                          __m256i brick_layer) {
+                                                           __m256i brick_layer) {
   const __m256i seven = _mm256_set1_epi64x(7), three = _mm256_set1_epi64x(3);
-  const __m256i in_brick = _mm256_or_si256(
-      _mm256_or_si256(_mm256_and_si256(x, seven), _mm256_slli_epi64(_mm256_and_si256(y, seven), 3)),
-      _mm256_slli_epi64(_mm256_and_si256(z, three), 6));
-  const __m256i bricks = _mm256_add_epi64(
-      _mm256_add_epi64(_mm256_slli_epi64(_mm256_srli_epi64(x, 3), 8), _mm256_mul_epu32(_mm256_srli_epi64(y, 3), brick_row)),
-      _mm256_mul_epu32(_mm256_srli_epi64(z, 2), brick_layer));
+  const __m256i in_brick =
+      _mm256_or_si256(_mm256_or_si256(_mm256_and_si256(x, seven), _mm256_slli_epi64(_mm256_and_si256(y, seven), 3)),
+                      _mm256_slli_epi64(_mm256_and_si256(z, three), 6));
+  const __m256i bricks = _mm256_add_epi64(_mm256_add_epi64(_mm256_slli_epi64(_mm256_srli_epi64(x, 3), 8),
+                                                           _mm256_mul_epu32(_mm256_srli_epi64(y, 3), brick_row)),
+                                          _mm256_mul_epu32(_mm256_srli_epi64(z, 2), brick_layer));
   return _mm256_add_epi64(in_brick, bricks);
 }
 
@@ -56,9 +56,9 @@ struct alignas(32) StartBlock {
   double t_max[3][4], t_delta[3][4], length[4];
   int64_t step[3][4];
   int64_t index_step[3][4];  // row-by-row layouts: the index's change for a step along each axis
-  int64_t end_index[4];  // the end voxel's index in the grid; -1 (no voxel's) where the end lies outside the window
-  int64_t out[3][4];  // the first coordinate (key - window.lo) outside the window along the step
-  int order[4];       // the rays (places above) that leave the origin voxel; the others are unused
+  int64_t end_index[4];      // the end voxel's index in the grid; -1 (no voxel's) where the end lies outside the window
+  int64_t out[3][4];         // the first coordinate (key - window.lo) outside the window along the step
+  int order[4];              // the rays (places above) that leave the origin voxel; the others are unused
   int count = 0, next = 0;
 };
 
@@ -118,12 +118,13 @@ class RayFeed {
         const __m256d scaled = _mm256_mul_pd(_mm256_set1_pd(1.0 / res_), _mm256_cvtps_pd(e[i]));
         const __m128i floored = _mm256_cvttpd_epi32(_mm256_round_pd(scaled, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
         key[i] = _mm256_sub_epi64(_mm256_cvtepi32_epi64(floored), _mm256_set1_epi64x(lo_minus_max_[i]));
-        inside = _mm256_and_si256(inside, _mm256_andnot_si256(_mm256_cmpgt_epi64(_mm256_setzero_si256(), key[i]),
-                                                              _mm256_cmpgt_epi64(_mm256_set1_epi64x(extent_[i]), key[i])));
+        inside =
+            _mm256_and_si256(inside, _mm256_andnot_si256(_mm256_cmpgt_epi64(_mm256_setzero_si256(), key[i]),
+                                                         _mm256_cmpgt_epi64(_mm256_set1_epi64x(extent_[i]), key[i])));
         at_origin = _mm256_and_si256(at_origin, _mm256_cmpeq_epi64(key[i], _mm256_set1_epi64x(origin_[i])));
       }
-      const __m256i occupied = _mm256_cvtepi32_epi64(_mm_castps_si128(_mm_cmpneq_ps(
-          _mm_and_ps(e[3], _mm_castsi128_ps(_mm_set1_epi32(kRayEndOccupied))), _mm_setzero_ps())));
+      const __m256i occupied = _mm256_cvtepi32_epi64(_mm_castps_si128(
+          _mm_cmpneq_ps(_mm_and_ps(e[3], _mm_castsi128_ps(_mm_set1_epi32(kRayEndOccupied))), _mm_setzero_ps())));
       const __m256i index =
           rows_ ? _mm256_add_epi64(key[0], _mm256_add_epi64(_mm256_mul_epu32(key[1], _mm256_set1_epi64x(stride_[1])),
                                                             _mm256_mul_epu32(key[2], _mm256_set1_epi64x(stride_[2]))))
@@ -138,8 +139,8 @@ class RayFeed {
       block_.count = 0, block_.next = 0;
       for (int bits = walks; bits; bits &= bits - 1) block_.order[block_.count++] = __builtin_ctz(unsigned(bits));
       // Rays that do not walk take a direction that cannot divide by zero; their starts go unused.
-      const __m128 unused = _mm_castsi128_ps(_mm_cmpeq_epi32(
-          _mm_and_si128(_mm_set1_epi32(walks), _mm_setr_epi32(1, 2, 4, 8)), _mm_setzero_si128()));
+      const __m128 unused = _mm_castsi128_ps(
+          _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(walks), _mm_setr_epi32(1, 2, 4, 8)), _mm_setzero_si128()));
       alignas(16) float ends[3][4];
       for (int i = 0; i < 3; ++i) _mm_store_ps(ends[i], _mm_blendv_ps(e[i], _mm_set1_ps(b_.origin(i) + 1.0f), unused));
       compute_starts(ends);
@@ -162,7 +163,8 @@ class RayFeed {
     __m128 d[3];
     for (int i = 0; i < 3; ++i) d[i] = _mm_sub_ps(_mm_load_ps(ends[i]), _mm_set1_ps(b_.origin(i)));
     // norm_sq in float as (x*x + y*y) + z*z, sqrt in double, cast to float.
-    const __m128 norm_sq = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d[0], d[0]), _mm_mul_ps(d[1], d[1])), _mm_mul_ps(d[2], d[2]));
+    const __m128 norm_sq =
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(d[0], d[0]), _mm_mul_ps(d[1], d[1])), _mm_mul_ps(d[2], d[2]));
     const __m128 length = _mm256_cvtpd_ps(_mm256_sqrt_pd(_mm256_cvtps_pd(norm_sq)));
     _mm256_store_pd(block_.length, _mm256_cvtps_pd(length));
     const __m256d max = _mm256_set1_pd(std::numeric_limits<double>::max());
@@ -177,11 +179,11 @@ class RayFeed {
       const __m256i step = _mm256_or_si256(_mm256_and_si256(up64, _mm256_set1_epi64x(1)), down64);
       _mm256_store_si256((__m256i*)block_.step[i], step);
       _mm256_store_si256((__m256i*)block_.index_step[i], _mm256_mul_epi32(step, _mm256_set1_epi64x(stride_[i])));
-      _mm256_store_si256((__m256i*)block_.out[i], _mm256_blendv_epi8(_mm256_set1_epi64x(-1),
-                                                                      _mm256_set1_epi64x(extent_[i]), up64));
+      _mm256_store_si256((__m256i*)block_.out[i],
+                         _mm256_blendv_epi8(_mm256_set1_epi64x(-1), _mm256_set1_epi64x(extent_[i]), up64));
       const __m256d moving = _mm256_castsi256_pd(_mm256_or_si256(up64, down64));
-      const __m256d border = _mm256_blendv_pd(_mm256_set1_pd(border_down_[i]), _mm256_set1_pd(border_up_[i]),
-                                              _mm256_castsi256_pd(up64));
+      const __m256d border =
+          _mm256_blendv_pd(_mm256_set1_pd(border_down_[i]), _mm256_set1_pd(border_up_[i]), _mm256_castsi256_pd(up64));
       const __m256d dir64 = _mm256_cvtps_pd(dir);
       const __m256d t_max = _mm256_div_pd(_mm256_sub_pd(border, _mm256_set1_pd(double(b_.origin(i)))), dir64);
       const __m256d t_delta = _mm256_div_pd(res, _mm256_cvtps_pd(_mm_andnot_ps(sign, dir)));  // fabs in float
@@ -225,7 +227,7 @@ struct LaneState {
   }
   // Lane `lane` (all ones there, zeros elsewhere) starts ray r of block b at the origin voxel.
   __attribute__((target("avx2"), always_inline)) void start(const StartBlock& b, int r, const int64_t* origin,
-                                                             const int64_t& origin_index, __m256d lane) {
+                                                            const int64_t& origin_index, __m256d lane) {
     tx = put(tx, b.t_max[0][r], lane), ty = put(ty, b.t_max[1][r], lane), tz = put(tz, b.t_max[2][r], lane);
     dx = put(dx, b.t_delta[0][r], lane), dy = put(dy, b.t_delta[1][r], lane), dz = put(dz, b.t_delta[2][r], lane);
     length = put(length, b.length[r], lane);
@@ -250,15 +252,15 @@ struct LaneState {
 template <bool kRows, bool kExits>
 __attribute__((target("avx2"))) void walk_lanes(const RayBatch& b, size_t begin, size_t end, const BrickLayout& layout,
                                                 double resolution, GridMarker& marker) {
-  const __m256i brick_row = _mm256_set1_epi64x(layout.brick_row()), brick_layer = _mm256_set1_epi64x(layout.brick_layer());
+  const __m256i brick_row = _mm256_set1_epi64x(layout.brick_row()),
+                brick_layer = _mm256_set1_epi64x(layout.brick_layer());
   const __m256i free_bit = _mm256_set1_epi64x(kStateFree), fifteen = _mm256_set1_epi64x(15);
   const long long* grid = reinterpret_cast<const long long*>(marker.grid);
   RayFeed feed(b, begin, end, layout, resolution, marker);
   const int64_t* origin = feed.origin();
-  const __m256d lane_masks[4] = {_mm256_castsi256_pd(_mm256_setr_epi64x(-1, 0, 0, 0)),
-                                 _mm256_castsi256_pd(_mm256_setr_epi64x(0, -1, 0, 0)),
-                                 _mm256_castsi256_pd(_mm256_setr_epi64x(0, 0, -1, 0)),
-                                 _mm256_castsi256_pd(_mm256_setr_epi64x(0, 0, 0, -1))};
+  const __m256d lane_masks[4] = {
+      _mm256_castsi256_pd(_mm256_setr_epi64x(-1, 0, 0, 0)), _mm256_castsi256_pd(_mm256_setr_epi64x(0, -1, 0, 0)),
+      _mm256_castsi256_pd(_mm256_setr_epi64x(0, 0, -1, 0)), _mm256_castsi256_pd(_mm256_setr_epi64x(0, 0, 0, -1))};
   LaneState L{};
   int live = 0;
   for (int l = 0; l < 4; ++l) {
@@ -269,8 +271,8 @@ __attribute__((target("avx2"))) void walk_lanes(const RayBatch& b, size_t begin,
   }
   alignas(32) uint32_t pending[kPending];
   int n_pending = 0;
-  auto& [tx, ty, tz, dx, dy, dz, length, x, y, z, sx, sy, sz, x_out, y_out, z_out, end_index, active, row_index, index_dx,
-         index_dy, index_dz] = L;
+  auto& [tx, ty, tz, dx, dy, dz, length, x, y, z, sx, sy, sz, x_out, y_out, z_out, end_index, active, row_index,
+         index_dx, index_dy, index_dz] = L;
   while (live > 0) {
     // The scalar walk: x if tx < ty and tx < tz; else y if !(tx < ty) and ty < tz; else z.
     const __m256d x_lt_y = _mm256_cmp_pd(tx, ty, _CMP_LT_OQ), x_lt_z = _mm256_cmp_pd(tx, tz, _CMP_LT_OQ),
@@ -286,17 +288,19 @@ __attribute__((target("avx2"))) void walk_lanes(const RayBatch& b, size_t begin,
     ty = _mm256_add_pd(ty, _mm256_and_pd(step_y, dy));
     tz = _mm256_add_pd(tz, _mm256_andnot_pd(step_xy, dz));
     // Stops: out of the window along the step, at the end voxel, past the length.
-    const __m256i left = kExits ? _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi64(x, x_out), _mm256_cmpeq_epi64(y, y_out)),
-                                                  _mm256_cmpeq_epi64(z, z_out))
-                                : _mm256_setzero_si256();
+    const __m256i left =
+        kExits ? _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi64(x, x_out), _mm256_cmpeq_epi64(y, y_out)),
+                                 _mm256_cmpeq_epi64(z, z_out))
+               : _mm256_setzero_si256();
     // The voxel's index in the grid (BrickLayout::index as bit operations; meaningless in a lane
     // that left the window, which stops on `left`); the end voxel by its index, a bijection of
     // the window's keys (an end outside the window has index -1, no voxel's).
     if constexpr (kRows) {
       // The stepping axis's change: x's where x steps, else y's where y steps, else z's.
-      row_index = _mm256_add_epi64(row_index, _mm256_castpd_si256(_mm256_blendv_pd(
-          _mm256_blendv_pd(_mm256_castsi256_pd(index_dz), _mm256_castsi256_pd(index_dy), step_y),
-          _mm256_castsi256_pd(index_dx), step_x)));
+      row_index = _mm256_add_epi64(
+          row_index, _mm256_castpd_si256(_mm256_blendv_pd(
+                         _mm256_blendv_pd(_mm256_castsi256_pd(index_dz), _mm256_castsi256_pd(index_dy), step_y),
+                         _mm256_castsi256_pd(index_dx), step_x)));
     }
     const __m256i index = kRows ? row_index : brick_index(x, y, z, brick_row, brick_layer);
     const __m256i at_end = _mm256_cmpeq_epi64(index, end_index);
@@ -315,7 +319,8 @@ __attribute__((target("avx2"))) void walk_lanes(const RayBatch& b, size_t begin,
     const int unmarked = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_andnot_si256(is_set, visiting)));
     // Their indices go to `pending` without a branch (a branch on the gathered bits
     // mispredicts on most visits away from the sensor); marked (tested again) when it fills.
-    const __m256i packed = _mm256_permutevar8x32_epi32(index, _mm256_load_si256(reinterpret_cast<const __m256i*>(kPackLanes.control[unmarked])));
+    const __m256i packed = _mm256_permutevar8x32_epi32(
+        index, _mm256_load_si256(reinterpret_cast<const __m256i*>(kPackLanes.control[unmarked])));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(pending + n_pending), _mm256_castsi256_si128(packed));
     n_pending += __builtin_popcount(unsigned(unmarked));
     if (n_pending > kPending - 4) {
@@ -352,7 +357,8 @@ __attribute__((target("avx2"))) bool rays_stay_inside(const RayBatch& b, size_t 
   }
   if (b.keys_hold_ends) {  // the batch's box decides without a pass over the rays
     bool inside = true;
-    for (int i = 0; i < 3; ++i) inside = inside && b.keys.lo[i] >= w.lo[i] + kInsideBy && b.keys.hi[i] <= w.hi[i] - kInsideBy;
+    for (int i = 0; i < 3; ++i)
+      inside = inside && b.keys.lo[i] >= w.lo[i] + kInsideBy && b.keys.hi[i] <= w.hi[i] - kInsideBy;
     return inside;
   }
   __m256i outside = _mm256_setzero_si256();
@@ -365,19 +371,19 @@ __attribute__((target("avx2"))) bool rays_stay_inside(const RayBatch& b, size_t 
       const __m256d scaled = _mm256_mul_pd(_mm256_set1_pd(1.0 / res), _mm256_cvtps_pd(e[i]));
       const __m256i key = _mm256_cvtepi32_epi64(
           _mm256_cvttpd_epi32(_mm256_round_pd(scaled, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)));
-      outside = _mm256_or_si256(outside, _mm256_or_si256(_mm256_cmpgt_epi64(lo[i], key), _mm256_cmpgt_epi64(key, hi[i])));
+      outside =
+          _mm256_or_si256(outside, _mm256_or_si256(_mm256_cmpgt_epi64(lo[i], key), _mm256_cmpgt_epi64(key, hi[i])));
     }
   }
   return _mm256_testz_si256(outside, outside);
 }
 
-
 __attribute__((target("avx2"))) void walk_rays_avx2(const RayBatch& b, size_t begin, size_t end,
-                                                     const BrickLayout& layout, double resolution,
-                                                     GridMarker& marker) {
+                                                    const BrickLayout& layout, double resolution, GridMarker& marker) {
   if (!layout.contains(b.origin_key)) throw std::logic_error("walk_rays_avx2: the origin lies outside the window");
   if (!layout.rows()) return walk_lanes<false, true>(b, begin, end, layout, resolution, marker);
-  if (rays_stay_inside(b, begin, end, layout, resolution)) return walk_lanes<true, false>(b, begin, end, layout, resolution, marker);
+  if (rays_stay_inside(b, begin, end, layout, resolution))
+    return walk_lanes<true, false>(b, begin, end, layout, resolution, marker);
   walk_lanes<true, true>(b, begin, end, layout, resolution, marker);
 }
 

@@ -31,15 +31,15 @@ struct AppliedTiming {
   double octree_ms = 0;      // stage 2 wall time: MapEngine::apply (map lock held)
   double end_to_end_ms = 0;  // receipt by the LCM thread -> applied
   int64_t points = 0;
-  bool overlapped = false;   // its octree update overlapped a shoot of another scan
+  bool overlapped = false;  // its octree update overlapped a shoot of another scan
   ScanWaits waits;
-  StageTimes stage1;         // the engine's parts of stage 1 (prepare, upload, shoot, compact)
+  StageTimes stage1;  // the engine's parts of stage 1 (prepare, upload, shoot, compact)
   Stage2Parts stage2;
   std::string robot_id;
   int64_t seq = 0;
   std::chrono::steady_clock::time_point received;  // by the LCM thread
-  uint64_t voxels = 0;       // voxel updates stage 2 applied (free + occupied)
-  int64_t new_nodes = 0;     // octree nodes the scan added (negative: pruned more than added)
+  uint64_t voxels = 0;                             // voxel updates stage 2 applied (free + occupied)
+  int64_t new_nodes = 0;                           // octree nodes the scan added (negative: pruned more than added)
 };
 
 }  // namespace ort::daemon

@@ -14,15 +14,15 @@ namespace ort::daemon {
 
 // The figures the rule reads, gathered by the server for one status period.
 struct DegradedSignals {
-  std::string save_error;            // "" unless the latest periodic save failed
-  double longest_busy_s = 0;         // the longest a stage has been busy on its current scan
-  double stuck_stage_s = 0;          // <= 0: never called stuck
+  std::string save_error;     // "" unless the latest periodic save failed
+  double longest_busy_s = 0;  // the longest a stage has been busy on its current scan
+  double stuck_stage_s = 0;   // <= 0: never called stuck
   uint64_t queue_bytes = 0, queue_total_budget = 0;
-  double oldest_queued_s = 0;        // age of the oldest queued scan
-  double latency_bound_s = 0;        // <= 0: no bound
-  double e2e_p99_ms = 0;             // end-to-end p99 over the latency window
+  double oldest_queued_s = 0;                     // age of the oldest queued scan
+  double latency_bound_s = 0;                     // <= 0: no bound
+  double e2e_p99_ms = 0;                          // end-to-end p99 over the latency window
   int64_t scans_dropped = 0, scans_rejected = 0;  // totals over all producers
-  int64_t kernel_drops = -1;         // datagrams dropped on the server's socket; < 0: unknown
+  int64_t kernel_drops = -1;                      // datagrams dropped on the server's socket; < 0: unknown
 };
 
 class DegradedTracker {

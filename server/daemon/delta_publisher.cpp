@@ -32,8 +32,7 @@ DeltaPublisher::DeltaPublisher(LcmLoop& loop, DeltaConfig cfg, std::function<int
 DeltaPublisher::~DeltaPublisher() {
   try {
     stop();
-  } catch (...) {
-  }
+  } catch (...) {}
 }
 
 void DeltaPublisher::start(uint64_t version) {

@@ -29,8 +29,8 @@ namespace ort::daemon {
 
 struct DeltaConfig {
   std::string channel = "OCTOMAP_RT_MAP_DELTA";
-  double max_rate_hz = 10;      // <= 0: no deltas
-  bool exact = false;           // every changed leaf with its log-odds, not only class changes
+  double max_rate_hz = 10;  // <= 0: no deltas
+  bool exact = false;       // every changed leaf with its log-odds, not only class changes
   int zstd_level = 3;
   double part_interval_ms = 1.5;  // pacing between the parts of one change set
   std::string server_id;

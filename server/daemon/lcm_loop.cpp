@@ -160,8 +160,7 @@ void LcmLoop::stop() {
 
 bool LcmLoop::drain_lcm() {
   int r;
-  while ((r = lc_.handleTimeout(0)) > 0) {
-  }
+  while ((r = lc_.handleTimeout(0)) > 0) {}
   return r >= 0;
 }
 
@@ -178,7 +177,8 @@ void LcmLoop::run() {
     }
     if (fds[1].revents) {
       uint64_t count = 0;
-      if (::read(wake_fd_, &count, sizeof count) < 0 && errno != EAGAIN) log_ << "octomap-rt-server: eventfd read failed\n";
+      if (::read(wake_fd_, &count, sizeof count) < 0 && errno != EAGAIN)
+        log_ << "octomap-rt-server: eventfd read failed\n";
       std::lock_guard lock(mutex_);
       run_posted();
       if (stopping_) break;

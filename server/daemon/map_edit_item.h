@@ -12,13 +12,13 @@ namespace ort::daemon {
 struct MapEditResult {
   bool ok = false;
   std::string error;
-  uint64_t version = 0;           // map state id right after the edit
+  uint64_t version = 0;  // map state id right after the edit
   int64_t map_utime = 0;
-  int64_t voxels = 0;             // finest voxels of the box
+  int64_t voxels = 0;  // finest voxels of the box
 };
 
 struct MapEditItem {
-  int8_t op = 0;                  // map_edit_t.OP_*
+  int8_t op = 0;  // map_edit_t.OP_*
   double box_min[3] = {0, 0, 0}, box_max[3] = {0, 0, 0};
   // Called by stage 2 after the edit (outside the map lock).
   std::function<void(const MapEditResult&)> done;

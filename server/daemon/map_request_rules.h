@@ -10,14 +10,14 @@ namespace ort::daemon {
 
 enum class RequestRefusal : uint8_t {
   kNone,
-  kUndecodable,       // failed the pre-decode checks (no reply possible)
-  kBadClientId,       // not 1..63 of [A-Za-z0-9_-]
-  kBadReplyChannel,   // not OCTOMAP_RT_MAP_REPLY_<name>
+  kUndecodable,      // failed the pre-decode checks (no reply possible)
+  kBadClientId,      // not 1..63 of [A-Za-z0-9_-]
+  kBadReplyChannel,  // not OCTOMAP_RT_MAP_REPLY_<name>
   kUnknownFormat,
-  kBadChunkIndex,     // negative index in the list
-  kUnknownSnapshot,   // not (or no longer) kept
-  kChunkOutOfRange,   // an index >= num_chunks of that snapshot
-  kBusy,              // the service's request queue was full
+  kBadChunkIndex,    // negative index in the list
+  kUnknownSnapshot,  // not (or no longer) kept
+  kChunkOutOfRange,  // an index >= num_chunks of that snapshot
+  kBusy,             // the service's request queue was full
   kCount
 };
 inline constexpr size_t kRequestRefusalCount = static_cast<size_t>(RequestRefusal::kCount);

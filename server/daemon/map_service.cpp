@@ -23,14 +23,17 @@ int64_t utime_now() {
 
 MapService::MapService(LcmLoop& loop, MapState& map, MapServiceConfig cfg, std::function<int64_t()> last_delta_seq,
                        std::ostream& log)
-    : loop_(loop), map_(map), cfg_(std::move(cfg)), last_delta_seq_(std::move(last_delta_seq)), log_(log),
+    : loop_(loop),
+      map_(map),
+      cfg_(std::move(cfg)),
+      last_delta_seq_(std::move(last_delta_seq)),
+      log_(log),
       store_(cfg_.snapshots) {}
 
 MapService::~MapService() {
   try {
     stop();
-  } catch (...) {
-  }
+  } catch (...) {}
 }
 
 void MapService::open() {
@@ -104,7 +107,8 @@ void MapService::run() {
       lock.unlock();
       publish_info();
       lock.lock();
-      next_info = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg_.info_period_s));
+      next_info =
+          Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg_.info_period_s));
     }
   }
 }
@@ -114,9 +118,9 @@ void MapService::serve(const octomap_rt::map_request_t& req) {
   if (why != RequestRefusal::kNone) return refuse(&req, why, "");
   bool took_new = false;
   // snapshot_id: < 0 a fresh snapshot, 0 the latest kept (maybe older than the map), > 0 that one.
-  std::shared_ptr<const SnapshotBlob> blob =
-      req.snapshot_id <= 0 ? store_.latest(map_, req.format, req.snapshot_id < 0, took_new)
-                           : store_.find(static_cast<uint64_t>(req.snapshot_id), req.format);
+  std::shared_ptr<const SnapshotBlob> blob = req.snapshot_id <= 0
+                                                 ? store_.latest(map_, req.format, req.snapshot_id < 0, took_new)
+                                                 : store_.find(static_cast<uint64_t>(req.snapshot_id), req.format);
   if (!blob)
     return refuse(&req, RequestRefusal::kUnknownSnapshot,
                   "snapshot " + std::to_string(req.snapshot_id) + " is not kept; the latest is " +
@@ -167,7 +171,8 @@ void MapService::send_chunks(const octomap_rt::map_request_t& req, const Snapsho
   std::vector<int32_t> indices = req.chunk_indices;
   if (indices.empty())
     for (int32_t i = 0; i < n; ++i) indices.push_back(i);
-  const auto interval = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::milli>(cfg_.chunk_interval_ms));
+  const auto interval =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::milli>(cfg_.chunk_interval_ms));
   auto next = Clock::now();
   Chunk c{};
   c.request_id = req.request_id;

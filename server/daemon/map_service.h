@@ -33,7 +33,7 @@ struct MapServiceConfig {
   SnapshotPolicy snapshots;
   double chunk_interval_ms = 1.5;  // between two chunks sent (pacing)
   double info_period_s = 1.0;
-  size_t request_queue = 32;       // requests waiting; more are refused as busy
+  size_t request_queue = 32;  // requests waiting; more are refused as busy
   std::string server_id, map_frame = "map";
   double resolution = 0;
   double region_min[3] = {0, 0, 0}, region_max[3] = {0, 0, 0};  // set by the server

@@ -3,17 +3,17 @@
 // scans. Stage 2 holds the lock for one scan's octree update at a time.
 #pragma once
 
-#include <cstdint>
-#include <memory>
 #include <condition_variable>
+#include <cstdint>
 #include <map>
+#include <memory>
 #include <shared_mutex>
 #include <string>
 
 #include <octomap/OcTree.h>
 
-#include "daemon/applied_order.h"
 #include "core/voxel_update.h"
+#include "daemon/applied_order.h"
 #include "octree/leaf_changes.h"
 
 namespace ort::daemon {
@@ -43,7 +43,7 @@ struct MapState {
   // state a query was answered on are this number. A map edit (daemon/map_edit_item.h)
   // also adds 1: the id changes whenever the map does.
   uint64_t version = 0;
-  int64_t last_scan_utime = 0;   // utime of the newest applied scan
+  int64_t last_scan_utime = 0;            // utime of the newest applied scan
   MapChangeObserver* observer = nullptr;  // set before the pipeline starts
   // Newest applied seq per robot (lower-case id), for queries that wait for their own scan.
   std::map<std::string, int64_t> applied_seq;

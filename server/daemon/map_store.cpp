@@ -121,8 +121,8 @@ std::unique_ptr<octomap::OcTree> load_map(const std::string& path, double resolu
   // rounding, and then use the requested value bit for bit.
   if (std::abs(file_res - resolution) > 1e-6 * resolution) {
     std::ostringstream msg;
-    msg << "map '" << path << "' has resolution " << file_res << " m but the server was started with -r "
-        << resolution << "; start with -r " << file_res << " or use another --map file";
+    msg << "map '" << path << "' has resolution " << file_res << " m but the server was started with -r " << resolution
+        << "; start with -r " << file_res << " or use another --map file";
     throw MapStoreError(Kind::kWrongResolution, msg.str());
   }
   if (file_res != resolution) tree->setResolution(resolution);

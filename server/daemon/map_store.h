@@ -22,16 +22,16 @@ namespace ort::daemon {
 class MapStoreError : public std::runtime_error {
  public:
   enum class Kind {
-    kOpen,            // the file cannot be opened
-    kRead,            // reading it failed
-    kCorrupt,         // not a complete OctoMap .ot file (truncated, overwritten, inconsistent)
-    kWrongType,       // an OctoMap file, but not an OcTree
-    kWrongResolution, // an OcTree of another resolution than the server's
-    kWrite,           // creating or writing the temporary file failed (e.g. disk full)
-    kSync,            // fsync of the file or its directory failed
-    kRename,          // the atomic rename failed
-    kNotWritable,     // the start-up probe could not write and sync in the map's directory
-    kSerialize,       // OctoMap could not serialize the map
+    kOpen,             // the file cannot be opened
+    kRead,             // reading it failed
+    kCorrupt,          // not a complete OctoMap .ot file (truncated, overwritten, inconsistent)
+    kWrongType,        // an OctoMap file, but not an OcTree
+    kWrongResolution,  // an OcTree of another resolution than the server's
+    kWrite,            // creating or writing the temporary file failed (e.g. disk full)
+    kSync,             // fsync of the file or its directory failed
+    kRename,           // the atomic rename failed
+    kNotWritable,      // the start-up probe could not write and sync in the map's directory
+    kSerialize,        // OctoMap could not serialize the map
   };
   MapStoreError(Kind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
   Kind kind() const { return kind_; }

@@ -48,7 +48,8 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ost
   const uint64_t largest = 12 * cfg_.max_points + 4096;
   if (queue_.per_producer_budget() < largest)
     throw std::runtime_error("queue budget " + std::to_string(queue_.per_producer_budget() >> 20) +
-                             " MiB per producer cannot hold one scan of --max-points " + std::to_string(cfg_.max_points));
+                             " MiB per producer cannot hold one scan of --max-points " +
+                             std::to_string(cfg_.max_points));
 
   load_or_create_map();  // first: a wrong map file fails before any device is opened
   engine_ = std::make_unique<MapEngine>(cfg_.engine, log_to(log_));
@@ -86,7 +87,8 @@ std::unique_ptr<octomap::OcTree> MappingServer::load_checked_map() {
                                         "; the file is left as it is (start with --move-corrupt-map-aside to keep it "
                                         "under another name and start a new map)");
     const std::string aside = move_map_aside(cfg_.map_path);
-    if (std::filesystem::exists(cfg_.map_path + ".order")) std::filesystem::rename(cfg_.map_path + ".order", aside + ".order");
+    if (std::filesystem::exists(cfg_.map_path + ".order"))
+      std::filesystem::rename(cfg_.map_path + ".order", aside + ".order");
     log_ << "octomap-rt-server: warning: " << e.what() << "; moved it to " << aside << " and starting a new map\n";
     return nullptr;
   }
@@ -133,7 +135,8 @@ void MappingServer::start() {
   pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, log_, cfg_.pipeline,
                                              std::chrono::duration<double>(cfg_.latency_bound_s));
   pipeline_->start();
-  intake_ = std::make_unique<ScanIntake>(*loop_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
+  intake_ =
+      std::make_unique<ScanIntake>(*loop_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
   intake_->open();  // services subscribe before the loop starts: 1.3.1's subscribe races with handle
   map_service_->open();
   queries_ = std::make_unique<QueryService>(cfg_.queries, map_, queue_, *loop_, server_id_, cfg_.engine.resolution);
@@ -196,8 +199,8 @@ void MappingServer::open_map_serving() {
     m.region_min[k] = -half;
     m.region_max[k] = half;
   }
-  map_service_ = std::make_unique<MapService>(*loop_, map_, m, [this] { return deltas_ ? deltas_->last_seq() : -1; },
-                                              log_);
+  map_service_ = std::make_unique<MapService>(
+      *loop_, map_, m, [this] { return deltas_ ? deltas_->last_seq() : -1; }, log_);
 }
 
 bool MappingServer::stop() {
@@ -228,7 +231,8 @@ bool MappingServer::stop() {
       log_ << "octomap-rt-server: error: the final save failed (the previous map file is intact): " << e.what() << "\n";
     }
   }
-  set_state(Status::STATE_STOPPING, final_save_error_.empty() ? "stopped" : "stopped; the final save failed: " + final_save_error_);
+  set_state(Status::STATE_STOPPING,
+            final_save_error_.empty() ? "stopped" : "stopped; the final save failed: " + final_save_error_);
   {
     std::lock_guard lock(state_mutex_);
     status_exit_ = true;
@@ -271,7 +275,8 @@ void MappingServer::save(bool force) {
   std::lock_guard save_lock(save_mutex_);
   const auto t0 = std::chrono::steady_clock::now();
   // Copy under the map lock (a state between two whole scans); serialize and write outside it.
-  std::optional<MapCopy> copy = force ? std::optional<MapCopy>(copy_map(map_)) : copy_map_if_changed(map_, saved_version_);
+  std::optional<MapCopy> copy =
+      force ? std::optional<MapCopy>(copy_map(map_)) : copy_map_if_changed(map_, saved_version_);
   if (!copy) return;
   const std::string bytes = serialize_map(*copy->tree);
   copy->tree.reset();

@@ -56,7 +56,9 @@ class MappingServer {
 
   octomap_rt::server_status_t status();
   std::vector<ProducerStats> producer_stats() const { return producers_.snapshot(); }
-  std::vector<QueryClientStats> query_stats() const { return queries_ ? queries_->stats() : std::vector<QueryClientStats>{}; }
+  std::vector<QueryClientStats> query_stats() const {
+    return queries_ ? queries_->stats() : std::vector<QueryClientStats>{};
+  }
   std::vector<AppliedEntry> applied_order() const { return map_.order.entries(); }
   // Runs f(const OcTree&) under the map lock: a state between two whole scans.
   template <class F>
@@ -96,7 +98,7 @@ class MappingServer {
   PipelineMetrics metrics_;
   std::unique_ptr<ScanIntake> intake_;
   std::unique_ptr<ScanPipeline> pipeline_;
-  std::unique_ptr<QueryService> queries_;      // planners' queries and map edits
+  std::unique_ptr<QueryService> queries_;               // planners' queries and map edits
   std::unique_ptr<OctomapRawPublisher> raw_publisher_;  // the map for LCM viewers (off by default)
   std::unique_ptr<DeltaPublisher> deltas_;
   std::unique_ptr<MapService> map_service_;
@@ -105,7 +107,7 @@ class MappingServer {
   int64_t start_utime_ = 0;
   std::chrono::steady_clock::time_point start_;
 
-  mutable std::mutex state_mutex_;            // state, message, status seq, threads' wake-up
+  mutable std::mutex state_mutex_;  // state, message, status seq, threads' wake-up
   std::condition_variable wake_;
   int8_t state_ = octomap_rt::server_status_t::STATE_STARTING;
   std::string message_;
@@ -115,20 +117,20 @@ class MappingServer {
   std::atomic<size_t> cached_leaves_{0};
   std::atomic<int64_t> cached_nodes_{0}, cached_memory_{0}, cached_version_{0};
   std::chrono::steady_clock::time_point leaves_time_;
-  std::atomic<int64_t> leaves_version_{-1};       // map version of cached_leaves_
-  std::atomic<bool> pipeline_drained_{false};     // set by stop() once the pipeline is joined
+  std::atomic<int64_t> leaves_version_{-1};    // map version of cached_leaves_
+  std::atomic<bool> pipeline_drained_{false};  // set by stop() once the pipeline is joined
   // Maps up to this size have their leaves counted at every status (under ~1.5 ms of the map
   // lock on the dev machine).
   static constexpr size_t kLeafWalkEveryStatus = 65'536;
-  DegradedTracker degraded_;                  // used by the status thread only
+  DegradedTracker degraded_;  // used by the status thread only
   std::thread status_thread_, save_thread_;
 
-  std::mutex save_mutex_;                     // one save at a time
+  std::mutex save_mutex_;  // one save at a time
   uint64_t saved_version_ = UINT64_MAX;
   std::atomic<int64_t> saves_{0}, last_save_utime_{0};
   double max_save_lock_ms_ = 0, last_save_ms_ = 0;
-  std::string final_save_error_;              // "" unless the save at stop failed
-  std::string last_save_error_;               // "" unless the latest periodic save failed (under state_mutex_)
+  std::string final_save_error_;  // "" unless the save at stop failed
+  std::string last_save_error_;   // "" unless the latest periodic save failed (under state_mutex_)
 };
 
 }  // namespace ort::daemon

@@ -44,8 +44,8 @@ StatusInputs MappingServer::gather_status() {
       const octomap::OcTree& t = *map_.tree;
       const auto now = std::chrono::steady_clock::now();
       const int64_t version = static_cast<int64_t>(map_.version);
-      if (version != leaves_version_ && (t.size() <= kLeafWalkEveryStatus || pipeline_drained_ ||
-                                         now - leaves_time_ > std::chrono::seconds(10))) {
+      if (version != leaves_version_ &&
+          (t.size() <= kLeafWalkEveryStatus || pipeline_drained_ || now - leaves_time_ > std::chrono::seconds(10))) {
         cached_leaves_ = t.getNumLeafNodes();
         leaves_time_ = now;
         leaves_version_ = version;
@@ -58,7 +58,8 @@ StatusInputs MappingServer::gather_status() {
     }
     in.map_version = cached_version_;
     in.num_nodes = cached_nodes_;
-    in.num_leaf_nodes = static_cast<int64_t>(std::min<size_t>(cached_leaves_.load(), static_cast<size_t>(cached_nodes_.load())));
+    in.num_leaf_nodes =
+        static_cast<int64_t>(std::min<size_t>(cached_leaves_.load(), static_cast<size_t>(cached_nodes_.load())));
     in.memory_bytes = cached_memory_;
   }
   in.queue_depth = static_cast<int32_t>(queue_.depth());

@@ -32,9 +32,7 @@ std::string kib(size_t bytes) { return std::to_string((bytes + 1023) / 1024) + "
 
 }  // namespace
 
-size_t raw_message_bytes(size_t data_bytes) {
-  return 8 /* fingerprint */ + 8 + 16 * 8 + 4 + data_bytes;
-}
+size_t raw_message_bytes(size_t data_bytes) { return 8 /* fingerprint */ + 8 + 16 * 8 + 4 + data_bytes; }
 
 octomap::OcTree cut_at_depth(const octomap::OcTree& tree, unsigned depth) {
   const unsigned levels = tree.getTreeDepth() - depth;  // levels cut off below `depth`
@@ -74,8 +72,8 @@ RawMap make_raw_map(const octomap::OcTree& tree, int64_t utime, const RawMapOpti
     r.depth = depth;
     if (depth < full_depth)
       r.note = "OCTOMAP map depth-limited to " + std::to_string(depth) + " of " + std::to_string(full_depth) + " (" +
-               metres(tree.getResolution() * double(1u << (full_depth - depth))) + " m voxels): " +
-               kib(r.full_bytes) + " at full depth > cap " + kib(options.max_bytes);
+               metres(tree.getResolution() * double(1u << (full_depth - depth))) + " m voxels): " + kib(r.full_bytes) +
+               " at full depth > cap " + kib(options.max_bytes);
     return r;
   }
   r.depth = 0;

@@ -46,8 +46,7 @@ void OctomapRawPublisher::encode_if_changed() {
   auto copy = copy_map_if_changed(map_, encoded_version_);
   if (!copy) return;
   encoded_version_ = copy->version;
-  const RawMap raw =
-      make_raw_map(*copy->tree, copy->last_scan_utime, RawMapOptions{cfg_.max_bytes, cfg_.min_depth});
+  const RawMap raw = make_raw_map(*copy->tree, copy->last_scan_utime, RawMapOptions{cfg_.max_bytes, cfg_.min_depth});
   encoded_.clear();
   if (raw.message) {
     encoded_.resize(static_cast<size_t>(raw.message->getEncodedSize()));

@@ -84,8 +84,7 @@ size_t ProducerRegistry::producer_for(const std::string& channel, Clock::time_po
     last_arrival_[it->second] = now;
     return it->second;
   }
-  const std::string robot =
-      channel.compare(0, prefix_.size(), prefix_) == 0 ? channel.substr(prefix_.size()) : channel;
+  const std::string robot = channel.compare(0, prefix_.size(), prefix_) == 0 ? channel.substr(prefix_.size()) : channel;
   if (!allowed(robot)) return special_entry(refused_index_, "!", "(not allowed)");
   size_t slot = SIZE_MAX;
   if (slots_used_ < policy_.max_producers) {

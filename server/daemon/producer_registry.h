@@ -26,14 +26,14 @@ namespace ort::daemon {
 
 struct ProducerStats {
   std::string channel;
-  std::string robot_id;        // the channel's suffix (what robot_id must match)
+  std::string robot_id;  // the channel's suffix (what robot_id must match)
   int64_t received = 0, applied = 0, rejected = 0, dropped = 0, missed = 0;
-  int64_t in_flight = 0;       // accepted, not yet applied or rejected
+  int64_t in_flight = 0;  // accepted, not yet applied or rejected
   int64_t points_applied = 0;
   int64_t last_seq = -1, last_utime = 0;
-  bool has_seq = false;        // a valid scan was seen (last_seq is meaningful)
-  int64_t seq_restarts = 0;    // seq went backwards or jumped: the producer restarted (not a gap)
-  int64_t released = 0;        // (released entry only) slots let go after being idle
+  bool has_seq = false;      // a valid scan was seen (last_seq is meaningful)
+  int64_t seq_restarts = 0;  // seq went backwards or jumped: the producer restarted (not a gap)
+  int64_t released = 0;      // (released entry only) slots let go after being idle
   double last_end_to_end_ms = 0;
   std::array<int64_t, kRejectReasonCount> rejects{};
   std::array<int64_t, kRejectReasonCount> drop_reasons{};  // why dropped (queue full, shed, ...)

@@ -83,14 +83,17 @@ std::string validate(const octomap_rt::box_query_t& q, double) {
   return "";
 }
 std::string validate(const octomap_rt::grid_query_t& q, double res) {
-  const double v[] = {q.z_min, q.z_max, q.cell_size, q.window_min[0], q.window_min[1], q.window_max[0], q.window_max[1]};
-  if (!std::all_of(std::begin(v), std::end(v), [](double x) { return std::isfinite(x); })) return "a number is not finite";
+  const double v[] = {q.z_min,         q.z_max,         q.cell_size,    q.window_min[0],
+                      q.window_min[1], q.window_max[0], q.window_max[1]};
+  if (!std::all_of(std::begin(v), std::end(v), [](double x) { return std::isfinite(x); }))
+    return "a number is not finite";
   if (q.z_min > q.z_max) return "z_min > z_max";
   if (q.cell_size < 0) return "cell_size < 0";
   const double k = q.cell_size / res;
   if (q.cell_size > 0 && (std::abs(k - std::round(k)) > 1e-6 || std::round(k) < 1 || k > 32768))
     return "cell_size must be a multiple of the resolution " + std::to_string(res);
-  if (q.use_window && (q.window_min[0] > q.window_max[0] || q.window_min[1] > q.window_max[1])) return "window min > max";
+  if (q.use_window && (q.window_min[0] > q.window_max[0] || q.window_min[1] > q.window_max[1]))
+    return "window min > max";
   return "";
 }
 
@@ -107,8 +110,8 @@ EncodedReplies points(const octomap::OcTree& t, const octomap_rt::occupancy_quer
   return {h.reply_channel, {encode(r)}};
 }
 
-EncodedReplies rays(const octomap::OcTree& t, const octomap_rt::ray_query_t& q, const QueryHeader& h,
-                    const MapStamp& s, const std::string& id) {
+EncodedReplies rays(const octomap::OcTree& t, const octomap_rt::ray_query_t& q, const QueryHeader& h, const MapStamp& s,
+                    const std::string& id) {
   query::RayBatchOptions opt;
   opt.ignore_unknown = q.ignore_unknown != 0;
   opt.max_range = q.max_range;
@@ -234,11 +237,16 @@ EncodedReplies error_reply(const QueryMessage& q, int8_t status, const std::stri
     stamp_reply(m, h, s, id, status, error);
     out.messages.push_back(encode(m));
   };
-  if (std::holds_alternative<octomap_rt::occupancy_query_t>(q)) one(octomap_rt::occupancy_reply_t{});
-  else if (std::holds_alternative<octomap_rt::ray_query_t>(q)) one(octomap_rt::ray_reply_t{});
-  else if (std::holds_alternative<octomap_rt::grid_query_t>(q)) one(octomap_rt::grid_t{});
-  else if (std::get<octomap_rt::box_query_t>(q).mode == Box::MODE_REGION) one(octomap_rt::region_chunk_t{});
-  else one(octomap_rt::box_reply_t{});
+  if (std::holds_alternative<octomap_rt::occupancy_query_t>(q))
+    one(octomap_rt::occupancy_reply_t{});
+  else if (std::holds_alternative<octomap_rt::ray_query_t>(q))
+    one(octomap_rt::ray_reply_t{});
+  else if (std::holds_alternative<octomap_rt::grid_query_t>(q))
+    one(octomap_rt::grid_t{});
+  else if (std::get<octomap_rt::box_query_t>(q).mode == Box::MODE_REGION)
+    one(octomap_rt::region_chunk_t{});
+  else
+    one(octomap_rt::box_reply_t{});
   return out;
 }
 

@@ -11,8 +11,10 @@ std::string reason_key(QueryClients::Count what, const std::string& error) {
   if (what == QueryClients::Count::kNotReady) return "not ready: the awaited map state came after wait_timeout_ms";
   std::string key;
   for (char c : error.substr(0, 120)) {
-    if (!std::isdigit(static_cast<unsigned char>(c))) key += c;
-    else if (key.empty() || key.back() != '#') key += '#';
+    if (!std::isdigit(static_cast<unsigned char>(c)))
+      key += c;
+    else if (key.empty() || key.back() != '#')
+      key += '#';
   }
   return key;
 }
@@ -117,7 +119,8 @@ void print_query_summary(std::ostream& out, const std::vector<QueryClientStats>&
   for (const QueryClientStats& c : clients) {
     out << "    " << c.client_id << ": received " << c.received << ", answered " << c.answered << ", bad " << c.bad
         << ", busy " << c.busy << ", not ready " << c.not_ready << ", dropped " << c.dropped;
-    if (c.edits_applied || c.edits_refused) out << ", edits applied " << c.edits_applied << " refused " << c.edits_refused;
+    if (c.edits_applied || c.edits_refused)
+      out << ", edits applied " << c.edits_applied << " refused " << c.edits_refused;
     if (!c.last_error.empty()) out << " (last: " << c.last_error << ")";
     out << "\n";
   }

@@ -23,8 +23,8 @@
 
 namespace ort::daemon {
 
-using QueryMessage =
-    std::variant<octomap_rt::occupancy_query_t, octomap_rt::ray_query_t, octomap_rt::box_query_t, octomap_rt::grid_query_t>;
+using QueryMessage = std::variant<octomap_rt::occupancy_query_t, octomap_rt::ray_query_t, octomap_rt::box_query_t,
+                                  octomap_rt::grid_query_t>;
 
 struct PendingQuery {
   QueryMessage msg;
@@ -32,12 +32,12 @@ struct PendingQuery {
 };
 
 struct QueryClientStats {
-  std::string client_id;                 // "?": messages that named no usable client
+  std::string client_id;  // "?": messages that named no usable client
   int64_t received = 0, answered = 0, bad = 0, busy = 0, not_ready = 0, dropped = 0;
   int64_t edits_applied = 0, edits_refused = 0;
-  int64_t last_utime = 0;                // when its last message arrived [us since the epoch]
-  int64_t queue_depth = 0;               // queued now (filled by snapshot())
-  std::string reply_channel;             // of its last message
+  int64_t last_utime = 0;     // when its last message arrived [us since the epoch]
+  int64_t queue_depth = 0;    // queued now (filled by snapshot())
+  std::string reply_channel;  // of its last message
   std::string last_error;
 };
 
@@ -73,13 +73,13 @@ class QueryClients {
     QueryClientStats stats;
     std::deque<PendingQuery> queue;
   };
-  Client& at(const std::string& client);  // under mutex_
+  Client& at(const std::string& client);                                 // under mutex_
   void bump(QueryClientStats& s, Count what, const std::string& error);  // under mutex_
 
   mutable std::mutex mutex_;
   size_t per_client_queue_, max_clients_;
   std::map<std::string, Client> clients_;
-  std::string next_;                     // round-robin position: first client after this name
+  std::string next_;  // round-robin position: first client after this name
   size_t queued_ = 0;
   std::map<std::string, int64_t> reasons_;
 };

@@ -11,9 +11,9 @@ namespace ort::daemon {
 
 // The 2D grid published at a rate (daemon/grid_publisher.h).
 struct GridPublishConfig {
-  double rate_hz = 0;              // 0: not published
-  double z_min = 0, z_max = 0;     // the band [m]
-  double cell_size = 0;            // [m]; 0: the resolution; else a multiple of it
+  double rate_hz = 0;           // 0: not published
+  double z_min = 0, z_max = 0;  // the band [m]
+  double cell_size = 0;         // [m]; 0: the resolution; else a multiple of it
   std::string channel = octomap_rt::wire::kGridChannel;
 };
 
@@ -23,10 +23,10 @@ struct QueryServiceConfig {
   std::string boxes_channel = octomap_rt::wire::kQueryBoxesChannel;
   std::string grid_channel = octomap_rt::wire::kQueryGridChannel;
   std::string edit_channel = octomap_rt::wire::kMapEditChannel;
-  std::string control_token;       // "": every edit is refused
-  size_t per_client_queue = 16;    // queued queries per client; more get BUSY
-  size_t max_clients = 256;        // distinct client ids tracked; the rest share "*"
-  int max_wait_ms = 30000;         // longest wait_timeout_ms honoured
+  std::string control_token;     // "": every edit is refused
+  size_t per_client_queue = 16;  // queued queries per client; more get BUSY
+  size_t max_clients = 256;      // distinct client ids tracked; the rest share "*"
+  int max_wait_ms = 30000;       // longest wait_timeout_ms honoured
   GridPublishConfig grid;
 };
 

@@ -39,8 +39,14 @@ int64_t now_us() {
 
 QueryService::QueryService(const QueryServiceConfig& cfg, MapState& map, ScanQueue& scans, LcmLoop& loop,
                            std::string server_id, double resolution)
-    : cfg_(cfg), map_(map), scans_(scans), loop_(loop), server_id_(std::move(server_id)), resolution_(resolution),
-      clients_(cfg.per_client_queue, cfg.max_clients), grids_(cfg.grid, map, loop, server_id_) {}
+    : cfg_(cfg),
+      map_(map),
+      scans_(scans),
+      loop_(loop),
+      server_id_(std::move(server_id)),
+      resolution_(resolution),
+      clients_(cfg.per_client_queue, cfg.max_clients),
+      grids_(cfg.grid, map, loop, server_id_) {}
 
 QueryService::~QueryService() { stop(); }
 
@@ -58,8 +64,8 @@ void QueryService::open() {
   subs_.push_back(loop_.subscribe(cfg_.grid_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
     on_query<grid_query_t>(rb, check_grid_query);
   }));
-  subs_.push_back(loop_.subscribe(cfg_.edit_channel,
-                                  [this](const lcm::ReceiveBuffer& rb, const std::string&) { on_edit(rb); }));
+  subs_.push_back(
+      loop_.subscribe(cfg_.edit_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) { on_edit(rb); }));
 }
 
 QueryServiceStats QueryService::service_stats() const {
@@ -94,8 +100,8 @@ std::string QueryService::check_addressing(const std::string& client, const std:
   for (char c : channel)
     if (!std::isgraph(static_cast<unsigned char>(c))) return "reply_channel may hold only printable characters";
   // Replies must not land on the server's own inputs.
-  for (const std::string* own : {&cfg_.points_channel, &cfg_.rays_channel, &cfg_.boxes_channel, &cfg_.grid_channel,
-                                 &cfg_.edit_channel})
+  for (const std::string* own :
+       {&cfg_.points_channel, &cfg_.rays_channel, &cfg_.boxes_channel, &cfg_.grid_channel, &cfg_.edit_channel})
     if (channel == *own) return "reply_channel is one of the server's request channels";
   if (channel == cfg_.grid.channel) return "reply_channel is the server's grid channel";
   if (channel.rfind(octomap_rt::wire::kScanChannelPrefix, 0) == 0 || channel == octomap_rt::wire::kStatusChannel)
@@ -139,8 +145,8 @@ void QueryService::on_query(const lcm::ReceiveBuffer& rb, std::string (*check)(c
   QueryMessage copy_for_busy = q.msg;
   if (!clients_.push(h.client_id, std::move(q))) {
     publish(error_reply(copy_for_busy, Reply::REPLY_BUSY,
-                        "busy: " + std::to_string(cfg_.per_client_queue) + " queries of this client are queued",
-                        {}, server_id_));
+                        "busy: " + std::to_string(cfg_.per_client_queue) + " queries of this client are queued", {},
+                        server_id_));
     return;
   }
   wake_.notify_one();
@@ -180,10 +186,13 @@ void QueryService::on_edit(const lcm::ReceiveBuffer& rb) {
     loop_.publish(msg.reply_channel, a);
   };
   std::string refuse;
-  if (cfg_.control_token.empty()) refuse = "map edits are off: the server was started without --control-token";
-  else if (msg.token != cfg_.control_token) refuse = "wrong control token";
+  if (cfg_.control_token.empty())
+    refuse = "map edits are off: the server was started without --control-token";
+  else if (msg.token != cfg_.control_token)
+    refuse = "wrong control token";
   int8_t status = Reply::REPLY_REFUSED;
-  if (refuse.empty() && msg.op != Edit::OP_CLEAR_TO_FREE && msg.op != Edit::OP_CLEAR_TO_UNKNOWN && msg.op != Edit::OP_RESET)
+  if (refuse.empty() && msg.op != Edit::OP_CLEAR_TO_FREE && msg.op != Edit::OP_CLEAR_TO_UNKNOWN &&
+      msg.op != Edit::OP_RESET)
     refuse = "unknown op " + std::to_string(msg.op), status = Reply::REPLY_BAD_REQUEST;
   if (refuse.empty() && msg.op != Edit::OP_RESET) {
     for (int a = 0; a < 3 && refuse.empty(); ++a)

@@ -32,7 +32,6 @@
 
 namespace ort::daemon {
 
-
 class QueryService {
  public:
   QueryService(const QueryServiceConfig& cfg, MapState& map, ScanQueue& scans, LcmLoop& loop, std::string server_id,

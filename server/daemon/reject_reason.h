@@ -11,35 +11,35 @@ enum class Reject {
   kNone = 0,
   // Wire-level checks, made on the raw bytes BEFORE the generated decode() runs (decode
   // throws or allocates gigabytes on corrupt lengths; see ../shared/notes/lcm-1.3.1.md §0.8).
-  kTooLarge,            // message larger than the size bound
-  kTruncated,           // shorter than its fixed fields
-  kWrongFingerprint,    // first 8 bytes are not scan_t's fingerprint
-  kNegativeCount,       // num_xyz < 0
-  kCountTooLarge,       // num_xyz above the configured maximum points per scan
-  kCountExceedsData,    // num_xyz (or a string length) needs more bytes than the message has
-  kTrailingBytes,       // the message has more bytes than its counts account for
-  kBadStringLength,     // a string length field < 1 (LCM counts the NUL) or implausibly long
-  kDecodeFailed,        // decode() threw or returned an error despite the checks
+  kTooLarge,          // message larger than the size bound
+  kTruncated,         // shorter than its fixed fields
+  kWrongFingerprint,  // first 8 bytes are not scan_t's fingerprint
+  kNegativeCount,     // num_xyz < 0
+  kCountTooLarge,     // num_xyz above the configured maximum points per scan
+  kCountExceedsData,  // num_xyz (or a string length) needs more bytes than the message has
+  kTrailingBytes,     // the message has more bytes than its counts account for
+  kBadStringLength,   // a string length field < 1 (LCM counts the NUL) or implausibly long
+  kDecodeFailed,      // decode() threw or returned an error despite the checks
   // Content checks on the decoded message.
   kCountNotMultipleOf3,
   kNonFinitePoint,
   kNonFinitePose,
   kZeroQuaternion,
-  kNonUnitQuaternion,   // | |q| - 1 | > 1e-3
-  kBadMaxRange,         // NaN or infinite
+  kNonUnitQuaternion,  // | |q| - 1 | > 1e-3
+  kBadMaxRange,        // NaN or infinite
   kUnknownPointsFrame,
-  kBadRobotId,          // empty, too long, or outside [A-Za-z0-9_-]
-  kRobotIdMismatch,     // robot_id differs from the channel's suffix
-  kOriginOutsideMap,    // sensor origin outside the map's key range (OctoMap skips the scan)
-  kTooManyProducers,    // more scan channels than --max-producers
-  kRobotNotAllowed,     // the channel's robot is not on the --allow-robot list
-  kEngineError,         // the engine threw while shooting or applying this scan
-  kRayTooLong,          // a ray's walk is longer than OctoMap's KeyRay holds (points km away at fine -r)
-  kTooMuchWork,         // the scan's ray walks exceed the per-scan work bound (--max-scan-work)
+  kBadRobotId,        // empty, too long, or outside [A-Za-z0-9_-]
+  kRobotIdMismatch,   // robot_id differs from the channel's suffix
+  kOriginOutsideMap,  // sensor origin outside the map's key range (OctoMap skips the scan)
+  kTooManyProducers,  // more scan channels than --max-producers
+  kRobotNotAllowed,   // the channel's robot is not on the --allow-robot list
+  kEngineError,       // the engine threw while shooting or applying this scan
+  kRayTooLong,        // a ray's walk is longer than OctoMap's KeyRay holds (points km away at fine -r)
+  kTooMuchWork,       // the scan's ray walks exceed the per-scan work bound (--max-scan-work)
   // Why a valid scan was dropped (counted as dropped, not rejected).
-  kQueueFull,           // the producer's queue budget was full on arrival
-  kOverLatencyBound,    // waited in the queue longer than --max-queue-age (overload shedding)
-  kLeftAtShutdown,      // still queued when the drain deadline passed at stop
+  kQueueFull,         // the producer's queue budget was full on arrival
+  kOverLatencyBound,  // waited in the queue longer than --max-queue-age (overload shedding)
+  kLeftAtShutdown,    // still queued when the drain deadline passed at stop
   kCount_
 };
 

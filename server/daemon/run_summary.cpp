@@ -18,13 +18,15 @@ void print_producers(std::ostream& out, const StatusInputs& s) {
     out << line;
     std::string reasons;
     for (size_t k = 0; k < kRejectReasonCount; ++k)
-      if (p.rejects[k]) reasons += std::string(reasons.empty() ? "" : ", ") + to_string(static_cast<Reject>(k)) + " " +
-                                   std::to_string(p.rejects[k]);
+      if (p.rejects[k])
+        reasons += std::string(reasons.empty() ? "" : ", ") + to_string(static_cast<Reject>(k)) + " " +
+                   std::to_string(p.rejects[k]);
     if (!reasons.empty()) out << "      rejected: " << reasons << "\n";
     std::string drops;
     for (size_t k = 0; k < kRejectReasonCount; ++k)
-      if (p.drop_reasons[k]) drops += std::string(drops.empty() ? "" : ", ") + to_string(static_cast<Reject>(k)) + " " +
-                                      std::to_string(p.drop_reasons[k]);
+      if (p.drop_reasons[k])
+        drops += std::string(drops.empty() ? "" : ", ") + to_string(static_cast<Reject>(k)) + " " +
+                 std::to_string(p.drop_reasons[k]);
     if (!drops.empty()) out << "      dropped: " << drops << "\n";
   }
 }
@@ -49,8 +51,7 @@ void print_stages(std::ostream& out, const MetricsSnapshot& m) {
   std::snprintf(line, sizeof line,
                 "  waits:        decode (LCM thread) p50 %.2f ms p99 %.2f ms; queue p50 %.2f ms p99 %.2f ms; hand-off "
                 "to stage 2 p50 %.2f ms p99 %.2f ms\n",
-                m.decode.p50, m.decode.p99, m.queue_wait.p50, m.queue_wait.p99, m.handoff_wait.p50,
-                m.handoff_wait.p99);
+                m.decode.p50, m.decode.p99, m.queue_wait.p50, m.queue_wait.p99, m.handoff_wait.p50, m.handoff_wait.p99);
   out << line;
   std::snprintf(line, sizeof line,
                 "  overlap:      stage 1 busy %.3f s, stage 2 busy %.3f s, both at once %.3f s; %lld of %lld scans "
@@ -63,8 +64,8 @@ void print_stages(std::ostream& out, const MetricsSnapshot& m) {
 // One line a scan: its end-to-end time split into the parts that add up to it.
 void print_slowest(std::ostream& out, const MetricsSnapshot& m) {
   if (m.slowest.empty()) return;
-  out << "  slowest scans (end to end = decode + queue + stage 1 + hand-off + stage 2; of all "
-      << m.scans_applied << " applied):\n";
+  out << "  slowest scans (end to end = decode + queue + stage 1 + hand-off + stage 2; of all " << m.scans_applied
+      << " applied):\n";
   char line[768];
   for (const SlowScan& s : m.slowest) {
     const AppliedTiming& t = s.timing;
@@ -145,7 +146,8 @@ void print_run_summary(std::ostream& out, const RunSummaryInputs& in) {
   print_producers(out, s);
   print_stages(out, s.metrics);
   print_slowest(out, s.metrics);
-  std::snprintf(line, sizeof line, "  map:          %lld nodes (%lld leaves), %.1f MiB in memory, %zu scans applied in total\n",
+  std::snprintf(line, sizeof line,
+                "  map:          %lld nodes (%lld leaves), %.1f MiB in memory, %zu scans applied in total\n",
                 (long long)s.num_nodes, (long long)s.num_leaf_nodes, s.memory_bytes / 1048576.0, in.scans_in_map);
   out << line;
   out << "  kernel UDP drops: " << s.socket_rcvbuf_drops << " on the server's sockets, " << s.kernel_rcvbuf_errors

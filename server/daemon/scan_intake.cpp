@@ -2,16 +2,19 @@
 
 namespace ort::daemon {
 
-ScanIntake::ScanIntake(LcmLoop& loop, std::string channel_regex, const ScanLimits& limits,
-                       ProducerRegistry& producers, ScanQueue& queue, int lcm_queue_capacity)
-    : loop_(loop), regex_(std::move(channel_regex)), limits_(limits), producers_(producers), queue_(queue),
+ScanIntake::ScanIntake(LcmLoop& loop, std::string channel_regex, const ScanLimits& limits, ProducerRegistry& producers,
+                       ScanQueue& queue, int lcm_queue_capacity)
+    : loop_(loop),
+      regex_(std::move(channel_regex)),
+      limits_(limits),
+      producers_(producers),
+      queue_(queue),
       lcm_queue_capacity_(lcm_queue_capacity) {}
 
 ScanIntake::~ScanIntake() {
   try {
     close();
-  } catch (...) {
-  }
+  } catch (...) {}
 }
 
 void ScanIntake::open() {

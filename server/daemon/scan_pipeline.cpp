@@ -104,7 +104,8 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
       log_ << "octomap-rt-server: " << job.shot.shoot.walk_overruns << " ray walks hit the GPU step guard\n";
     }
     if (ok && job.shot.refusal != ShotRefusal::kNone) {
-      reject(item.producer, job.shot.refusal == ShotRefusal::kRayTooLong ? Reject::kRayTooLong : Reject::kTooMuchWork, "");
+      reject(item.producer, job.shot.refusal == ShotRefusal::kRayTooLong ? Reject::kRayTooLong : Reject::kTooMuchWork,
+             "");
       ok = false;
     }
   } catch (const std::exception& e) {

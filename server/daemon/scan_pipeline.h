@@ -24,7 +24,7 @@ struct ShotJob {
   int64_t seq = 0, utime = 0, points = 0;
   Clock::time_point received;
   Clock::time_point shot_at;  // when stage 1 finished it
-  ScanWaits waits;         // decode and queue wait so far; stage 2 adds its hand-off wait
+  ScanWaits waits;            // decode and queue wait so far; stage 2 adds its hand-off wait
   double shoot_ms = 0;
   ShotScan shot;
   std::shared_ptr<MapEditItem> edit;  // set: apply this edit instead of a scan

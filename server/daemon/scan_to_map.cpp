@@ -11,7 +11,8 @@ octomap::pose6d scan_pose(const octomap_rt::scan_t& m) {
   const octomath::Vector3 t(static_cast<float>(m.sensor_position[0]), static_cast<float>(m.sensor_position[1]),
                             static_cast<float>(m.sensor_position[2]));
   const octomath::Quaternion q(static_cast<float>(m.sensor_orientation[0]), static_cast<float>(m.sensor_orientation[1]),
-                               static_cast<float>(m.sensor_orientation[2]), static_cast<float>(m.sensor_orientation[3]));
+                               static_cast<float>(m.sensor_orientation[2]),
+                               static_cast<float>(m.sensor_orientation[3]));
   return octomap::pose6d(t, q);
 }
 
@@ -32,7 +33,8 @@ PosedMessageScan to_posed_scan(const octomap_rt::scan_t& m) {
 }
 
 double effective_max_range(float scan_max_range, double server_max_range) {
-  if (scan_max_range > 0) return server_max_range > 0 ? std::min<double>(scan_max_range, server_max_range) : scan_max_range;
+  if (scan_max_range > 0)
+    return server_max_range > 0 ? std::min<double>(scan_max_range, server_max_range) : scan_max_range;
   return server_max_range;
 }
 

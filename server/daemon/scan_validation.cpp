@@ -53,15 +53,14 @@ Reject check_scan_wire(const uint8_t* data, size_t size, const ScanLimits& limit
   if (size > max_size) return Reject::kTooLarge;
   // scan_t's layout (lcmtypes/octomap_rt_scan_t.lcm): the fixed fields, num_xyz, xyz[], robot_id, map_frame.
   namespace p = protocol;
-  return reject_of(p::check_wire(data, size, octomap_rt::scan_t::getHash(),
-                                  {p::wire_fixed(kScanNumXyzOffset - 8),
-                                   p::wire_count(3 * static_cast<int64_t>(limits.max_points)), p::wire_array(4),
-                                   p::wire_string(kMaxRobotIdLength), p::wire_string(kMaxMapFrameLength)})
-                       .fault);
+  return reject_of(
+      p::check_wire(data, size, octomap_rt::scan_t::getHash(),
+                    {p::wire_fixed(kScanNumXyzOffset - 8), p::wire_count(3 * static_cast<int64_t>(limits.max_points)),
+                     p::wire_array(4), p::wire_string(kMaxRobotIdLength), p::wire_string(kMaxMapFrameLength)})
+          .fault);
 }
 
-Reject check_scan_content(const octomap_rt::scan_t& m, const std::string& expected_robot_id,
-                          const ScanLimits& limits) {
+Reject check_scan_content(const octomap_rt::scan_t& m, const std::string& expected_robot_id, const ScanLimits& limits) {
   if (m.num_xyz % 3 != 0) return Reject::kCountNotMultipleOf3;
   if (!all_finite(m.xyz)) return Reject::kNonFinitePoint;
   for (double v : m.sensor_position) {
@@ -90,8 +89,8 @@ Reject check_scan_content(const octomap_rt::scan_t& m, const std::string& expect
   return Reject::kNone;
 }
 
-Reject validate_scan(const uint8_t* data, size_t size, const std::string& expected_robot_id,
-                     const ScanLimits& limits, octomap_rt::scan_t& out) {
+Reject validate_scan(const uint8_t* data, size_t size, const std::string& expected_robot_id, const ScanLimits& limits,
+                     octomap_rt::scan_t& out) {
   if (Reject r = check_scan_wire(data, size, limits); r != Reject::kNone) return r;
   try {
     const int used = decode_scan(data, size, out);  // = out.decode(), the point array vectorized

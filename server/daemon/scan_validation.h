@@ -16,7 +16,7 @@ namespace ort::daemon {
 
 struct ScanLimits {
   uint64_t max_points = octomap_rt::wire::kDefaultMaxScanPoints;  // per scan; bounds num_xyz before any allocation
-  double resolution = 0.1;          // map resolution: the origin must have a key
+  double resolution = 0.1;                                        // map resolution: the origin must have a key
 };
 
 // Byte offsets in an encoded scan_t (the 8-byte fingerprint included). The .lcm file keeps
@@ -32,8 +32,8 @@ bool valid_robot_id(const std::string& id);
 bool same_robot_id(const std::string& a, const std::string& b);
 
 // Checks `data` and decodes it into `out`. `expected_robot_id` is the channel's suffix.
-Reject validate_scan(const uint8_t* data, size_t size, const std::string& expected_robot_id,
-                     const ScanLimits& limits, octomap_rt::scan_t& out);
+Reject validate_scan(const uint8_t* data, size_t size, const std::string& expected_robot_id, const ScanLimits& limits,
+                     octomap_rt::scan_t& out);
 
 // Wire checks only (no decode): kNone when decode() may run safely.
 Reject check_scan_wire(const uint8_t* data, size_t size, const ScanLimits& limits);

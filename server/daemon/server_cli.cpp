@@ -22,7 +22,8 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                "new map (default: refuse to start)");
   app.add_option("--save-interval", s.save_interval_s, "seconds between periodic saves; 0: only at exit")
       ->capture_default_str();
-  app.add_option("--applied-log", s.applied_log, "also append each applied scan's (robot, seq) to this file as it happens");
+  app.add_option("--applied-log", s.applied_log,
+                 "also append each applied scan's (robot, seq) to this file as it happens");
   app.add_option("--lcm-url", s.lcm_url,
                  std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + octomap_rt::wire::kDefaultLcmUrl +
                      "); udpm URLs get recv_buf_size=min(--recv-buf-size, net.core.rmem_max) unless they set it");
@@ -41,10 +42,11 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                  "size cap of one octomap.raw_t [KiB]; a larger map is sent depth-limited, or not at all (said in "
                  "the status); default: 90 % of net.core.rmem_default");
   app.add_flag("--no-pipeline", f.no_pipeline, "run the GPU and CPU stages on one thread, one scan after another");
-  app.add_option("--warm-up-points", s.warm_up_points,
-                 "points of the synthetic scan shot and applied to a scratch tree at start-up, so the first scans "
-                 "pay no one-time costs (buffers sized, threads started); at most --max-points; the map is untouched; 0: "
-                 "no warm-up")
+  app.add_option(
+         "--warm-up-points", s.warm_up_points,
+         "points of the synthetic scan shot and applied to a scratch tree at start-up, so the first scans "
+         "pay no one-time costs (buffers sized, threads started); at most --max-points; the map is untouched; 0: "
+         "no warm-up")
       ->capture_default_str();
   app.add_option("--server-id", s.server_id, "name in status messages (default octomap-rt-server@HOST)");
   app.add_option("--queue-mib", f.queue_mib,
@@ -122,8 +124,9 @@ void add_grid_flags(CLI::App& app, GridPublishConfig& g) {
       ->check(CLI::Range(0.0, 50.0))
       ->needs(z)
       ->capture_default_str();
-  app.add_option("--grid-cell", g.cell_size, "cell size of the published grid [m], a multiple of the resolution; 0: "
-                                             "the resolution")
+  app.add_option("--grid-cell", g.cell_size,
+                 "cell size of the published grid [m], a multiple of the resolution; 0: "
+                 "the resolution")
       ->capture_default_str();
 }
 
@@ -149,7 +152,8 @@ ServerConfig to_server_config(const ServerFlags& f) {
   c.octomap_raw.max_bytes = static_cast<size_t>(f.octomap_raw_max_kib * 1024.0);
   if (!(c.status_period_s > 0 && c.status_period_s < 1e6))
     throw CLI::ValidationError("--status-period", "must be a number of seconds > 0");
-  if (!std::isfinite(c.save_interval_s)) throw CLI::ValidationError("--save-interval", "must be a finite number of seconds");
+  if (!std::isfinite(c.save_interval_s))
+    throw CLI::ValidationError("--save-interval", "must be a finite number of seconds");
   if (c.max_points == 0) throw CLI::ValidationError("--max-points", "must be > 0");
   if (c.max_producers == 0) throw CLI::ValidationError("--max-producers", "must be > 0");
   if (c.snapshot_zstd_level < 0 || c.snapshot_zstd_level > 19)
@@ -162,8 +166,9 @@ ServerConfig to_server_config(const ServerFlags& f) {
     if (const std::string bad = validate_query(QueryMessage(q), c.engine.resolution); !bad.empty())
       throw CLI::ValidationError("--grid-z/--grid-cell", bad);
   }
-  for (const auto& [value, name] : {std::pair{c.latency_bound_s, "--latency-bound"}, std::pair{c.drain_timeout_s, "--drain-timeout"},
-                                    std::pair{c.stuck_stage_s, "--stuck-stage"}})
+  for (const auto& [value, name] :
+       {std::pair{c.latency_bound_s, "--latency-bound"}, std::pair{c.drain_timeout_s, "--drain-timeout"},
+        std::pair{c.stuck_stage_s, "--stuck-stage"}})
     if (!(value >= 0 && value <= 1e6)) throw CLI::ValidationError(name, "must be a number of seconds in [0, 1e6]");
   if (!std::isfinite(c.producer_idle_release_s))
     throw CLI::ValidationError("--producer-idle-release", "must be a finite number of seconds");

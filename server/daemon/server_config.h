@@ -14,47 +14,47 @@ namespace ort::daemon {
 
 // The map for LCM's OctoMap viewers (octomap.raw_t; daemon/octomap_raw_publisher.h).
 struct OctomapRawConfig {
-  double rate_hz = 0;              // 0: off
+  double rate_hz = 0;  // 0: off
   std::string channel = "OCTOMAP";
-  size_t max_bytes = 0;            // whole message; 0: octomap_raw_default_cap()
-  unsigned min_depth = 10;         // coarsest depth-limited map sent before giving up
+  size_t max_bytes = 0;     // whole message; 0: octomap_raw_default_cap()
+  unsigned min_depth = 10;  // coarsest depth-limited map sent before giving up
 };
 
 struct ServerConfig {
-  EngineOptions engine;                        // resolution, sensor model, max range, back end
-  std::string lcm_url;                         // "": $LCM_DEFAULT_URL, else host-local udpm
-  uint64_t recv_buf_size = 16u << 20;          // udpm receive buffer wanted (capped by rmem_max)
+  EngineOptions engine;                                             // resolution, sensor model, max range, back end
+  std::string lcm_url;                                              // "": $LCM_DEFAULT_URL, else host-local udpm
+  uint64_t recv_buf_size = 16u << 20;                               // udpm receive buffer wanted (capped by rmem_max)
   std::string scan_channels = octomap_rt::wire::kScanChannelRegex;  // regex; its literal prefix + robot id
   std::string status_channel = octomap_rt::wire::kStatusChannel;
-  std::string map_path;                        // .ot; "": no persistence
-  bool move_corrupt_map_aside = false;         // corrupt map: keep it as FILE.corrupt-<time>, start anew
-  std::string applied_log;                     // live applied-order log; "": none
-  double save_interval_s = 30;                 // <= 0: save only at exit
+  std::string map_path;                 // .ot; "": no persistence
+  bool move_corrupt_map_aside = false;  // corrupt map: keep it as FILE.corrupt-<time>, start anew
+  std::string applied_log;              // live applied-order log; "": none
+  double save_interval_s = 30;          // <= 0: save only at exit
   double status_period_s = 1.0;
-  bool pipeline = true;                        // false: both stages on one thread
+  bool pipeline = true;  // false: both stages on one thread
   // Points of the synthetic scan the engine shoots and applies to a scratch tree before the
   // intake opens (engine/engine_warm_up.h), so the first scans pay no one-time costs; 0: none.
   // Default: one VGA depth image (640 x 480).
   size_t warm_up_points = 640 * 480;
-  std::string server_id;                       // "": octomap-rt-server@<host>
-  uint64_t queue_budget_bytes = 0;             // per producer; 0: automatic_queue_budget()
+  std::string server_id;                                          // "": octomap-rt-server@<host>
+  uint64_t queue_budget_bytes = 0;                                // per producer; 0: automatic_queue_budget()
   uint64_t max_points = octomap_rt::wire::kDefaultMaxScanPoints;  // per scan
   size_t max_producers = 64;
-  double producer_idle_release_s = 600;        // an idle producer's slot goes to a new robot; <= 0: never
-  std::vector<std::string> allowed_robots;     // --allow-robot; empty: any valid robot id
-  int lcm_queue_capacity = 64;                 // LCM's own per-subscription queue (messages)
+  double producer_idle_release_s = 600;     // an idle producer's slot goes to a new robot; <= 0: never
+  std::vector<std::string> allowed_robots;  // --allow-robot; empty: any valid robot id
+  int lcm_queue_capacity = 64;              // LCM's own per-subscription queue (messages)
   OctomapRawConfig octomap_raw;
   // Serving the map (docs/PROTOCOL.md).
   std::string map_request_channel = "OCTOMAP_RT_MAP_REQUEST";
   std::string map_info_channel = "OCTOMAP_RT_MAP_INFO";
   std::string map_delta_channel = "OCTOMAP_RT_MAP_DELTA";
-  int snapshot_zstd_level = 3;                 // 0: snapshots uncompressed
-  size_t snapshots_kept = 4;                   // for re-sends of chunks
-  double snapshot_min_interval_s = 0.5;        // a new snapshot at most this often
-  double chunk_interval_ms = 1.5;              // pacing of snapshot chunks and delta parts
-  double delta_rate_hz = 10;                   // most change sets a second; <= 0: no deltas
-  bool delta_exact = false;                    // deltas carry every changed leaf's log-odds
-  QueryServiceConfig queries;                  // queries and map edits (daemon/query_service.h)
+  int snapshot_zstd_level = 3;           // 0: snapshots uncompressed
+  size_t snapshots_kept = 4;             // for re-sends of chunks
+  double snapshot_min_interval_s = 0.5;  // a new snapshot at most this often
+  double chunk_interval_ms = 1.5;        // pacing of snapshot chunks and delta parts
+  double delta_rate_hz = 10;             // most change sets a second; <= 0: no deltas
+  bool delta_exact = false;              // deltas carry every changed leaf's log-odds
+  QueryServiceConfig queries;            // queries and map edits (daemon/query_service.h)
   // Overload: a scan that waited longer than this in the queue is dropped ("over latency
   // bound") instead of applied late, and the status is DEGRADED while the end-to-end p99
   // exceeds it. <= 0: never shed.

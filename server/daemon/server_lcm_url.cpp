@@ -38,7 +38,8 @@ LcmUrlChoice choose_lcm_url(const std::string& requested, uint64_t wanted, int64
                 std::to_string(rmem_max) + " bytes, below the " + std::to_string(asked) +
                 " wanted. Multi-MB scans from several robots can then be lost whole (they show up as "
                 "kernel_rcvbuf_errors and scans_missed in the status). Raise it on this host with:\n"
-                "    sudo sysctl -w net.core.rmem_max=" + std::to_string(asked) +
+                "    sudo sysctl -w net.core.rmem_max=" +
+                std::to_string(asked) +
                 "\n  (persist it in /etc/sysctl.d/; inside a network namespace the host's value applies)";
   }
   return c;

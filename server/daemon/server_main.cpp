@@ -60,8 +60,9 @@ void watch_signals(ort::daemon::MappingServer& server, sigset_t sigs, Clock::tim
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"octomap-rt-server: LCM mapping daemon. Robots publish octomap_rt::scan_t on "
-               "OCTOMAP_RT_SCAN_<ROBOT>; status goes to OCTOMAP_RT_STATUS (watch it with tools/octomap-rt-spy)."};
+  CLI::App app{
+      "octomap-rt-server: LCM mapping daemon. Robots publish octomap_rt::scan_t on "
+      "OCTOMAP_RT_SCAN_<ROBOT>; status goes to OCTOMAP_RT_STATUS (watch it with tools/octomap-rt-spy)."};
   ort::daemon::ServerFlags flags;
   ort::daemon::add_server_flags(app, flags);
   ort::daemon::ServerConfig cfg;
@@ -86,13 +87,13 @@ int main(int argc, char** argv) {
     std::cerr << "octomap-rt-server: listening on " << server.lcm_url() << " for " << cfg.scan_channels
               << "; status on " << cfg.status_channel << "; pid " << ::getpid() << "\n";
     int sig = 0;
-    while (sigwait(&sigs, &sig) != 0) {
-    }
+    while (sigwait(&sigs, &sig) != 0) {}
     if (sig == SIGQUIT) exit_now(server, sig);
     std::cerr << "octomap-rt-server: " << signal_name(sig) << ": stopping intake, applying queued scans for at most "
               << cfg.drain_timeout_s << " s, saving\n";
-    watch_signals(server, sigs, Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                   std::chrono::duration<double>(cfg.drain_timeout_s)));
+    watch_signals(
+        server, sigs,
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.drain_timeout_s)));
     const bool saved = server.stop();
     server.print_summary(std::cout);
     std::cout.flush();

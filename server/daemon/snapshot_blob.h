@@ -21,16 +21,16 @@ struct SnapshotContents {
   int64_t map_utime = 0;
   double bbox_min[3] = {0, 0, 0}, bbox_max[3] = {0, 0, 0};
   std::vector<std::pair<std::string, int64_t>> producer_last_seq;  // robot id, newest seq in it
-  double copy_lock_ms = 0;  // how long taking the copy held the map lock
+  double copy_lock_ms = 0;                                         // how long taking the copy held the map lock
 };
 
 struct SnapshotBlob {
   SnapshotContents contents;
-  int8_t format = 0;        // map_chunk_t::FORMAT_*
-  int8_t compression = 0;   // map_chunk_t::COMPRESSION_*
+  int8_t format = 0;       // map_chunk_t::FORMAT_*
+  int8_t compression = 0;  // map_chunk_t::COMPRESSION_*
   int64_t raw_size = 0;
-  std::string bytes;        // compressed
-  int64_t hash = 0;         // protocol::blob_hash(bytes)
+  std::string bytes;  // compressed
+  int64_t hash = 0;   // protocol::blob_hash(bytes)
   double serialize_ms = 0, compress_ms = 0;
   int32_t num_chunks(size_t chunk_bytes) const {
     return static_cast<int32_t>((bytes.size() + chunk_bytes - 1) / chunk_bytes);

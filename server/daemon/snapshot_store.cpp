@@ -56,7 +56,8 @@ std::shared_ptr<const SnapshotBlob> SnapshotStore::blob_of(Entry& e, int8_t form
   if (format < 1 || format > 2) throw std::invalid_argument("unknown snapshot format");
   if (!e.blob[format]) {
     if (!e.tree) return nullptr;
-    e.blob[format] = std::make_shared<const SnapshotBlob>(make_snapshot_blob(*e.tree, e.contents, format, policy_.zstd_level));
+    e.blob[format] =
+        std::make_shared<const SnapshotBlob>(make_snapshot_blob(*e.tree, e.contents, format, policy_.zstd_level));
     last_made_ = e.blob[format];
   }
   return e.blob[format];

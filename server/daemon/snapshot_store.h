@@ -16,9 +16,9 @@
 namespace ort::daemon {
 
 struct SnapshotPolicy {
-  size_t kept = 4;                 // snapshots kept for re-sends
-  int zstd_level = 3;              // 0: uncompressed
-  double min_interval_s = 0.5;     // a new snapshot at most this often, however many ask
+  size_t kept = 4;              // snapshots kept for re-sends
+  int zstd_level = 3;           // 0: uncompressed
+  double min_interval_s = 0.5;  // a new snapshot at most this often, however many ask
 };
 
 class SnapshotStore {
@@ -43,7 +43,7 @@ class SnapshotStore {
  private:
   struct Entry {
     SnapshotContents contents;
-    std::unique_ptr<octomap::OcTree> tree;  // newest only
+    std::unique_ptr<octomap::OcTree> tree;        // newest only
     std::shared_ptr<const SnapshotBlob> blob[3];  // by format (1: .bt, 2: .ot)
   };
   std::shared_ptr<const SnapshotBlob> blob_of(Entry& e, int8_t format);

@@ -37,7 +37,8 @@ bool automatic_device_is_cpu(const BackendOptions& opts) {
 std::unique_ptr<RayBackend> make_backend(const BackendOptions& opts, const Log& log) {
   switch (opts.kind) {
     case BackendKind::kCpu: return make_cpu_backend(opts.resolution);
-    case BackendKind::kCpuGrid: return make_cpu_grid_backend({opts.resolution, opts.grid_budget_bytes, opts.threads, true, opts.helpers_yield});
+    case BackendKind::kCpuGrid:
+      return make_cpu_grid_backend({opts.resolution, opts.grid_budget_bytes, opts.threads, true, opts.helpers_yield});
     case BackendKind::kVulkan: return make_vulkan_backend(opts, log);
     case BackendKind::kRt: return make_rt_backend(opts, log);
     case BackendKind::kAuto: break;
@@ -49,8 +50,9 @@ std::unique_ptr<RayBackend> make_backend(const BackendOptions& opts, const Log& 
   }
   try {
     if (automatic_device_is_cpu(opts)) {
-      log.info("vulkan back end not used: the Vulkan device is a CPU implementation; using cpu-grid (the native "
-               "walk on the same cores)");
+      log.info(
+          "vulkan back end not used: the Vulkan device is a CPU implementation; using cpu-grid (the native "
+          "walk on the same cores)");
       return make_cpu_grid_backend({opts.resolution, opts.grid_budget_bytes, opts.threads, true, opts.helpers_yield});
     }
     return make_vulkan_backend(opts, log);

@@ -5,11 +5,9 @@
 namespace ort::cli {
 
 void add_engine_flags(CLI::App& cmd, EngineFlags& f, bool require_resolution) {
-  auto* r = cmd.add_option("-r,--resolution", f.resolution, "voxel edge length [m]")
-                ->check(CLI::PositiveNumber);
+  auto* r = cmd.add_option("-r,--resolution", f.resolution, "voxel edge length [m]")->check(CLI::PositiveNumber);
   if (require_resolution) r->required();
-  cmd.add_option("--max-range", f.max_range, "cut rays longer than this [m]; < 0: no limit")
-      ->capture_default_str();
+  cmd.add_option("--max-range", f.max_range, "cut rays longer than this [m]; < 0: no limit")->capture_default_str();
   cmd.add_option("--backend", f.backend,
                  "ray shooting: auto, cpu (OctoMap's own walk, the reference), cpu-grid (native threads "
                  "into the 2-bit grid), vulkan (compute shaders) or rt (ray-tracing pipeline: --traversal exact "
@@ -24,7 +22,8 @@ void add_engine_flags(CLI::App& cmd, EngineFlags& f, bool require_resolution) {
   cmd.add_option("--octree", f.octree, "octree stage: sequential (updateNode loop) or batched")
       ->check(CLI::IsMember({"sequential", "batched"}))
       ->capture_default_str();
-  cmd.add_option("--threads", f.threads, "threads of the CPU stages (octree, cpu-grid rays); 0: all hardware threads")->capture_default_str();
+  cmd.add_option("--threads", f.threads, "threads of the CPU stages (octree, cpu-grid rays); 0: all hardware threads")
+      ->capture_default_str();
   cmd.add_option("--prob-hit", f.sensor.prob_hit, "sensor model: P(occupied | hit)")->capture_default_str();
   cmd.add_option("--prob-miss", f.sensor.prob_miss, "sensor model: P(occupied | miss)")->capture_default_str();
   cmd.add_option("--clamp-min", f.sensor.clamping_min, "sensor model: lower clamping probability")
@@ -45,7 +44,8 @@ EngineOptions to_engine_options(const EngineFlags& f) {
     throw CLI::ValidationError("--max-range", "must be a finite number of metres (< 0: no limit)");
   o.resolution = f.resolution;
   o.max_range = f.max_range;
-  if (!parse_backend(f.backend, o.backend.kind)) throw CLI::ValidationError("--backend", "unknown back end " + f.backend);
+  if (!parse_backend(f.backend, o.backend.kind))
+    throw CLI::ValidationError("--backend", "unknown back end " + f.backend);
   if (!parse_traversal(f.traversal, o.traversal))
     throw CLI::ValidationError("--traversal", "unknown traversal " + f.traversal);
   o.backend.device = f.device;

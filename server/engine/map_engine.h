@@ -16,8 +16,8 @@
 #include "core/log.h"
 #include "core/prepare_scan.h"
 #include "core/ray_backend.h"
-#include "engine/backend_factory.h"
 #include "core/sensor_model.h"
+#include "engine/backend_factory.h"
 #include "octree/octree_update.h"
 
 namespace ort {
@@ -26,7 +26,7 @@ struct EngineOptions {
   double resolution = 0.1;
   double max_range = -1.0;  // < 0: no limit (OctoMap's default)
   Traversal traversal = Traversal::kOctomap;
-  BackendOptions backend;   // resolution/max_range are filled in from above
+  BackendOptions backend;  // resolution/max_range are filled in from above
   OctreeUpdateOptions octree;
   SensorModel sensor;
   // Most key steps one scan may cost (the sum over its windows of the walks of their rays);
@@ -60,8 +60,8 @@ inline constexpr unsigned kSpareCoreAbove = 8;
 // Why shoot() refused a scan whose origin was fine (the scan is then not shot at all).
 enum class ShotRefusal {
   kNone,
-  kRayTooLong,    // a ray's walk exceeds OctoMap's KeyRay (100,000 keys): OctoMap cannot insert it
-  kTooMuchWork,   // the scan's walk keys exceed EngineOptions::max_scan_walk_keys
+  kRayTooLong,   // a ray's walk exceeds OctoMap's KeyRay (100,000 keys): OctoMap cannot insert it
+  kTooMuchWork,  // the scan's walk keys exceed EngineOptions::max_scan_walk_keys
 };
 
 // One scan on its way through the pipeline.
@@ -70,10 +70,10 @@ struct ShotScan {
   ShootStats shoot;
   VoxelList voxels;
   uint64_t free_voxels = 0, occupied_voxels = 0;
-  uint64_t walk_keys = 0;          // the scan's cost: key steps over all its windows
-  uint64_t tiles = 0;              // path-following tiles (0: the scan's box was shot whole)
+  uint64_t walk_keys = 0;  // the scan's cost: key steps over all its windows
+  uint64_t tiles = 0;      // path-following tiles (0: the scan's box was shot whole)
   ShotRefusal refusal = ShotRefusal::kNone;
-  std::string refusal_detail;      // says why, with the numbers
+  std::string refusal_detail;  // says why, with the numbers
 
   // Ready for the next scan, as a fresh ShotScan but keeping the voxel list's storage: a
   // large scan's list (campus: 60 MB) allocated anew each scan costs a page fault every 4 KiB
@@ -96,8 +96,7 @@ class MapEngine {
   std::unique_ptr<octomap::OcTree> make_tree() const;
 
   // Stage 1. `max_range` overrides the engine's when >= -1 is not wanted: pass opts' value.
-  void shoot(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range,
-             ShotScan& out);
+  void shoot(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range, ShotScan& out);
   // Stage 1 for a scan in the sensor frame: `pose` takes the points into the map frame (as
   // OctoMap's Pointcloud::transform), `origin` is the sensor origin in the map frame. The
   // back end prepares it on its device where it can (BackendOptions::gpu_prepare), else the
@@ -146,7 +145,7 @@ class MapEngine {
 
   EngineOptions opts_;
   std::unique_ptr<RayBackend> backend_;
-  mutable OctreeStage octree_stage_;  // keeps the batched stage's threads between scans; only apply() uses it
+  mutable OctreeStage octree_stage_;          // keeps the batched stage's threads between scans; only apply() uses it
   std::vector<octomap::point3d> map_points_;  // shoot_posed_xyz's map-frame points, kept between scans
 };
 

@@ -17,7 +17,8 @@ static_assert(sizeof(octomap::point3d) == 12, "points are uploaded as they lie i
 constexpr uint64_t kMinPointCapacity = 1 << 16;
 constexpr VkBufferUsageFlags kStorage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-constexpr VkMemoryPropertyFlags kHostCoherent = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+constexpr VkMemoryPropertyFlags kHostCoherent =
+    VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
 constexpr VkMemoryPropertyFlags kHostCached = VK_MEMORY_PROPERTY_HOST_CACHED_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
 
 // OctoMap's test: Vector3::norm() (sqrt in double of the float |d|^2) <= max_range.
@@ -73,7 +74,8 @@ GpuPrepare::GpuPrepare(std::shared_ptr<const vk::Context> ctx)
     result_ = vk::Buffer(*ctx_, sizeof(PrepareCounts), kStorage, kHostCoherent, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   } else {
     result_ = vk::Buffer(*ctx_, sizeof(PrepareCounts), kStorage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    result_readback_ = vk::Buffer(*ctx_, sizeof(PrepareCounts), kStorage, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT, kHostCached);
+    result_readback_ =
+        vk::Buffer(*ctx_, sizeof(PrepareCounts), kStorage, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT, kHostCached);
   }
   ensure_point_capacity(kMinPointCapacity);
 }

@@ -64,8 +64,8 @@ class GpuPrepare {
   bool unified_ = false;
   vk::CommandRunner runner_;
   vk::ComputePipeline pass_;
-  vk::Buffer points_staging_, points_;  // points_staging_: discrete GPUs only
-  vk::Buffer result_, result_readback_; // result_readback_: discrete GPUs only
+  vk::Buffer points_staging_, points_;   // points_staging_: discrete GPUs only
+  vk::Buffer result_, result_readback_;  // result_readback_: discrete GPUs only
   uint64_t point_capacity_ = 0;
   uint64_t staged_points_ = 0;
   VkBuffer bound_rays_ = VK_NULL_HANDLE;

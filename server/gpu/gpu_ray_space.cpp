@@ -19,7 +19,8 @@ using Clock = std::chrono::steady_clock;
 constexpr uint64_t kMinRayCapacity = 1 << 16;
 constexpr VkBufferUsageFlags kStorage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-constexpr VkMemoryPropertyFlags kHostCoherent = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+constexpr VkMemoryPropertyFlags kHostCoherent =
+    VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
 constexpr VkMemoryPropertyFlags kHostCached = VK_MEMORY_PROPERTY_HOST_CACHED_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
 
 // Timestamp slots of one window's first submission.
@@ -84,7 +85,8 @@ GpuRaySpace::GpuRaySpace(std::shared_ptr<const vk::Context> ctx, const GpuRaySpa
 void GpuRaySpace::make_buffers() {
   const vk::Context& c = *ctx_;
   const RaySpaceSizing& s = opts_.sizing;
-  const VkMemoryPropertyFlags required = unified_ ? kHostCoherent : VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  const VkMemoryPropertyFlags required =
+      unified_ ? kHostCoherent : VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   const VkMemoryPropertyFlags preferred = unified_ ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT : 0;
   grid_ = vk::Buffer(c, s.grid_words * 4, kStorage, required, preferred);
   ++grid_allocations_;
@@ -176,8 +178,8 @@ void GpuRaySpace::shoot_windows(const RayBatch& batch, uint32_t ray_count, std::
   stats.windows += windows.size();
 }
 
-void GpuRaySpace::shoot_window(const RayBatch& batch, uint32_t ray_count, const KeyBox& window, const RecordShoot& record_shoot,
-                               VoxelList& out, ShootStats& stats) {
+void GpuRaySpace::shoot_window(const RayBatch& batch, uint32_t ray_count, const KeyBox& window,
+                               const RecordShoot& record_shoot, VoxelList& out, ShootStats& stats) {
   const CompactPush cp = compact_push(window, opts_.sizing.chunk_words);
   const auto t_submit = Clock::now();
   VkCommandBuffer cmd = runner_.begin();

@@ -89,8 +89,8 @@ class GpuRaySpace {
   void ensure_ray_capacity(uint64_t rays);
   void shoot_windows(const RayBatch& batch, uint32_t ray_count, std::span<const KeyBox> windows,
                      const RecordShoot& record_shoot, VoxelList& out, ShootStats& stats);
-  void shoot_window(const RayBatch& batch, uint32_t ray_count, const KeyBox& window, const RecordShoot& record_shoot, VoxelList& out,
-                    ShootStats& stats);
+  void shoot_window(const RayBatch& batch, uint32_t ray_count, const KeyBox& window, const RecordShoot& record_shoot,
+                    VoxelList& out, ShootStats& stats);
   void record_first_pass(VkCommandBuffer cmd, const ShootPush& push, const RecordShoot& record_shoot,
                          const CompactPush& cp);
   uint64_t compact_rest(CompactPush cp, const Counters& first, VoxelList& out, StageTimes& times);

@@ -12,8 +12,8 @@ uint64_t auto_grid_budget(uint64_t max_storage_buffer_range, uint64_t device_loc
   return std::min({max_storage_buffer_range, device_local_bytes / 8, uint64_t(1) << 30});
 }
 
-RaySpaceSizing size_ray_space(double max_range, double resolution, uint64_t budget_bytes,
-                              uint64_t max_buffer_bytes, uint32_t max_dispatch_groups, uint64_t output_voxels) {
+RaySpaceSizing size_ray_space(double max_range, double resolution, uint64_t budget_bytes, uint64_t max_buffer_bytes,
+                              uint32_t max_dispatch_groups, uint64_t output_voxels) {
   RaySpaceSizing s;
   // Voxel indices inside a window are uint32 in the shaders: at most 2^28 words.
   uint64_t words = std::min({budget_bytes, max_buffer_bytes, uint64_t(1) << 30}) / 4;
@@ -30,7 +30,8 @@ RaySpaceSizing size_ray_space(double max_range, double resolution, uint64_t budg
   const uint64_t output_cap = std::min<uint64_t>(max_buffer_bytes, uint64_t(512) << 20) / 8;
   s.output_voxels = std::min({words * kVoxelsPerWord, std::max<uint64_t>(uint64_t(16) << 20, words * 4), output_cap});
   if (output_voxels) s.output_voxels = std::min(output_voxels, output_cap);
-  const uint64_t chunk = std::min<uint64_t>(s.output_voxels / kVoxelsPerWord, uint64_t(max_dispatch_groups) * kCompactGroup);
+  const uint64_t chunk =
+      std::min<uint64_t>(s.output_voxels / kVoxelsPerWord, uint64_t(max_dispatch_groups) * kCompactGroup);
   s.chunk_words = uint32_t(std::max<uint64_t>(chunk, 1));
   s.output_voxels = std::max<uint64_t>(s.output_voxels, uint64_t(s.chunk_words) * kVoxelsPerWord);
   return s;

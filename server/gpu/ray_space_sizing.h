@@ -24,7 +24,7 @@ uint64_t auto_grid_budget(uint64_t max_storage_buffer_range, uint64_t device_loc
 // by max_buffer_bytes and 512 MiB; larger scans are compacted in several chunks.
 // `output_voxels` > 0 replaces the automatic output capacity (tests use a small one to make
 // compaction run in chunks).
-RaySpaceSizing size_ray_space(double max_range, double resolution, uint64_t budget_bytes,
-                              uint64_t max_buffer_bytes, uint32_t max_dispatch_groups, uint64_t output_voxels = 0);
+RaySpaceSizing size_ray_space(double max_range, double resolution, uint64_t budget_bytes, uint64_t max_buffer_bytes,
+                              uint32_t max_dispatch_groups, uint64_t output_voxels = 0);
 
 }  // namespace ort::gpu

@@ -39,7 +39,7 @@ static_assert(sizeof(CompactPush) == 32);
 // prepare_rays.comp's push constants: the pose, the origin and the max-range rule of a scan.
 struct PreparePush {
   double resolution_factor;
-  float rot[4];    // u, x, y, z
+  float rot[4];  // u, x, y, z
   float trans[3];
   uint32_t point_count;
   float origin[3];
@@ -70,7 +70,7 @@ struct Counters {
   uint32_t touched_count;
   uint32_t emitted_count;
   uint32_t walk_overruns;    // rays stopped by the shaders' step guard: must stay 0
-  uint32_t words_compacted; // touched words the compact passes read and cleared
+  uint32_t words_compacted;  // touched words the compact passes read and cleared
 };
 static_assert(sizeof(Counters) == 28);
 inline constexpr size_t kEmittedOffset = offsetof(Counters, emitted_count);

@@ -50,7 +50,8 @@ class VulkanBackend final : public RayBackend {
  public:
   VulkanBackend(const BackendOptions& opts, const VulkanTuning& tuning, const Log& log)
       : ctx_(make_context(opts)),
-        space_(ctx_, {.sizing = sizing_for(*ctx_, opts, tuning), .voxels_in_host_memory = opts.compact_into_host_memory}),
+        space_(ctx_,
+               {.sizing = sizing_for(*ctx_, opts, tuning), .voxels_in_host_memory = opts.compact_into_host_memory}),
         shoot_octomap_(*ctx_, shoot_octomap_spv, 4, sizeof(gpu::ShootPush)),
         shoot_exact_(*ctx_, shoot_exact_spv, 4, sizeof(gpu::ShootPush)),
         max_groups_(ctx_->properties().limits.maxComputeWorkGroupCount[0]),
@@ -124,7 +125,8 @@ class VulkanBackend final : public RayBackend {
       box *= side + 2 * uint64_t(kWindowMargin);
       extents += side;
     }
-    return (scan.max_box_voxels && box > scan.max_box_voxels) || (scan.max_walk_keys && rays * extents > scan.max_walk_keys);
+    return (scan.max_box_voxels && box > scan.max_box_voxels) ||
+           (scan.max_walk_keys && rays * extents > scan.max_walk_keys);
   }
 
   // One invocation per ray, in dispatches of at most max_groups_ groups.

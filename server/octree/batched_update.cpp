@@ -41,8 +41,8 @@ BatchedOctreeUpdater::BatchedOctreeUpdater(const BatchedUpdateOptions& opts)
 
 BatchedOctreeUpdater::~BatchedOctreeUpdater() = default;
 
-void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
-                                 BatchedUpdateStats* stats, LeafChanges* changes) {
+void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates, BatchedUpdateStats* stats,
+                                 LeafChanges* changes) {
   BatchedUpdateStats local;
   BatchedUpdateStats& st = stats ? *stats : local;
   st = BatchedUpdateStats{};
@@ -93,8 +93,7 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
       } else {
         sort_bucket(voxels, sort_tmp_[worker], node_bits);
       }
-      const bool changed =
-          update_subtree(tree, node_ops, s.root, voxels, changes ? &changes->lane(worker) : nullptr);
+      const bool changed = update_subtree(tree, node_ops, s.root, voxels, changes ? &changes->lane(worker) : nullptr);
       if (changes) changes->close_segment(worker, order[k] + 1);
       top.child_done(s.parent, changed, node_ops);
     }

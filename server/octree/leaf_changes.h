@@ -30,9 +30,9 @@ namespace ort {
 
 struct LeafChange {
   static constexpr uint64_t kUnknownBit = 1ull << 63;
-  uint64_t code = 0;   // Morton code of the key (morton_order.h); kUnknownBit: no node covered it before
-  float before = 0;    // log-odds before (0 when unknown)
-  float after = 0;     // log-odds after
+  uint64_t code = 0;  // Morton code of the key (morton_order.h); kUnknownBit: no node covered it before
+  float before = 0;   // log-odds before (0 when unknown)
+  float after = 0;    // log-odds after
 
   static LeafChange make(uint64_t morton, bool was_unknown, float before, float after) {
     return LeafChange{morton | (was_unknown ? kUnknownBit : 0), before, after};

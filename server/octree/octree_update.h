@@ -33,8 +33,7 @@ void apply_updates_sequential(octomap::OcTree& tree, std::span<const VoxelUpdate
 void update_node_logged(octomap::OcTree& tree, const VoxelUpdate& u, std::vector<LeafChange>* lane);
 
 // One-off: the batched mode starts its threads for this call only (see OctreeStage).
-void apply_updates(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
-                   const OctreeUpdateOptions& opts);
+void apply_updates(octomap::OcTree& tree, std::span<const VoxelUpdate> updates, const OctreeUpdateOptions& opts);
 
 class BatchedOctreeUpdater;
 

@@ -12,9 +12,8 @@ bool any_voxel_applies(const octomap::OcTree& tree, const octomap::OcTreeNode& n
                        std::span<const SortedVoxel> voxels) {
   const bool occupied_applies = !at_clamping_bound(tree, node, tree.getProbHitLog());
   const bool free_applies = !at_clamping_bound(tree, node, tree.getProbMissLog());
-  return std::any_of(voxels.begin(), voxels.end(), [&](SortedVoxel v) {
-    return sorted_voxel_occupied(v) ? occupied_applies : free_applies;
-  });
+  return std::any_of(voxels.begin(), voxels.end(),
+                     [&](SortedVoxel v) { return sorted_voxel_occupied(v) ? occupied_applies : free_applies; });
 }
 
 }  // namespace

@@ -44,8 +44,8 @@ class SplitTop {
   void child_done(int parent, bool changed, octomap::OcTree& node_ops);
 
  private:
-  std::vector<Node> nodes_;  // root first, each node after its parent
-  std::vector<PlannedSubtree> subtrees_;  // in Morton order
+  std::vector<Node> nodes_;                      // root first, each node after its parent
+  std::vector<PlannedSubtree> subtrees_;         // in Morton order
   std::unique_ptr<std::atomic<int>[]> pending_;  // children not yet done, per node
   std::unique_ptr<std::atomic<bool>[]> changed_;
 };

@@ -38,7 +38,8 @@ void apply_to_block(const octomap::OcTree& tree, octomap::OcTreeNode& leaf, floa
   const float before = leaf.getLogOdds();
   update_leaf_log_odds(tree, leaf, update);
   if (changes)
-    for (const SortedVoxel v : block) log_leaf_change(*changes, sorted_voxel_code(v), just_created, before, leaf.getLogOdds());
+    for (const SortedVoxel v : block)
+      log_leaf_change(*changes, sorted_voxel_code(v), just_created, before, leaf.getLogOdds());
 }
 
 // Whether two voxels' leaves have one parent (their codes differ in the last 3 bits at most).

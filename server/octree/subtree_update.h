@@ -46,8 +46,7 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
 // Whether OctoMap's updateNode would return early for an update of `log_odds_update` that
 // finds `node` as the deepest existing node on its path: already at the clamping bound in
 // the update's direction (OccupancyOcTreeBase::updateNode).
-inline bool at_clamping_bound(const octomap::OcTree& tree, const octomap::OcTreeNode& node,
-                              float log_odds_update) {
+inline bool at_clamping_bound(const octomap::OcTree& tree, const octomap::OcTreeNode& node, float log_odds_update) {
   const float v = node.getLogOdds();
   return (log_odds_update >= 0 && v >= tree.getClampingThresMaxLog()) ||
          (log_odds_update <= 0 && v <= tree.getClampingThresMinLog());

@@ -68,8 +68,11 @@ void mark_alone(std::span<const VoxelUpdate> updates, std::vector<uint8_t>& seen
 // Bit g * 2^shift of the result is set iff a bit of [g * 2^shift, (g + 1) * 2^shift) is
 // (shift < 6: the groups lie inside the word).
 uint64_t fold_groups(uint64_t v, unsigned shift) {
-  static constexpr std::array<uint64_t, 6> kGroupStarts{~0ull, 0x5555555555555555ull, 0x1111111111111111ull,
-                                                        0x0101010101010101ull, 0x0001000100010001ull,
+  static constexpr std::array<uint64_t, 6> kGroupStarts{~0ull,
+                                                        0x5555555555555555ull,
+                                                        0x1111111111111111ull,
+                                                        0x0101010101010101ull,
+                                                        0x0001000100010001ull,
                                                         0x0000000100000001ull};
   for (unsigned j = 0; j < shift; ++j) v |= v >> (1u << j);
   return v & kGroupStarts[shift];
@@ -164,8 +167,8 @@ bool direct_sort(SortedVoxel* data, size_t n, unsigned bits, std::vector<SortedV
 
 }  // namespace
 
-void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& opts, WorkerPool* pool,
-                   VoxelBuckets& out, BucketScratch& scratch) {
+void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& opts, WorkerPool* pool, VoxelBuckets& out,
+                   BucketScratch& scratch) {
   const size_t n = updates.size();
   if (n > out.voxels.capacity()) {
     out.voxels = {};  // the last list is not kept: growing copies nothing, and a quarter spare
@@ -176,8 +179,7 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
   out.depth = 0;
   if (n == 0) return;
   if (pool && n < kParallelMin) pool = nullptr;
-  const size_t chunks =
-      pool ? std::clamp<size_t>(n / kMinChunk, 1, kChunksPerWorker * pool->size()) : 1;
+  const size_t chunks = pool ? std::clamp<size_t>(n / kMinChunk, 1, kChunksPerWorker * pool->size()) : 1;
   auto chunk_begin = [&](size_t k) { return n * k / chunks; };
 
   // Pass 1: which key coordinates occur, per axis, as bits shared by the threads.
@@ -212,8 +214,8 @@ void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& op
   const unsigned ny = build_rank_table(axis_bits[1], shift, nx, scratch.cell_of_axis[1], node_of[1]);
   const unsigned nz = build_rank_table(axis_bits[2], shift, nx * ny, scratch.cell_of_axis[2], node_of[2]);
   const size_t cells = size_t{nx} * ny * nz;
-  const CellOf cell_of{scratch.cell_of_axis[0].data(), scratch.cell_of_axis[1].data(),
-                      scratch.cell_of_axis[2].data(), shift};
+  const CellOf cell_of{scratch.cell_of_axis[0].data(), scratch.cell_of_axis[1].data(), scratch.cell_of_axis[2].data(),
+                       shift};
 
   // Pass 2: voxels per cell, per chunk (each chunk's row cleared by its thread first).
   scratch.counts.resize(chunks * cells);

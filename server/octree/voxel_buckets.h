@@ -16,8 +16,8 @@
 #include <cstddef>
 #include <memory>
 #include <new>
-#include <utility>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/voxel_update.h"
@@ -61,8 +61,8 @@ struct UninitializedAllocator : std::allocator<T> {
 
 struct VoxelBuckets {
   std::vector<SortedVoxel, UninitializedAllocator<SortedVoxel>> voxels;  // grouped by bucket, buckets in Morton order
-  std::vector<size_t> begin;        // bucket b is voxels[begin[b], begin[b + 1])
-  unsigned depth = 0;               // D: every bucket holds the voxels below one node at D
+  std::vector<size_t> begin;                                             // bucket b is voxels[begin[b], begin[b + 1])
+  unsigned depth = 0;  // D: every bucket holds the voxels below one node at D
 
   size_t count() const { return begin.empty() ? 0 : begin.size() - 1; }
   std::span<SortedVoxel> bucket(size_t b) { return {voxels.data() + begin[b], begin[b + 1] - begin[b]}; }
@@ -70,11 +70,11 @@ struct VoxelBuckets {
 
 // Reused storage of bucket_voxels (per-chunk counts, rank tables).
 struct BucketScratch {
-  std::vector<uint64_t> occupied;  // [axis][1024 words]: key coordinates that occur, one bit each
-  std::vector<uint8_t> seen;       // [axis][65536]: the same as bytes, on one thread
-  std::vector<uint32_t> counts;    // [chunk][cell]: voxels, then the chunks' offsets
-  std::vector<uint32_t> totals;    // [cell]: voxels
-  std::vector<uint32_t> cell_begin;  // [cell]: first index of its bucket (nonempty cells)
+  std::vector<uint64_t> occupied;      // [axis][1024 words]: key coordinates that occur, one bit each
+  std::vector<uint8_t> seen;           // [axis][65536]: the same as bytes, on one thread
+  std::vector<uint32_t> counts;        // [chunk][cell]: voxels, then the chunks' offsets
+  std::vector<uint32_t> totals;        // [cell]: voxels
+  std::vector<uint32_t> cell_begin;    // [cell]: first index of its bucket (nonempty cells)
   std::vector<SortedVoxel> cell_code;  // [cell]: its node's code bits of every voxel in it (nonempty cells)
   std::vector<uint32_t> cell_of_axis[3];
   std::vector<std::pair<uint64_t, uint32_t>> nonempty;  // (node code, cell)
@@ -83,8 +83,8 @@ struct BucketScratch {
 // Buckets `updates` (order within a bucket: the list's order). Keys may repeat.
 // With a pool the passes' chunks are shared out over its threads (WorkerPool::run_shared; not
 // from inside a run of the same pool).
-void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& opts, WorkerPool* pool,
-                   VoxelBuckets& out, BucketScratch& scratch);
+void bucket_voxels(std::span<const VoxelUpdate> updates, const BucketOptions& opts, WorkerPool* pool, VoxelBuckets& out,
+                   BucketScratch& scratch);
 
 // Sorts one bucket into Morton order (stable: a repeated key keeps the list's order of its
 // updates). `tmp` is reused storage. `node_bits`: the low code bits the bucket's voxels can

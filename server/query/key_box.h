@@ -10,8 +10,8 @@
 namespace ort::query {
 
 struct KeyBox {
-  octomap::OcTreeKey min{0, 0, 0}, max{0, 0, 0};      // inclusive, min <= max per axis
-  int64_t voxels() const;           // (max - min + 1) per axis, multiplied
+  octomap::OcTreeKey min{0, 0, 0}, max{0, 0, 0};  // inclusive, min <= max per axis
+  int64_t voxels() const;                         // (max - min + 1) per axis, multiplied
 };
 
 // The voxels of the metric box [lo, hi]: coordToKey of each corner (OctoMap's own

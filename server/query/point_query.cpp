@@ -10,8 +10,7 @@ namespace ort::query {
 unsigned checked_depth(const octomap::OcTree& tree, int depth) {
   const int top = static_cast<int>(tree.getTreeDepth());
   if (depth < 0 || depth > top)
-    throw QueryError("depth " + std::to_string(depth) + " is not in 0.." + std::to_string(top) +
-                     " (0 = finest level)");
+    throw QueryError("depth " + std::to_string(depth) + " is not in 0.." + std::to_string(top) + " (0 = finest level)");
   return static_cast<unsigned>(depth);
 }
 

@@ -14,11 +14,11 @@
 namespace ort::query {
 
 struct GridRequest {
-  double z_min = 0, z_max = 0;      // metres; the band is coordToKey(z_min) .. coordToKey(z_max)
-  int cell_voxels = 1;              // >= 1: cell size = cell_voxels * resolution
-  bool window = false;              // false: the map's xy extent (its stored leaves)
+  double z_min = 0, z_max = 0;  // metres; the band is coordToKey(z_min) .. coordToKey(z_max)
+  int cell_voxels = 1;          // >= 1: cell size = cell_voxels * resolution
+  bool window = false;          // false: the map's xy extent (its stored leaves)
   double x_min = 0, y_min = 0, x_max = 0, y_max = 0;
-  int64_t max_cells = 16'000'000;   // more: QueryError
+  int64_t max_cells = 16'000'000;  // more: QueryError
 };
 
 // Throws QueryError: non-finite or inverted band or window, cell_voxels < 1, too many cells.

@@ -30,8 +30,8 @@ struct PointAnswer {
 };
 
 struct RayAnswer {
-  bool hit = false;                 // what OcTree::castRay returned
-  octomap::point3d end;             // what OcTree::castRay wrote into `end`
+  bool hit = false;                             // what OcTree::castRay returned
+  octomap::point3d end;                         // what OcTree::castRay wrote into `end`
   VoxelState end_state = VoxelState::kUnknown;  // the end voxel's state (search(end))
 };
 
@@ -43,23 +43,23 @@ struct BoxCounts {
 
 // A node returned by region extraction: a cube of 2^(16 - depth) finest voxels a side.
 struct RegionVoxel {
-  octomap::OcTreeKey lo{0, 0, 0};   // the cube's lowest finest-level key
-  uint8_t depth = 16;               // 1 .. tree depth
+  octomap::OcTreeKey lo{0, 0, 0};  // the cube's lowest finest-level key
+  uint8_t depth = 16;              // 1 .. tree depth
   VoxelState state = VoxelState::kFree;
-  octomap::point3d center;          // keyToCoord of the node (OctoMap's iterator coordinate)
+  octomap::point3d center;  // keyToCoord of the node (OctoMap's iterator coordinate)
 };
 
 // A 2D occupancy grid in the map's xy plane: cells of `cell_voxels` finest voxels a side.
 // Cell (i, j) covers x keys [key_x0 + i*m, key_x0 + (i+1)*m - 1] (m = cell_voxels), the same
 // for y, and the key band [key_z0, key_z1] in z. Row j holds cells (0..width-1, j).
 struct Grid2D {
-  int key_x0 = 0, key_y0 = 0;       // lowest key of cell (0, 0) (may be < 0 at the map's edge)
-  int key_z0 = 0, key_z1 = 0;       // the z band, inclusive
+  int key_x0 = 0, key_y0 = 0;  // lowest key of cell (0, 0) (may be < 0 at the map's edge)
+  int key_z0 = 0, key_z1 = 0;  // the z band, inclusive
   int cell_voxels = 1;
-  double cell_size = 0;             // metres: cell_voxels * resolution
+  double cell_size = 0;               // metres: cell_voxels * resolution
   double origin_x = 0, origin_y = 0;  // metres: the min corner of cell (0, 0)
   int width = 0, height = 0;
-  std::vector<VoxelState> cells;    // width * height, row-major
+  std::vector<VoxelState> cells;  // width * height, row-major
   VoxelState at(int i, int j) const { return cells[static_cast<size_t>(j) * width + i]; }
 };
 

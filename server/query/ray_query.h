@@ -14,7 +14,7 @@ namespace ort::query {
 
 struct RayBatchOptions {
   bool ignore_unknown = false;
-  double max_range = -1;            // <= 0: no limit (castRay's default)
+  double max_range = -1;  // <= 0: no limit (castRay's default)
 };
 
 // One ray. An origin outside the map's key range gives hit = false, end = origin, unknown

@@ -15,9 +15,9 @@
 namespace ort::query {
 
 struct RegionOptions {
-  int depth = 0;                    // 1 .. tree depth; 0 = finest
+  int depth = 0;  // 1 .. tree depth; 0 = finest
   bool include_free = false;
-  size_t max_voxels = 1'000'000;    // more: QueryError (the reply would be too large)
+  size_t max_voxels = 1'000'000;  // more: QueryError (the reply would be too large)
 };
 
 std::vector<RegionVoxel> extract_region(const octomap::OcTree& tree, const KeyBox& box, const RegionOptions& opt);

@@ -115,7 +115,7 @@ TEST(Render, ObliqueViewShowsTopFacesAboveTheirBase) {
   EXPECT_LT(top.y, base.y - 100);  // up is up, and 3 m is long
   const HeightColours colours(0, 3);
   expect_colour(p.canvas.at(int(top.x), int(top.y)), colours.at(2.95));  // the lit top face, top voxel's height
-  EXPECT_FALSE(p.canvas.at(int(base.x), int(base.y - 20)) == kWhite);  // a side face
+  EXPECT_FALSE(p.canvas.at(int(base.x), int(base.y - 20)) == kWhite);    // a side face
 }
 
 TEST(Render, HeightRangeCutsWhatIsOutside) {
@@ -143,7 +143,7 @@ TEST(Render, FreeSpaceIsAFaintFootprintUnderTheVoxels) {
   const ScreenPoint free_spot = p.camera.project(1.5, 0.05, 0.1), end = p.camera.project(3.05, 0.05, 0.1);
   const Rgb f = p.canvas.at(int(free_spot.x), int(free_spot.y));
   EXPECT_FALSE(f == kWhite);
-  EXPECT_GT(int(f.r) + f.g + f.b, 3 * 200);  // faint
+  EXPECT_GT(int(f.r) + f.g + f.b, 3 * 200);                // faint
   EXPECT_FALSE(p.canvas.at(int(end.x), int(end.y)) == f);  // the occupied end is drawn over it
 }
 
@@ -164,8 +164,11 @@ TEST(Render, CommandDrawsAMapFile) {
   const octomap::OcTree tree = two_boxes();
   ASSERT_TRUE(tree.writeBinaryConst(dir + "/map.bt"));
   const std::string cli = OCTOMAP_RT_CLI;
-  ASSERT_EQ(std::system((cli + " render " + dir + "/map.bt -o " + dir + "/top.png --width 500 2>/dev/null").c_str()), 0);
-  ASSERT_EQ(std::system((cli + " render " + dir + "/map.bt -o " + dir + "/obl.png --view oblique --z 0:1 2>/dev/null").c_str()), 0);
+  ASSERT_EQ(std::system((cli + " render " + dir + "/map.bt -o " + dir + "/top.png --width 500 2>/dev/null").c_str()),
+            0);
+  ASSERT_EQ(std::system(
+                (cli + " render " + dir + "/map.bt -o " + dir + "/obl.png --view oblique --z 0:1 2>/dev/null").c_str()),
+            0);
   EXPECT_EQ(read_png(dir + "/top.png").width(), 500);
   EXPECT_EQ(read_png(dir + "/obl.png").width(), 1200);
   EXPECT_NE(std::system((cli + " render " + dir + "/map.bt -o " + dir + "/x.png --z 2:1 2>/dev/null").c_str()), 0);

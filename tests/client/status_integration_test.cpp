@@ -48,8 +48,9 @@ TEST(StatusIntegration, ShowsARunningServerAsTextJsonAndWatch) {
     const char junk[16] = "not a scan_t";
     lc.publish("OCTOMAP_RT_SCAN_ALPHA", junk, sizeof junk);
   }
-  ChildProcess query({client_program(), "query", "points", "0,0,0", "1,1,1", "--client-id", "planner1", "--lcm-url", url},
-                     dir + "/query.log");
+  ChildProcess query(
+      {client_program(), "query", "points", "0,0,0", "1,1,1", "--client-id", "planner1", "--lcm-url", url},
+      dir + "/query.log");
   ASSERT_EQ(query.wait(60), 0) << query.log();
   ASSERT_TRUE(status.wait_for(
       [](const octomap_rt::server_status_t& s) {

@@ -19,7 +19,7 @@ namespace ort::test {
 namespace {
 
 struct ParityCase {
-  std::string data;    // relative to the data folder, or "synthetic"
+  std::string data;  // relative to the data folder, or "synthetic"
   double resolution;
   double max_range;
   std::string backend;
@@ -27,11 +27,11 @@ struct ParityCase {
 
 std::string case_name(const testing::TestParamInfo<ParityCase>& info) {
   const ParityCase& c = info.param;
-  std::string n = std::filesystem::path(c.data).stem().string() + "_r" +
-                  std::to_string(int(c.resolution * 100)) + "cm_" +
-                  (c.max_range < 0 ? std::string("nolimit") : "max" + std::to_string(int(c.max_range))) + "_" +
+  std::string n = std::filesystem::path(c.data).stem().string() + "_r" + std::to_string(int(c.resolution * 100)) +
+                  "cm_" + (c.max_range < 0 ? std::string("nolimit") : "max" + std::to_string(int(c.max_range))) + "_" +
                   c.backend;
-  for (char& ch : n) if (!isalnum((unsigned char)ch)) ch = '_';
+  for (char& ch : n)
+    if (!isalnum((unsigned char)ch)) ch = '_';
   return n;
 }
 

@@ -33,23 +33,23 @@ TEST(BrickLayout, IndexIsABijectionAndKeyOfInvertsIt) {
   EXPECT_FALSE(BrickLayout::rows_for(big));
   EXPECT_EQ(BrickLayout::padded_voxels(big), 126u * 126u * 4u * 256u);
   for (bool rows : {false, true}) {
-  const BrickLayout layout(w, rows);
-  EXPECT_EQ(layout.rows(), rows);
-  const uint64_t padded = layout.voxels();
-  EXPECT_EQ(padded, rows ? 32u * 9u * 16u : 3u * 2u * 4u * 256u);
-  std::set<uint32_t> seen;
-  for (int z = w.lo[2]; z <= w.hi[2]; ++z)
-    for (int y = w.lo[1]; y <= w.hi[1]; ++y)
-      for (int x = w.lo[0]; x <= w.hi[0]; ++x) {
-        const octomap::OcTreeKey k(x, y, z);
-        ASSERT_TRUE(layout.contains(k));
-        const uint32_t i = layout.index(k);
-        ASSERT_LT(i, padded);
-        ASSERT_TRUE(seen.insert(i).second) << "two keys share index " << i;
-        ASSERT_TRUE(layout.key_of(i / 16, i % 16) == k) << x << " " << y << " " << z << " rows " << rows;
-      }
-  EXPECT_FALSE(layout.contains(octomap::OcTreeKey(4, 1000, 65535)));
-  EXPECT_FALSE(layout.contains(octomap::OcTreeKey(5, 1009, 65535)));
+    const BrickLayout layout(w, rows);
+    EXPECT_EQ(layout.rows(), rows);
+    const uint64_t padded = layout.voxels();
+    EXPECT_EQ(padded, rows ? 32u * 9u * 16u : 3u * 2u * 4u * 256u);
+    std::set<uint32_t> seen;
+    for (int z = w.lo[2]; z <= w.hi[2]; ++z)
+      for (int y = w.lo[1]; y <= w.hi[1]; ++y)
+        for (int x = w.lo[0]; x <= w.hi[0]; ++x) {
+          const octomap::OcTreeKey k(x, y, z);
+          ASSERT_TRUE(layout.contains(k));
+          const uint32_t i = layout.index(k);
+          ASSERT_LT(i, padded);
+          ASSERT_TRUE(seen.insert(i).second) << "two keys share index " << i;
+          ASSERT_TRUE(layout.key_of(i / 16, i % 16) == k) << x << " " << y << " " << z << " rows " << rows;
+        }
+    EXPECT_FALSE(layout.contains(octomap::OcTreeKey(4, 1000, 65535)));
+    EXPECT_FALSE(layout.contains(octomap::OcTreeKey(5, 1009, 65535)));
   }
 }
 
@@ -70,12 +70,15 @@ std::vector<octomap::point3d> scan_points(const octomap::point3d& origin, float 
     switch (i % 6) {
       case 0: d = octomap::point3d(0, 0, 0), d(i / 6 % 3) = (i / 18) % 2 ? 1.0f : -1.0f; break;  // along an axis
       case 1: d(i / 6 % 3) = 0.0f; break;                                                        // in an axis plane
-      case 2: d = octomap::point3d(u(rng) < 0 ? -1.0f : 1.0f, u(rng) < 0 ? -1.0f : 1.0f, u(rng) < 0 ? -1.0f : 1.0f); break;
+      case 2:
+        d = octomap::point3d(u(rng) < 0 ? -1.0f : 1.0f, u(rng) < 0 ? -1.0f : 1.0f, u(rng) < 0 ? -1.0f : 1.0f);
+        break;
       default: break;
     }
     if (d.norm() == 0.0f) continue;
     octomap::point3d e = origin + d.normalized() * (reach * len(rng));
-    if (i % 7 == 0) e = octomap::point3d(std::round(e.x() * 10) / 10, std::round(e.y() * 10) / 10, e.z());  // on borders
+    if (i % 7 == 0)
+      e = octomap::point3d(std::round(e.x() * 10) / 10, std::round(e.y() * 10) / 10, e.z());  // on borders
     pts.push_back(e);
   }
   return pts;
@@ -96,7 +99,8 @@ void expect_grid_equals_cpu(const octomap::point3d& origin, float reach, uint64_
     ShootStats sa, sg;
     reference->shoot(b, Traversal::kOctomap, a, sa);
     grid->shoot(b, Traversal::kOctomap, g, sg);
-    EXPECT_EQ(sg.windows > 1, expect_split) << "windows " << sg.windows << " seed " << seed << " origin " << origin << " box " << b.keys.voxel_count();
+    EXPECT_EQ(sg.windows > 1, expect_split)
+        << "windows " << sg.windows << " seed " << seed << " origin " << origin << " box " << b.keys.voxel_count();
     ASSERT_EQ(as_set(g), as_set(a)) << "seed " << seed << " threads " << threads << " simd " << simd;
     ASSERT_EQ(g.size(), a.size()) << "a key listed twice";
   }
@@ -106,8 +110,8 @@ void expect_grid_equals_cpu(const octomap::point3d& origin, float reach, uint64_
 TEST(CpuGridBackend, BrickedWalkEqualsCpuBackendInOneWindow) {
   for (bool simd : {false, true}) {
     for (unsigned threads : {1u, 2u}) {
-      expect_grid_equals_cpu({0.05f, 0.05f, 0.05f}, 12.0f, 0, threads, false, simd);  // origin at a voxel centre
-      expect_grid_equals_cpu({0.8f, -1.6f, 0.4f}, 9.0f, 0, threads, false, simd);    // origin on brick borders
+      expect_grid_equals_cpu({0.05f, 0.05f, 0.05f}, 12.0f, 0, threads, false, simd);        // origin at a voxel centre
+      expect_grid_equals_cpu({0.8f, -1.6f, 0.4f}, 9.0f, 0, threads, false, simd);           // origin on brick borders
       expect_grid_equals_cpu({3276.0f, -3276.0f, 3270.0f}, 6.0f, 0, threads, false, simd);  // at the key range's edge
     }
   }
@@ -187,7 +191,8 @@ TEST(CpuGridWalk, EndsOutsideTheWindowStopNoLaneInside) {
   const double res = 0.1;
   std::mt19937 rng(21);
   std::uniform_real_distribution<float> u(-1.6f, 3.2f), uz(-0.8f, 1.6f);
-  for (const octomap::point3d origin : {octomap::point3d(0.001f, 1.205f, 0.15f), octomap::point3d(0.75f, 0.85f, 0.35f)}) {
+  for (const octomap::point3d origin :
+       {octomap::point3d(0.001f, 1.205f, 0.15f), octomap::point3d(0.75f, 0.85f, 0.35f)}) {
     RayBatch b;
     PrepareReport rep;
     ASSERT_TRUE(prepare_origin(origin, res, b, rep));
@@ -195,45 +200,48 @@ TEST(CpuGridWalk, EndsOutsideTheWindowStopNoLaneInside) {
     for (int i = 0; i < 3; ++i) w.lo[i] = 32768, w.hi[i] = 32768 + (i < 2 ? 15 : 7);
     // From the first origin: through (0, 11, 1) to (16, 3, 1), whose brick arithmetic names (0, 11, 1).
     b.ends.push_back(RayEnd{1.65f, 0.35f, 0.15f, kRayEndOccupied});
-    for (int i = 0; i < 20000; ++i) b.ends.push_back(RayEnd{u(rng), u(rng), uz(rng), uint32_t(i % 3 ? kRayEndOccupied : 0)});
+    for (int i = 0; i < 20000; ++i)
+      b.ends.push_back(RayEnd{u(rng), u(rng), uz(rng), uint32_t(i % 3 ? kRayEndOccupied : 0)});
     for (bool rows : {false, true}) {
-    const BrickLayout layout(w, rows);
-    ASSERT_TRUE(layout.contains(b.origin_key));
-    // Ray by ray (a union over many rays would hide one ray's early stop), then all at once.
-    std::vector<uint32_t> grid(layout.voxels() / 16 + 2, 0), touched;
-    int mismatches = 0;
-    auto walk = [&](size_t begin, size_t end) {
-      std::map<std::tuple<int, int, int>, uint32_t> expected, got;
-      for (size_t r = begin; r < end; ++r) {
-        const RayEnd& e = b.ends[r];
-        octomap::OcTreeKey end_key;
-        EXPECT_TRUE(coord_to_key_checked(octomap::point3d(e.x, e.y, e.z), res, end_key));
-        walk_octomap_ray(b.origin, octomap::point3d(e.x, e.y, e.z), b.origin_key, end_key, res, [&](const octomap::OcTreeKey& k) {
-          if (layout.contains(k)) expected[{k[0], k[1], k[2]}] |= kStateFree;
-        });
-        if ((e.flags & kRayEndOccupied) && layout.contains(end_key)) expected[{end_key[0], end_key[1], end_key[2]}] |= kStateOccupied;
-      }
-      touched.clear();
-      GridMarker marker{grid.data(), touched, false};
-      walk_rays_avx2(b, begin, end, layout, res, marker);
-      for (uint32_t word : touched) {
-        for (uint32_t slot = 0; slot < 16; ++slot)
-          if (const uint32_t bits = grid[word] >> (2 * slot) & 3u) {
-            const octomap::OcTreeKey k = layout.key_of(word, slot);
-            got[{k[0], k[1], k[2]}] = bits;
-          }
-        grid[word] = 0;
-      }
-      if (got != expected && ++mismatches <= 3)
-        ADD_FAILURE() << "origin " << origin << " rows " << rows << " rays " << begin << "-" << end << ": " << got.size() << " voxels, OctoMap's walk "
-                      << expected.size();
-      return expected.size();
-    };
-    size_t inside = 0;
-    for (size_t r = 0; r < b.ends.size(); ++r) inside += walk(r, r + 1) > 1;
-    EXPECT_GT(inside, 1000u);
-    EXPECT_GT(walk(0, b.ends.size()), 500u);
-    EXPECT_EQ(mismatches, 0);
+      const BrickLayout layout(w, rows);
+      ASSERT_TRUE(layout.contains(b.origin_key));
+      // Ray by ray (a union over many rays would hide one ray's early stop), then all at once.
+      std::vector<uint32_t> grid(layout.voxels() / 16 + 2, 0), touched;
+      int mismatches = 0;
+      auto walk = [&](size_t begin, size_t end) {
+        std::map<std::tuple<int, int, int>, uint32_t> expected, got;
+        for (size_t r = begin; r < end; ++r) {
+          const RayEnd& e = b.ends[r];
+          octomap::OcTreeKey end_key;
+          EXPECT_TRUE(coord_to_key_checked(octomap::point3d(e.x, e.y, e.z), res, end_key));
+          walk_octomap_ray(b.origin, octomap::point3d(e.x, e.y, e.z), b.origin_key, end_key, res,
+                           [&](const octomap::OcTreeKey& k) {
+                             if (layout.contains(k)) expected[{k[0], k[1], k[2]}] |= kStateFree;
+                           });
+          if ((e.flags & kRayEndOccupied) && layout.contains(end_key))
+            expected[{end_key[0], end_key[1], end_key[2]}] |= kStateOccupied;
+        }
+        touched.clear();
+        GridMarker marker{grid.data(), touched, false};
+        walk_rays_avx2(b, begin, end, layout, res, marker);
+        for (uint32_t word : touched) {
+          for (uint32_t slot = 0; slot < 16; ++slot)
+            if (const uint32_t bits = grid[word] >> (2 * slot) & 3u) {
+              const octomap::OcTreeKey k = layout.key_of(word, slot);
+              got[{k[0], k[1], k[2]}] = bits;
+            }
+          grid[word] = 0;
+        }
+        if (got != expected && ++mismatches <= 3)
+          ADD_FAILURE() << "origin " << origin << " rows " << rows << " rays " << begin << "-" << end << ": "
+                        << got.size() << " voxels, OctoMap's walk " << expected.size();
+        return expected.size();
+      };
+      size_t inside = 0;
+      for (size_t r = 0; r < b.ends.size(); ++r) inside += walk(r, r + 1) > 1;
+      EXPECT_GT(inside, 1000u);
+      EXPECT_GT(walk(0, b.ends.size()), 500u);
+      EXPECT_EQ(mismatches, 0);
     }
   }
 }

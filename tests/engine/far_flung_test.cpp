@@ -12,10 +12,10 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.h"
-#include "core/ray_tiles.h"
-#include "engine/map_engine.h"
 #include "core/octomap_ray_walk.h"
 #include "core/prepare_scan.h"
+#include "core/ray_tiles.h"
+#include "engine/map_engine.h"
 #include "support/octomap_reference.h"
 #include "support/tree_compare.h"
 
@@ -129,7 +129,8 @@ TEST(RayTiles, BatchWalkKeysEqualRayByRay) {
                        size_t(8), size_t(9), all.size()}) {
         batch.ends.assign(all.begin(), all.begin() + n);
         uint64_t sum = 0, longest = 0;
-        for (const RayEnd& e : batch.ends) sum += ray_walk_keys(batch, e), longest = std::max(longest, ray_walk_keys(batch, e));
+        for (const RayEnd& e : batch.ends)
+          sum += ray_walk_keys(batch, e), longest = std::max(longest, ray_walk_keys(batch, e));
         for (bool simd : {true, false}) {
           const WalkKeyTotals t = batch_walk_keys(batch, simd);
           EXPECT_EQ(t.sum, sum) << "res " << res << " n " << n << " simd " << simd;

@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/map_engine.h"
 #include "core/prepare_scan.h"
+#include "engine/map_engine.h"
 
 namespace ort {
 namespace {
@@ -82,8 +82,18 @@ TEST(CoordToKey, MatchesOctomapOnBordersAndRangeEdges) {
   for (double res : {0.1, 0.05, 0.2, 0.3, 1.0}) {
     octomap::OcTree tree(res);
     const float edge = float(32768 * res);
-    std::vector<float> values = {0.0f, -0.0f, inf, -inf, nan, edge, -edge, std::nextafter(edge, 0.0f),
-                                 std::nextafter(-edge, 0.0f), std::nextafter(-edge, -2 * edge), 1e-30f, -1e-30f};
+    std::vector<float> values = {0.0f,
+                                 -0.0f,
+                                 inf,
+                                 -inf,
+                                 nan,
+                                 edge,
+                                 -edge,
+                                 std::nextafter(edge, 0.0f),
+                                 std::nextafter(-edge, 0.0f),
+                                 std::nextafter(-edge, -2 * edge),
+                                 1e-30f,
+                                 -1e-30f};
     for (int k = -300; k <= 300; ++k) {
       const float border = float(k * res);
       for (float v : {border, std::nextafter(border, inf), std::nextafter(border, -inf)}) values.push_back(v);
@@ -133,7 +143,8 @@ TEST(MapFrame, InlinedTransformEqualsPose6dTransformBitForBit) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f), mag(-3.0f, 3.5f);
   std::vector<octomap::pose6d> poses = {octomap::pose6d(0, 0, 0, 0, 0, 0), octomap::pose6d(1, 2, 3, 3.14159265, 0, 0),
                                         octomap::pose6d(-1, 0, 0.5, 0, 0, -3.14159265)};
-  for (int i = 0; i < 40; ++i) poses.emplace_back(shift(rng), shift(rng), shift(rng), angle(rng), angle(rng), angle(rng));
+  for (int i = 0; i < 40; ++i)
+    poses.emplace_back(shift(rng), shift(rng), shift(rng), angle(rng), angle(rng), angle(rng));
   const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
   std::vector<octomap::point3d> points = {{0, 0, 0}, {-0.0f, 0, -0.0f}, {inf, 1, 2}, {1, nan, 3}, {-inf, -inf, 0}};
   for (int i = 0; i < 20000; ++i) {
@@ -160,9 +171,11 @@ TEST(MapFrame, TransformInLanesEqualsPointByPointBitForBit) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f), mag(-3.0f, 3.5f);
   std::vector<octomap::pose6d> poses = {octomap::pose6d(0, 0, 0, 0, 0, 0), octomap::pose6d(1, 2, 3, 3.14159265, 0, 0),
                                         octomap::pose6d(-1, 0, 0.5, 0, 0, -3.14159265)};
-  for (int i = 0; i < 20; ++i) poses.emplace_back(shift(rng), shift(rng), shift(rng), angle(rng), angle(rng), angle(rng));
+  for (int i = 0; i < 20; ++i)
+    poses.emplace_back(shift(rng), shift(rng), shift(rng), angle(rng), angle(rng), angle(rng));
   const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
-  const octomap::point3d odd[] = {{0, 0, 0}, {-0.0f, 0, -0.0f}, {inf, 1, 2}, {1, nan, 3}, {-inf, -inf, 0}, {0, 0, -0.0f}};
+  const octomap::point3d odd[] = {{0, 0, 0},   {-0.0f, 0, -0.0f}, {inf, 1, 2},
+                                  {1, nan, 3}, {-inf, -inf, 0},   {0, 0, -0.0f}};
   std::vector<octomap::point3d> points;
   for (int i = 0; i < 20000; ++i) {
     const float scale = std::pow(10.0f, mag(rng));
@@ -181,7 +194,8 @@ TEST(MapFrame, TransformInLanesEqualsPointByPointBitForBit) {
         ASSERT_EQ(std::memcmp(&one_by_one[i], &expected, sizeof expected), 0) << i;
         ASSERT_EQ(std::memcmp(&apart[i], &expected, sizeof expected), 0) << i;
         ASSERT_EQ(std::memcmp(&lanes[i], &expected, sizeof expected), 0)
-            << points[i] << " under " << pose << ": " << lanes[i] << " vs " << expected << " (point " << i << " of " << n << ")";
+            << points[i] << " under " << pose << ": " << lanes[i] << " vs " << expected << " (point " << i << " of "
+            << n << ")";
       }
     }
   }
@@ -236,7 +250,8 @@ TEST(PrepareScan, FourPointsAtATimeGiveThePointByPointBatch) {
   std::uniform_real_distribution<float> u(-60.0f, 60.0f);
   std::uniform_int_distribution<int> pick(0, 15);
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
-  const float special[] = {0.0f, -0.0f, 0.1f, -0.1f, 0.3f, -0.3f, 3276.7f, -3276.8f, 3276.8f, -3276.9f, 1e7f, nan, inf, -inf};
+  const float special[] = {0.0f,     -0.0f,   0.1f,     -0.1f, 0.3f, -0.3f, 3276.7f,
+                           -3276.8f, 3276.8f, -3276.9f, 1e7f,  nan,  inf,   -inf};
   for (double res : {0.1, 0.05}) {
     for (size_t count : {0u, 1u, 3u, 4u, 7u, 50001u}) {
       std::vector<octomap::point3d> pts;
@@ -244,9 +259,12 @@ TEST(PrepareScan, FourPointsAtATimeGiveThePointByPointBatch) {
         octomap::point3d p(u(rng), u(rng), u(rng));
         for (int a = 0; a < 3; ++a) {
           const int k = pick(rng);
-          if (k < 14 && i % 5 == 0) p(a) = special[k];
-          else if (k == 14) p(a) = std::nextafter(std::round(p(a) * 10) / 10, 1e9f);
-          else if (k == 15) p(a) = std::nextafter(std::round(p(a) * 10) / 10, -1e9f);
+          if (k < 14 && i % 5 == 0)
+            p(a) = special[k];
+          else if (k == 14)
+            p(a) = std::nextafter(std::round(p(a) * 10) / 10, 1e9f);
+          else if (k == 15)
+            p(a) = std::nextafter(std::round(p(a) * 10) / 10, -1e9f);
         }
         pts.push_back(p);
       }

@@ -1,15 +1,15 @@
 // The native ray walk (core/octomap_ray_walk.h) and the cpu-grid back end against
 // OctoMap's own computeRayKeys and insertPointCloud, on rays chosen to hit the corner cases.
-#include <random>
 #include <cmath>
-#include <tuple>
+#include <random>
 #include <set>
+#include <tuple>
 
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
-#include "core/cpu_grid_backend.h"
 #include "core/cpu_backend.h"
+#include "core/cpu_grid_backend.h"
 #include "core/octomap_ray_walk.h"
 #include "core/prepare_scan.h"
 
@@ -29,17 +29,28 @@ std::vector<std::pair<octomap::point3d, octomap::point3d>> tricky_rays(size_t n,
     octomap::point3d o(u(rng), u(rng), u(rng)), e(u(rng), u(rng), u(rng));
     switch (kind(rng)) {
       case 0: break;
-      case 1: e = o; e(i % 3) += u(rng); break;                                       // axis-aligned
-      case 2: o = octomap::point3d(g(rng) * res, g(rng) * res, g(rng) * res);        // corners
-              e = octomap::point3d(g(rng) * res, g(rng) * res, g(rng) * res); break;
-      case 3: o = octomap::point3d(g(rng) * res, u(rng), g(rng) * res);              // along faces/edges
-              e = octomap::point3d(o.x(), u(rng), g(rng) * res); break;
+      case 1:
+        e = o;
+        e(i % 3) += u(rng);
+        break;  // axis-aligned
+      case 2:
+        o = octomap::point3d(g(rng) * res, g(rng) * res, g(rng) * res);  // corners
+        e = octomap::point3d(g(rng) * res, g(rng) * res, g(rng) * res);
+        break;
+      case 3:
+        o = octomap::point3d(g(rng) * res, u(rng), g(rng) * res);  // along faces/edges
+        e = octomap::point3d(o.x(), u(rng), g(rng) * res);
+        break;
       case 4: e = o + octomap::point3d(u(rng), u(rng), u(rng)) * float(res / 40); break;  // sub-voxel
-      case 5: e = o; break;                                                          // zero length
-      case 6: o = octomap::point3d(edge - 1.0f, -edge + 2.0f, u(rng));               // key-range edge
-              e = octomap::point3d(edge - 0.001f * (1 + g(rng) % 5), -edge + 0.001f, u(rng)); break;
-      case 7: o = octomap::point3d(-u(rng) - 0.5f, -std::abs(u(rng)), -1.0f);        // negative
-              e = o - octomap::point3d(std::abs(u(rng)), 0.5f, std::abs(u(rng))); break;
+      case 5: e = o; break;                                                               // zero length
+      case 6:
+        o = octomap::point3d(edge - 1.0f, -edge + 2.0f, u(rng));  // key-range edge
+        e = octomap::point3d(edge - 0.001f * (1 + g(rng) % 5), -edge + 0.001f, u(rng));
+        break;
+      case 7:
+        o = octomap::point3d(-u(rng) - 0.5f, -std::abs(u(rng)), -1.0f);  // negative
+        e = o - octomap::point3d(std::abs(u(rng)), 0.5f, std::abs(u(rng)));
+        break;
     }
     rays.push_back({o, e});
   }

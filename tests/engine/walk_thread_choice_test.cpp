@@ -36,7 +36,7 @@ TEST(WalkThreadChoice, HelpersThatGetTheirCoresKeepWalking) {
   c.record(3, kRays, 10.0, 2.0);  // two helpers, a tenth of a core each
   EXPECT_EQ(c.next(), 1u);
   for (unsigned w = 0; w + 1 < WalkThreadChoice::kProbeEvery; ++w) c.record(c.next(), kRays, 10.0, 0.0);
-  ASSERT_EQ(c.next(), 3u);  // the probe
+  ASSERT_EQ(c.next(), 3u);         // the probe
   c.record(3, kRays, 10.0, 19.0);  // now they got 0.95 of a core each: the other stage went idle
   EXPECT_NEAR(c.helper_share(), 0.95, 1e-12);
   for (int w = 0; w < 20; ++w) {

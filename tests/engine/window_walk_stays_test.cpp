@@ -31,11 +31,12 @@ RayBatch scan(const octomap::point3d& origin, float reach, uint32_t seed) {
   std::vector<octomap::point3d> pts;
   for (int i = 0; i < 8000; ++i) {
     octomap::point3d d(u(rng), u(rng), u(rng));
-    if (i % 5 == 0) d(i / 5 % 3) = 0.0f;                                         // in an axis plane
+    if (i % 5 == 0) d(i / 5 % 3) = 0.0f;                                                      // in an axis plane
     if (i % 5 == 1) d = octomap::point3d(0, 0, 0), d(i / 5 % 3) = u(rng) < 0 ? -1.0f : 1.0f;  // along an axis
     if (d.norm() == 0.0f) continue;
     octomap::point3d e = origin + d.normalized() * (reach * len(rng));
-    if (i % 4 == 0) e = octomap::point3d(std::round(e.x() * 10) / 10, std::round(e.y() * 10) / 10, std::round(e.z() * 10) / 10);
+    if (i % 4 == 0)
+      e = octomap::point3d(std::round(e.x() * 10) / 10, std::round(e.y() * 10) / 10, std::round(e.z() * 10) / 10);
     pts.push_back(e);
   }
   PrepareReport rep;
@@ -77,7 +78,7 @@ Marks walk_both(const RayBatch& b, size_t begin, size_t end, const BrickLayout& 
 TEST(WindowWalkStays, OneWindowOfTheWholeRaySpaceEqualsOctomapRayByRay) {
   if (!cpu_has_avx2()) GTEST_SKIP() << "no AVX2 on this CPU";
   for (const octomap::point3d& origin : {octomap::point3d(0.05f, 0.05f, 0.05f), octomap::point3d(0.8f, -1.6f, 0.4f),
-                                        octomap::point3d(-12.34f, 7.0f, 1.25f)}) {
+                                         octomap::point3d(-12.34f, 7.0f, 1.25f)}) {
     const RayBatch b = scan(origin, 4.0f, 7);
     const std::vector<KeyBox> windows = plan_windows(b.keys, 1ull << 30);
     ASSERT_EQ(windows.size(), 1u);
@@ -108,7 +109,8 @@ TEST(WindowWalkStays, RefusedWhereARayMayLeaveTheWindow) {
   RayBatch tile = b;
   tile.keys_hold_ends = false;
   for (int i = 0; i < 3; ++i) tile.keys.lo[i] = b.origin_key[i] - 8, tile.keys.hi[i] = b.origin_key[i] + 8;
-  EXPECT_FALSE(rays_stay_inside(tile, 0, tile.ends.size(), BrickLayout(plan_windows(tile.keys, 1ull << 30)[0], true), kRes));
+  EXPECT_FALSE(
+      rays_stay_inside(tile, 0, tile.ends.size(), BrickLayout(plan_windows(tile.keys, 1ull << 30)[0], true), kRes));
   // The whole ray space without the margin: ends on the faces; and each margin key matters,
   // judged from the batch's box and ray by ray.
   ASSERT_TRUE(b.keys_hold_ends);

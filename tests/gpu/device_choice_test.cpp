@@ -29,8 +29,11 @@ TEST(DeviceChoice, AutomaticPicksTheBestTypeThatQualifies) {
   ASSERT_FALSE(ctx.devices().empty());
   int best_rank = 99, chosen_rank = 99;
   auto rank = [](VkPhysicalDeviceType t) {
-    return t == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU ? 0 : t == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU ? 1
-         : t == VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU ? 2 : t == VK_PHYSICAL_DEVICE_TYPE_CPU ? 3 : 4;
+    return t == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU     ? 0
+           : t == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU ? 1
+           : t == VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU    ? 2
+           : t == VK_PHYSICAL_DEVICE_TYPE_CPU            ? 3
+                                                         : 4;
   };
   for (const vk::DeviceInfo& d : ctx.devices()) {
     std::printf("device %u: %s (%s) %s\n", d.index, d.name.c_str(), vk::device_type_name(d.type),
@@ -54,7 +57,8 @@ TEST(DeviceChoice, ByIndexAndByNameSubstring) {
 
   // A middle part of the name, in the other case.
   std::string part = automatic.device_name().substr(1, std::min<size_t>(6, automatic.device_name().size() - 1));
-  for (char& c : part) c = std::isupper((unsigned char)c) ? char(std::tolower((unsigned char)c)) : char(std::toupper((unsigned char)c));
+  for (char& c : part)
+    c = std::isupper((unsigned char)c) ? char(std::tolower((unsigned char)c)) : char(std::toupper((unsigned char)c));
   vk::ContextOptions by_name;
   by_name.device = part;
   EXPECT_EQ(vk::Context(by_name).device_name(), automatic.device_name()) << part;

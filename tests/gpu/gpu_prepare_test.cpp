@@ -14,9 +14,9 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/map_engine.h"
 #include "core/map_frame.h"
 #include "core/prepare_scan.h"
+#include "engine/map_engine.h"
 #include "gpu/gpu_prepare.h"
 #include "gpu/vk/vk_buffer.h"
 #include "gpu/vk/vk_context.h"
@@ -93,9 +93,9 @@ class GpuPrepareTest : public ::testing::Test {
       if (std::memcmp(&g, &w, sizeof g) == 0) continue;
       if (++differ <= 5) {
         ADD_FAILURE() << what << ": ray " << i << " GPU (" << g.x << ", " << g.y << ", " << g.z << ", " << g.flags
-                      << ") bits " << std::hex << bits(g.x) << " " << bits(g.y) << " " << bits(g.z) << ", CPU (" << std::dec
-                      << w.x << ", " << w.y << ", " << w.z << ", " << w.flags << ") bits " << std::hex << bits(w.x) << " "
-                      << bits(w.y) << " " << bits(w.z);
+                      << ") bits " << std::hex << bits(g.x) << " " << bits(g.y) << " " << bits(g.z) << ", CPU ("
+                      << std::dec << w.x << ", " << w.y << ", " << w.z << ", " << w.flags << ") bits " << std::hex
+                      << bits(w.x) << " " << bits(w.y) << " " << bits(w.z);
       }
     }
     EXPECT_EQ(differ, 0u) << what;

@@ -72,7 +72,8 @@ void sort_voxels(VoxelList& v) {
 }
 
 bool same_voxels(const VoxelList& a, const VoxelList& b) {
-  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](const VoxelUpdate& x, const VoxelUpdate& y) {
+  return a.size() == b.size() &&
+         std::equal(a.begin(), a.end(), b.begin(), [](const VoxelUpdate& x, const VoxelUpdate& y) {
            return pack(x) == pack(y) && x.state == y.state;
          });
 }
@@ -86,8 +87,10 @@ std::string diff_voxels(const VoxelList& got, const VoxelList& want, const RayBa
   std::vector<std::pair<uint64_t, std::string>> bad;
   for (const auto& [k, s] : g) {
     auto it = w.find(k);
-    if (it == w.end()) bad.push_back({k, "extra (state " + std::to_string(s) + ")"});
-    else if (it->second != s) bad.push_back({k, "state " + std::to_string(s) + " instead of " + std::to_string(it->second)});
+    if (it == w.end())
+      bad.push_back({k, "extra (state " + std::to_string(s) + ")"});
+    else if (it->second != s)
+      bad.push_back({k, "state " + std::to_string(s) + " instead of " + std::to_string(it->second)});
   }
   for (const auto& [k, s] : w) {
     if (!g.count(k)) bad.push_back({k, "missing (state " + std::to_string(s) + ")"});

@@ -8,7 +8,9 @@ namespace {
 
 using octomap::point3d;
 
-double uniform(std::mt19937_64& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
 int uniform_int(std::mt19937_64& rng, int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); }
 
 point3d random_direction(std::mt19937_64& rng) {
@@ -40,20 +42,23 @@ RandomScan random_scan(std::mt19937_64& rng) {
   const int rays = uniform_int(rng, 1, 8);
   const int kind = uniform_int(rng, 0, 9);
   auto random_point = [&](double half) {
-    return point3d(float(uniform(rng, -half, half)), float(uniform(rng, -half, half)), float(uniform(rng, -half, half)));
+    return point3d(float(uniform(rng, -half, half)), float(uniform(rng, -half, half)),
+                   float(uniform(rng, -half, half)));
   };
   switch (kind) {
     case 0:  // random rays around the map's centre, negative coordinates included
     case 1: {
       s.kind = "random";
       s.origin = random_point(20.0);
-      for (int i = 0; i < rays; ++i) s.points.push_back(s.origin + random_direction(rng) * float(uniform(rng, 0.0, 60 * res)));
+      for (int i = 0; i < rays; ++i)
+        s.points.push_back(s.origin + random_direction(rng) * float(uniform(rng, 0.0, 60 * res)));
       break;
     }
     case 2: {  // axis-aligned, from anywhere or from a voxel boundary
       s.kind = "axis";
       s.origin = random_point(10.0);
-      if (uniform_int(rng, 0, 1)) s.origin = point3d(on_grid(rng, res, 50), on_grid(rng, res, 50), on_grid(rng, res, 50));
+      if (uniform_int(rng, 0, 1))
+        s.origin = point3d(on_grid(rng, res, 50), on_grid(rng, res, 50), on_grid(rng, res, 50));
       for (int i = 0; i < rays; ++i) {
         point3d d(0, 0, 0);
         d(uniform_int(rng, 0, 2)) = float(uniform(rng, -40 * res, 40 * res));
@@ -89,11 +94,14 @@ RandomScan random_scan(std::mt19937_64& rng) {
     case 5: {  // zero-length and sub-voxel rays
       s.kind = "short";
       s.origin = random_point(5.0);
-      if (uniform_int(rng, 0, 1)) s.origin = point3d(on_grid(rng, res, 20), on_grid(rng, res, 20), on_grid(rng, res, 20));
+      if (uniform_int(rng, 0, 1))
+        s.origin = point3d(on_grid(rng, res, 20), on_grid(rng, res, 20), on_grid(rng, res, 20));
       for (int i = 0; i < rays; ++i) {
         const int how = uniform_int(rng, 0, 2);
-        if (how == 0) s.points.push_back(s.origin);
-        else s.points.push_back(s.origin + random_direction(rng) * float(uniform(rng, 0.0, how == 1 ? 1e-4 : res)));
+        if (how == 0)
+          s.points.push_back(s.origin);
+        else
+          s.points.push_back(s.origin + random_direction(rng) * float(uniform(rng, 0.0, how == 1 ? 1e-4 : res)));
       }
       break;
     }
@@ -106,21 +114,24 @@ RandomScan random_scan(std::mt19937_64& rng) {
         o(a) = uniform_int(rng, 0, 2) ? float(side * (edge - uniform(rng, 0.0, 8 * res))) : float(uniform(rng, -5, 5));
       }
       s.origin = o;
-      for (int i = 0; i < rays; ++i) s.points.push_back(s.origin + random_direction(rng) * float(uniform(rng, 0.0, 10 * res)));
+      for (int i = 0; i < rays; ++i)
+        s.points.push_back(s.origin + random_direction(rng) * float(uniform(rng, 0.0, 10 * res)));
       break;
     }
     case 7: {  // far from the centre, negative
       s.kind = "far";
       s.origin = point3d(float(-uniform(rng, 0.3, 0.9) * 32768 * res), float(uniform(rng, -0.9, 0.9) * 32768 * res),
                          float(-uniform(rng, 0.0, 0.9) * 32768 * res));
-      for (int i = 0; i < rays; ++i) s.points.push_back(s.origin + random_direction(rng) * float(uniform(rng, 0.0, 40 * res)));
+      for (int i = 0; i < rays; ++i)
+        s.points.push_back(s.origin + random_direction(rng) * float(uniform(rng, 0.0, 40 * res)));
       break;
     }
     default: {  // cut at max range: free space only, the cut end voxel not updated
       s.kind = "max_range";
       s.origin = random_point(10.0);
       s.max_range = uniform(rng, 2 * res, 20 * res);
-      for (int i = 0; i < rays; ++i) s.points.push_back(s.origin + random_direction(rng) * float(uniform(rng, 0.0, 40 * res)));
+      for (int i = 0; i < rays; ++i)
+        s.points.push_back(s.origin + random_direction(rng) * float(uniform(rng, 0.0, 40 * res)));
       break;
     }
   }

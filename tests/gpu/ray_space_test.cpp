@@ -54,8 +54,8 @@ TEST(VulkanRaySpace, TinyGridSplitsScansIntoWindowsAndStillEqualsCpu) {
       gpu->shoot(batch, mode, got, stats);
       sort_voxels(got);
       const VoxelList want = cpu_states(batch, mode);
-      EXPECT_TRUE(same_voxels(got, want)) << to_string(mode) << " scan " << scan << ": "
-                                          << diff_voxels(got, want, batch, mode).substr(0, 2000);
+      EXPECT_TRUE(same_voxels(got, want))
+          << to_string(mode) << " scan " << scan << ": " << diff_voxels(got, want, batch, mode).substr(0, 2000);
       EXPECT_GE(stats.windows, 8u) << "ray space " << batch.keys.voxel_count() << " voxels";
       std::printf("%s scan %zu: %zu rays, %llu windows, %zu voxels\n", to_string(mode), scan, batch.ends.size(),
                   (unsigned long long)stats.windows, got.size());
@@ -84,7 +84,8 @@ TEST(VulkanRaySpace, ManyScansOneGridNothingLeftBehind) {
       gpu->shoot(batch, Traversal::kOctomap, got, stats);
       sort_voxels(got);
       const VoxelList want = cpu_states(batch, Traversal::kOctomap);
-      EXPECT_TRUE(same_voxels(got, want)) << "scan " << scan << ": " << diff_voxels(got, want, batch, Traversal::kOctomap).substr(0, 2000);
+      EXPECT_TRUE(same_voxels(got, want))
+          << "scan " << scan << ": " << diff_voxels(got, want, batch, Traversal::kOctomap).substr(0, 2000);
       EXPECT_EQ(stats.windows, 1u);
       EXPECT_EQ(stats.grid_allocations, 1u);
       EXPECT_EQ(stats.words_read_back, stats.words_touched);
@@ -111,7 +112,8 @@ TEST(VulkanRaySpace, ChunkedCompactionWhenTouchedWordsExceedOnePass) {
     gpu->shoot(batch, mode, got, stats);
     sort_voxels(got);
     ASSERT_GT(stats.words_touched, 4u * 4096u) << "the scan does not exercise chunking";
-    std::printf("%s: %llu words touched, 4096 a compact pass\n", to_string(mode), (unsigned long long)stats.words_touched);
+    std::printf("%s: %llu words touched, 4096 a compact pass\n", to_string(mode),
+                (unsigned long long)stats.words_touched);
     EXPECT_EQ(stats.words_read_back, stats.words_touched);
     const VoxelList want = cpu_states(batch, mode);
     EXPECT_TRUE(same_voxels(got, want)) << diff_voxels(got, want, batch, mode).substr(0, 2000);
@@ -125,8 +127,8 @@ TEST(VulkanRaySpace, OccupiedWinsOverFreeInsideOneScan) {
   // passes through both but is cut at max range 6 m (x = 6.05): free space only, and the
   // voxel at the cut end is not updated;
   // ray 3 ends (a hit) in the origin's own voxel: occupied, although every ray starts there.
-  const std::vector<octomap::point3d> points = {{2.05f, 0.05f, 0.05f}, {5.05f, 0.05f, 0.05f},
-                                                {9.05f, 0.05f, 0.05f}, {0.07f, 0.06f, 0.04f}};
+  const std::vector<octomap::point3d> points = {
+      {2.05f, 0.05f, 0.05f}, {5.05f, 0.05f, 0.05f}, {9.05f, 0.05f, 0.05f}, {0.07f, 0.06f, 0.04f}};
   for (Traversal mode : {Traversal::kOctomap, Traversal::kExact}) {
     PrepareReport report;
     const RayBatch batch = prepare_scan(origin, points, 6.0, 0.1, report);

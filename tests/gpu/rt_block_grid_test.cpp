@@ -98,9 +98,12 @@ TEST(RtBlockGrid, WindowsTileTheWidenedKeyBoxOnceEach) {
   const int wanted[3] = {8, 8, 4};
   const BlockGrid s = choose_block_grid(4, wanted, BlockGridLimits{});
   KeyBox keys;
-  keys.lo[0] = 3; keys.hi[0] = 30;          // near the low key edge: clamped to 0
-  keys.lo[1] = 32760; keys.hi[1] = 32770;
-  keys.lo[2] = 65530; keys.hi[2] = 65535;   // at the high key edge: clamped to 65535
+  keys.lo[0] = 3;
+  keys.hi[0] = 30;  // near the low key edge: clamped to 0
+  keys.lo[1] = 32760;
+  keys.hi[1] = 32770;
+  keys.lo[2] = 65530;
+  keys.hi[2] = 65535;  // at the high key edge: clamped to 65535
   const auto windows = tile_windows(keys, s, 1);
   std::map<Key, int> hits;
   for (const KeyBox& w : windows) {
@@ -194,8 +197,9 @@ VoxelList model_rt_shoot(const RayBatch& batch, const BlockGrid& s, uint64_t* ca
         for (int y = vlo[1]; y <= vhi[1]; ++y)
           for (int x = vlo[0]; x <= vhi[0]; ++x) {
             const int v[3] = {x, y, z};  // window-local voxel
-            const uint64_t inst = uint64_t(x / s.block) +
-                                  uint64_t(s.blocks[0]) * (uint64_t(y / s.block) + uint64_t(s.blocks[1]) * uint64_t(z / s.block));
+            const uint64_t inst =
+                uint64_t(x / s.block) +
+                uint64_t(s.blocks[0]) * (uint64_t(y / s.block) + uint64_t(s.blocks[1]) * uint64_t(z / s.block));
             const uint32_t prim = uint32_t(x % s.block) + k * (uint32_t(y % s.block) + k * uint32_t(z % s.block));
             float t[3], lo[3], hi[3];
             instance_translation(s, inst, t);
@@ -274,9 +278,11 @@ TEST(RtBlockGrid, ModelOfTheRtShootEqualsTheExactCpuReference) {
       octomap::point3d e(u(rng), u(rng), u(rng));
       switch (pick(rng)) {
         case 0: e = octomap::point3d(g(rng) * 0.1f, g(rng) * 0.1f, g(rng) * 0.1f); break;  // grid point
-        case 1: e = octomap::point3d(e.x(), origin.y(), origin.z()); break;               // axis-aligned
-        case 2: e = octomap::point3d(g(rng) * 0.1f, origin.y(), e.z()); break;            // in a plane
-        case 3: if (r % 10 == 0) e = origin; break;                                       // zero length
+        case 1: e = octomap::point3d(e.x(), origin.y(), origin.z()); break;                // axis-aligned
+        case 2: e = octomap::point3d(g(rng) * 0.1f, origin.y(), e.z()); break;             // in a plane
+        case 3:
+          if (r % 10 == 0) e = origin;
+          break;  // zero length
         default: break;
       }
       ends.push_back(e);
@@ -296,8 +302,8 @@ TEST(RtBlockGrid, ModelCoversVoxelsJustBelowTheKeyBox) {
   // their low sides have keys below the scan's key box: the window margin must hold them.
   const double res = 0.5;
   const octomap::point3d origin(-16.0f, 5.0f, 4.0f);
-  const std::vector<octomap::point3d> ends = {{-16.0f, 5.0f, 18.1849651f}, {-16.0f, 5.0f, 4.34148407f},
-                                              {1.25694466f, 5.0f, 4.0f}, {-16.0f, 5.0f, 4.0f}};
+  const std::vector<octomap::point3d> ends = {
+      {-16.0f, 5.0f, 18.1849651f}, {-16.0f, 5.0f, 4.34148407f}, {1.25694466f, 5.0f, 4.0f}, {-16.0f, 5.0f, 4.0f}};
   const RayBatch batch = make_batch(origin, ends, res);
   auto cpu = make_cpu_backend(res);
   VoxelList want;
@@ -305,7 +311,8 @@ TEST(RtBlockGrid, ModelCoversVoxelsJustBelowTheKeyBox) {
   cpu->shoot(batch, Traversal::kExact, want, st);
   for (int k : {2, 4, 8}) {
     const int wanted[3] = {64, 64, 64};
-    EXPECT_EQ(sorted(model_rt_shoot(batch, choose_block_grid(k, wanted, BlockGridLimits{}))), sorted(want)) << "k " << k;
+    EXPECT_EQ(sorted(model_rt_shoot(batch, choose_block_grid(k, wanted, BlockGridLimits{}))), sorted(want))
+        << "k " << k;
   }
   const KeyBox w = tile_windows(batch.keys, choose_block_grid(4, wanted_cube(), BlockGridLimits{}))[0];
   EXPECT_EQ(w.lo[0], batch.keys.lo[0] - 1);

@@ -5,9 +5,9 @@
 //
 // Where the device has no ray tracing (lavapipe in CI), the clean refusal is what is tested
 // and the GPU comparisons are skipped.
+#include <array>
 #include <cstdio>
 #include <cstdlib>
-#include <array>
 #include <map>
 #include <random>
 #include <string>
@@ -140,9 +140,10 @@ TEST(RtBackend, RandomRaysEqualExactReferenceAndVulkan) {
   std::string kinds;
   for (const auto& [k, n] : by_kind) kinds += " " + k + "=" + std::to_string(n);
   std::printf("rt exact: %llu rays in %llu scans equal to the exact reference%s (seed %llu);%s\n",
-              (unsigned long long)rays, (unsigned long long)scans, vk ? " and to vulkan" : "",
-              (unsigned long long)seed, kinds.c_str());
-  for (const char* k : {"axis", "face", "corner", "short", "key_edge", "far", "max_range"}) EXPECT_GT(by_kind[k], 1000u) << k;
+              (unsigned long long)rays, (unsigned long long)scans, vk ? " and to vulkan" : "", (unsigned long long)seed,
+              kinds.c_str());
+  for (const char* k : {"axis", "face", "corner", "short", "key_edge", "far", "max_range"})
+    EXPECT_GT(by_kind[k], 1000u) << k;
 }
 
 struct RealCase {
@@ -188,7 +189,7 @@ void compare_on_real_data(const rt::RtOptions& knobs, bool check_reference_on_fi
       if (with_reference) {
         const VoxelList want = reference_states(batch, Traversal::kExact);
         EXPECT_TRUE(same(got, want)) << c.file << " @" << c.resolution << " scan " << scan << ": "
-                                 << diff_voxels(got, want, batch, Traversal::kExact);
+                                     << diff_voxels(got, want, batch, Traversal::kExact);
       }
       bool equal_vk = false;
       if (vk) {
@@ -198,12 +199,13 @@ void compare_on_real_data(const rt::RtOptions& knobs, bool check_reference_on_fi
         sort_voxels(other);
         equal_vk = same(got, other);
         EXPECT_TRUE(equal_vk) << c.file << " @" << c.resolution << " scan " << scan << ": rt " << got.size()
-                                  << " voxels, vulkan " << other.size();
+                              << " voxels, vulkan " << other.size();
       }
-      std::printf("%s res %.2f max_range %.0f scan %d: %zu rays, %zu voxels, %llu window(s), k=%d block grid %dx%dx%d%s\n",
-                  c.file, c.resolution, c.max_range, scan, batch.ends.size(), got.size(),
-                  (unsigned long long)stats.windows, info.block_grid.block, info.block_grid.voxels(0), info.block_grid.voxels(1),
-                  info.block_grid.voxels(2), equal_vk ? ", equal to vulkan" : (vk ? ", DIFFERENT from vulkan" : ""));
+      std::printf(
+          "%s res %.2f max_range %.0f scan %d: %zu rays, %zu voxels, %llu window(s), k=%d block grid %dx%dx%d%s\n",
+          c.file, c.resolution, c.max_range, scan, batch.ends.size(), got.size(), (unsigned long long)stats.windows,
+          info.block_grid.block, info.block_grid.voxels(0), info.block_grid.voxels(1), info.block_grid.voxels(2),
+          equal_vk ? ", equal to vulkan" : (vk ? ", DIFFERENT from vulkan" : ""));
       ++scan;
     }
   }

@@ -69,7 +69,8 @@ class BlockBatches {
         for (int j = 0; j < side; ++j)
           for (int k = 0; k < side; ++k) {
             const OcTreeKey key(x + i, y + j, z + k);
-            if (seen.emplace(morton_code(key[0], key[1], key[2]), true).second) list.push_back(make_update(key, occupied));
+            if (seen.emplace(morton_code(key[0], key[1], key[2]), true).second)
+              list.push_back(make_update(key, occupied));
           }
       if (list.size() == first) continue;
       const size_t victim = first + static_cast<size_t>(pick(0, static_cast<int>(list.size() - first) - 1));

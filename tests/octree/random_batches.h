@@ -24,9 +24,9 @@ struct Cluster {
 // At the map origin (crossing the depth-1 split), at both ends of the key range, and a
 // corner mixing both ends.
 inline constexpr Cluster kClusters[] = {{32768 - 8, 32768 - 8, 32768 - 8, 16},
-                             {0, 0, 0, 16},
-                             {65536 - 16, 65536 - 16, 65536 - 16, 16},
-                             {0, 65536 - 16, 0, 16}};
+                                        {0, 0, 0, 16},
+                                        {65536 - 16, 65536 - 16, 65536 - 16, 16},
+                                        {0, 65536 - 16, 0, 16}};
 
 class BatchGenerator {
  public:
@@ -57,8 +57,7 @@ class BatchGenerator {
     const int singles = pick(0, 200);
     for (int i = 0; i < singles; ++i) {
       const Cluster& c = kClusters[pick(0, 3)];
-      add(OcTreeKey(c.x + pick(0, c.side - 1), c.y + pick(0, c.side - 1), c.z + pick(0, c.side - 1)),
-          pick(0, 2) == 0);
+      add(OcTreeKey(c.x + pick(0, c.side - 1), c.y + pick(0, c.side - 1), c.z + pick(0, c.side - 1)), pick(0, 2) == 0);
     }
     // The very corners of the key range, often.
     if (pick(0, 2) == 0) add(OcTreeKey(0, 0, 0), pick(0, 1) == 0);

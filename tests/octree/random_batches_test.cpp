@@ -29,12 +29,12 @@ using test::BatchGenerator;
 // How often the special cases of updateNode came up, judged on the reference tree before
 // each batch.
 struct CaseCounts {
-  long created = 0;            // no node on the path yet
-  long saturated_leaf = 0;     // finest leaf at the bound: early exit
-  long saturated_pruned = 0;   // pruned node at the bound: early exit
-  long expanded = 0;           // pruned node that updateNode has to expand
-  long batches_pruning = 0;    // batches after which there are pruned nodes that were not there
-  long edge_voxels = 0;        // keys with a coordinate 0 or 65535
+  long created = 0;           // no node on the path yet
+  long saturated_leaf = 0;    // finest leaf at the bound: early exit
+  long saturated_pruned = 0;  // pruned node at the bound: early exit
+  long expanded = 0;          // pruned node that updateNode has to expand
+  long batches_pruning = 0;   // batches after which there are pruned nodes that were not there
+  long edge_voxels = 0;       // keys with a coordinate 0 or 65535
 };
 
 // Deepest existing node on the key's path and its depth.
@@ -75,7 +75,8 @@ void count_cases(const OcTree& tree, const VoxelList& batch, CaseCounts& c) {
 std::vector<std::pair<unsigned, uint64_t>> pruned_nodes(const OcTree& tree) {
   std::vector<std::pair<unsigned, uint64_t>> out;
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it)
-    if (it.getDepth() < 16) out.emplace_back(it.getDepth(), morton_code(it.getKey()[0], it.getKey()[1], it.getKey()[2]));
+    if (it.getDepth() < 16)
+      out.emplace_back(it.getDepth(), morton_code(it.getKey()[0], it.getKey()[1], it.getKey()[2]));
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -152,9 +153,10 @@ void run_scenario(unsigned seed, int batches, void (*sensor)(OcTree&), Start sta
 int batch_count() { return test::quick_mode() ? 20 : 50; }
 
 void expect_all_cases(const CaseCounts& c) {
-  std::printf("cases: %ld created, %ld saturated leaves, %ld saturated pruned, %ld expanded, %ld batches pruning, "
-              "%ld edge voxels\n",
-              c.created, c.saturated_leaf, c.saturated_pruned, c.expanded, c.batches_pruning, c.edge_voxels);
+  std::printf(
+      "cases: %ld created, %ld saturated leaves, %ld saturated pruned, %ld expanded, %ld batches pruning, "
+      "%ld edge voxels\n",
+      c.created, c.saturated_leaf, c.saturated_pruned, c.expanded, c.batches_pruning, c.edge_voxels);
   // The quick variant (fewer batches, under TSan) sees fewer of the rarer cases.
   const long scale = test::quick_mode() ? 20 : 1;
   EXPECT_GT(c.created, 1000 / scale);
@@ -199,9 +201,8 @@ TEST(BatchedUpdate, OctomapResultDoesNotDependOnKeyOrder) {
   for (int b = 0; b < batch_count(); ++b) {
     VoxelList batch = gen.next();
     apply_updates_sequential(shuffled, batch);
-    std::sort(batch.begin(), batch.end(), [](const VoxelUpdate& a, const VoxelUpdate& c) {
-      return make_sorted_voxel(a) < make_sorted_voxel(c);
-    });
+    std::sort(batch.begin(), batch.end(),
+              [](const VoxelUpdate& a, const VoxelUpdate& c) { return make_sorted_voxel(a) < make_sorted_voxel(c); });
     apply_updates_sequential(morton, batch);
     std::reverse(batch.begin(), batch.end());
     apply_updates_sequential(reversed, batch);

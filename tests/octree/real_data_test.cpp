@@ -93,8 +93,8 @@ void check_data_set(const std::string& graph) {
     EXPECT_EQ(bt_bytes(b->tree), bt) << b->threads << " threads";
     EXPECT_EQ(b->tree.memoryUsage(), reference.memoryUsage());
   }
-  std::printf("%s: %zu scans x %d passes, %zu voxel updates, %zu nodes\n", graph.c_str(), lists.size(), passes,
-              voxels, reference.size());
+  std::printf("%s: %zu scans x %d passes, %zu voxel updates, %zu nodes\n", graph.c_str(), lists.size(), passes, voxels,
+              reference.size());
 }
 
 TEST(BatchedUpdateRealData, ThreeDtkThreeScans) { check_data_set("3dtk_dat/3dtk_3scans.graph"); }

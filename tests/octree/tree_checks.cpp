@@ -13,8 +13,7 @@ namespace ort::test {
   const TreeDiff leaves = compare_leaves(reference, batched);
   if (!leaves.maps_equal())
     return ::testing::AssertionFailure() << "leaves: " << leaves.differing_voxels << " voxels, "
-                                         << leaves.differing_logodds << " log-odds differ; "
-                                         << leaves.first_difference;
+                                         << leaves.differing_logodds << " log-odds differ; " << leaves.first_difference;
   return ::testing::AssertionSuccess();
 }
 

@@ -60,8 +60,14 @@ TEST(VoxelBuckets, SortedBucketsAreTheMortonSortOfTheList) {
   deep.min_shift = 1;
   BucketOptions coarse;
   coarse.min_shift = 15;
-  for (auto [n, lo, hi] : {std::tuple{0, 0, 1}, {1, 0, 65535}, {1000, 32700, 32800}, {200000, 0, 65535},
-                           {100000, 32000, 33000}, {60000, 32760, 32800}, {50000, 0, 40}, {40000, 65500, 65535}}) {
+  for (auto [n, lo, hi] : {std::tuple{0, 0, 1},
+                           {1, 0, 65535},
+                           {1000, 32700, 32800},
+                           {200000, 0, 65535},
+                           {100000, 32000, 33000},
+                           {60000, 32760, 32800},
+                           {50000, 0, 40},
+                           {40000, 65500, 65535}}) {
     const VoxelList list = random_unique_list(rng, n, lo, hi);
     std::vector<SortedVoxel> expected;
     for (const VoxelUpdate& u : list) expected.push_back(make_sorted_voxel(u));
@@ -117,19 +123,22 @@ TEST(VoxelBuckets, SortBucketIsTheStableMortonSort) {
             for (int z = 0; z < side; ++z) all.emplace_back(32768 - side + x, 32768 - side + y, 32768 - side + z);
         std::shuffle(all.begin(), all.end(), rng);
         std::vector<SortedVoxel> bucket;
-        for (size_t i = 0; i < n && i < all.size(); ++i) bucket.push_back(make_sorted_voxel(make_update(all[i], rng() % 2)));
+        for (size_t i = 0; i < n && i < all.size(); ++i)
+          bucket.push_back(make_sorted_voxel(make_update(all[i], rng() % 2)));
         if (repeat) {
           // The first key again, in the other state, somewhere later.
           const SortedVoxel again = bucket.front() ^ 1u;
           bucket.insert(bucket.begin() + static_cast<long>(1 + rng() % (bucket.size() - 1)), again);
         }
         std::vector<SortedVoxel> expected = bucket;
-        std::stable_sort(expected.begin(), expected.end(), [](SortedVoxel a, SortedVoxel b) { return (a >> 1) < (b >> 1); });
+        std::stable_sort(expected.begin(), expected.end(),
+                         [](SortedVoxel a, SortedVoxel b) { return (a >> 1) < (b >> 1); });
         std::vector<SortedVoxel> told = bucket;  // sorted knowing its node's size, as bucket_voxels' buckets are
         sort_bucket(bucket, tmp);
         ASSERT_EQ(bucket, expected) << "side " << side << ", " << n << " voxels, repeat " << repeat;
         sort_bucket(told, tmp, 3 * side_bits);
-        ASSERT_EQ(told, expected) << "side " << side << ", " << n << " voxels, repeat " << repeat << ", node bits given";
+        ASSERT_EQ(told, expected) << "side " << side << ", " << n << " voxels, repeat " << repeat
+                                  << ", node bits given";
       }
     }
   }

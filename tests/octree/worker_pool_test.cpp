@@ -5,8 +5,8 @@
 // thread runs it twice or after it returned, also between run() jobs.
 #include <algorithm>
 #include <atomic>
-#include <cstdio>
 #include <chrono>
+#include <cstdio>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -93,8 +93,7 @@ void run_chunks(WorkerPool& pool, std::vector<int>& chunk_runs, std::vector<int>
       ++chunk_runs[k];  // plain: one thread a chunk
       // A few microseconds of work a chunk, so that woken threads join the job.
       const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(20);
-      while (std::chrono::steady_clock::now() < until) {
-      }
+      while (std::chrono::steady_clock::now() < until) {}
     }
   });
 }
@@ -150,8 +149,8 @@ TEST_P(WorkerPoolTest, AnErrorInASharedJobReachesTheCallerAndThePoolGoesOn) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Pools, WorkerPoolTest,
-                         ::testing::Values(PoolCase{1, false}, PoolCase{2, false}, PoolCase{2, true}, PoolCase{5, false},
-                                           PoolCase{5, true}),
+                         ::testing::Values(PoolCase{1, false}, PoolCase{2, false}, PoolCase{2, true},
+                                           PoolCase{5, false}, PoolCase{5, true}),
                          [](const ::testing::TestParamInfo<PoolCase>& i) {
                            return std::to_string(i.param.workers) + (i.param.spin ? "Spinning" : "Sleeping");
                          });

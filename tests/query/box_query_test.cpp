@@ -23,9 +23,8 @@ void expect_counts(const BoxCounts& got, const BoxCounts& want, const std::strin
 }
 
 std::string describe(const std::string& map, const KeyBox& b) {
-  return map + " box [" + std::to_string(b.min[0]) + "," + std::to_string(b.min[1]) + "," +
-         std::to_string(b.min[2]) + "]..[" + std::to_string(b.max[0]) + "," + std::to_string(b.max[1]) + "," +
-         std::to_string(b.max[2]) + "]";
+  return map + " box [" + std::to_string(b.min[0]) + "," + std::to_string(b.min[1]) + "," + std::to_string(b.min[2]) +
+         "]..[" + std::to_string(b.max[0]) + "," + std::to_string(b.max[1]) + "," + std::to_string(b.max[2]) + "]";
 }
 
 // A wrong variant: counting each visited leaf's whole cube (no intersection with the box)

@@ -25,7 +25,9 @@ TEST(PointQuery, SameAsOctomapSearchAtEveryDepth) {
       // search(p, depth) (its out-of-range branch prints an error and returns null).
       octomap::OcTreeKey k;
       const octomap::OcTreeNode* n = t.coordToKeyChecked(p, k) ? t.search(p, depth) : nullptr;
-      ASSERT_EQ(a.state, !n ? VoxelState::kUnknown : t.isNodeOccupied(n) ? VoxelState::kOccupied : VoxelState::kFree)
+      ASSERT_EQ(a.state, !n                    ? VoxelState::kUnknown
+                         : t.isNodeOccupied(n) ? VoxelState::kOccupied
+                                               : VoxelState::kFree)
           << m.name << " point " << p << " depth " << depth;
       EXPECT_EQ(a.probability, n ? float(n->getOccupancy()) : -1.0f);
       counts[int(a.state)]++;
@@ -51,7 +53,8 @@ TEST(PointQuery, BatchKeepsInputOrderAndRefusesBadDepth) {
   const auto answers = query::query_points(t, xyz, 0);
   ASSERT_EQ(answers.size(), 300u);
   for (size_t i = 0; i < answers.size(); ++i)
-    EXPECT_EQ(answers[i].state, query::query_point(t, octomap::point3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2])).state);
+    EXPECT_EQ(answers[i].state,
+              query::query_point(t, octomap::point3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2])).state);
   EXPECT_THROW(query::query_points(t, xyz, 17), query::QueryError);
   EXPECT_THROW(query::query_points(t, xyz, -1), query::QueryError);
   EXPECT_EQ(query::query_point(t, octomap::point3d(NAN, 0, 0)).state, VoxelState::kUnknown);

@@ -30,8 +30,8 @@ const std::vector<NamedMap>& query_test_maps() {
   static const auto geb = load_bt(data_file("octomap_share/geb079.bt"));
   static const auto dtk = build(data_file("3dtk_dat/3dtk_3scans.graph"), 0.2, 30.0);
   static const auto fr = build(data_file("octomap_share/scan_dat.graph"), 0.1, 10.0);
-  static const std::vector<NamedMap> maps = {{"geb079.bt", geb.get()}, {"3dtk 0.2 m", dtk.get()},
-                                             {"scan_dat 0.1 m", fr.get()}};
+  static const std::vector<NamedMap> maps = {
+      {"geb079.bt", geb.get()}, {"3dtk 0.2 m", dtk.get()}, {"scan_dat 0.1 m", fr.get()}};
   return maps;
 }
 
@@ -57,9 +57,9 @@ octomap::point3d random_point(const octomap::OcTree& t, std::mt19937& rng) {
   const int kind = std::uniform_int_distribution<int>(0, 9)(rng);
   for (int i = 0; i < 3; ++i) {
     double v = lo[i] + u(rng) * (hi[i] - lo[i]);
-    if (kind == 0) v = (hi[i] + 100.0) * (u(rng) < 0.5 ? -1 : 1) * 10;     // far outside
-    if (kind == 1) v = (u(rng) < 0.5 ? -1 : 1) * (32768 * res + u(rng));    // beyond the key range
-    if (kind >= 2 && kind <= 4) v = std::round(v / res) * res;              // on voxel faces
+    if (kind == 0) v = (hi[i] + 100.0) * (u(rng) < 0.5 ? -1 : 1) * 10;    // far outside
+    if (kind == 1) v = (u(rng) < 0.5 ? -1 : 1) * (32768 * res + u(rng));  // beyond the key range
+    if (kind >= 2 && kind <= 4) v = std::round(v / res) * res;            // on voxel faces
     p[i] = static_cast<float>(v);
   }
   return octomap::point3d(p[0], p[1], p[2]);

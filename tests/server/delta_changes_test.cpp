@@ -143,7 +143,7 @@ void check_scan(const VoxelList& voxels, const test::KeyValues& before, const oc
 std::vector<PosedScan> scans_of(const std::string& name) {
   if (name == "fr079-real") {
     PresetOptions o;
-    o.scan_scale = 0.05;   // 3 of the 66 scans
+    o.scan_scale = 0.05;  // 3 of the 66 scans
     o.point_scale = 0.25;
     o.data_dir = test::data_dir();
     return make_preset("fr079-real", o).scans;
@@ -199,9 +199,10 @@ void check_data_set(const std::string& name) {
     for (const auto& [code, v] : test::values_of(*tree, all))
       ASSERT_EQ(mirror.at(packed(code)), class_of(v, thr)) << name << ", pass " << pass << ": the set's mirror";
   }
-  std::printf("%s: %ld scans, %ld leaf changes, %ld class changes; the old look-up path sent %ld / %ld no-ops "
-              "besides (class / exact mode)\n",
-              name.c_str(), t.scans, t.changes, t.class_changes, t.old_extra_class, t.old_extra_exact);
+  std::printf(
+      "%s: %ld scans, %ld leaf changes, %ld class changes; the old look-up path sent %ld / %ld no-ops "
+      "besides (class / exact mode)\n",
+      name.c_str(), t.scans, t.changes, t.class_changes, t.old_extra_class, t.old_extra_exact);
   EXPECT_GT(t.class_changes, 0);
   // On these data the old estimate was never ambiguous: in class mode it sent exactly this.
   EXPECT_EQ(t.old_extra_class, 0);

@@ -23,14 +23,17 @@ TEST(InstallIntegration, AnOutOfTreeProgramBuildsAgainstTheInstallAndFetchesTheM
   ASSERT_TRUE(ns.ok()) << ns.error();
   const std::string dir = make_test_dir("install");
   const std::string prefix = dir + "/prefix", ex = dir + "/example";
-  ASSERT_EQ(run("cmake --install " OCTOMAP_RT_BUILD_DIR " --component Unspecified --prefix " + prefix, dir + "/install.log"), 0)
+  ASSERT_EQ(
+      run("cmake --install " OCTOMAP_RT_BUILD_DIR " --component Unspecified --prefix " + prefix, dir + "/install.log"),
+      0)
       << dir << "/install.log";
   EXPECT_TRUE(std::filesystem::exists(prefix + "/lib/cmake/octomap_rt/octomap_rtConfig.cmake"));
   EXPECT_TRUE(std::filesystem::exists(prefix + "/bin/octomap-rt-server"));
   EXPECT_TRUE(std::filesystem::exists(prefix + "/include/octomap_rt/octomap_rt/map_chunk_t.hpp"));
-  ASSERT_EQ(run("cmake -S " OCTOMAP_RT_SOURCE_DIR "/client/examples/map_fetch -B " + ex + " -DCMAKE_PREFIX_PATH=" + prefix,
-                dir + "/configure.log"),
-            0)
+  ASSERT_EQ(
+      run("cmake -S " OCTOMAP_RT_SOURCE_DIR "/client/examples/map_fetch -B " + ex + " -DCMAKE_PREFIX_PATH=" + prefix,
+          dir + "/configure.log"),
+      0)
       << dir << "/configure.log";
   ASSERT_EQ(run("cmake --build " + ex, dir + "/build.log"), 0) << dir << "/build.log";
 

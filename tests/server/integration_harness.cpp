@@ -39,8 +39,7 @@ int run_quietly(const std::vector<std::string>& argv) {
     _exit(127);
   }
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
@@ -220,8 +219,8 @@ void StatusWatcher::on_status(const lcm::ReceiveBuffer* rbuf, const std::string&
 std::optional<octomap_rt::server_status_t> StatusWatcher::wait_for(
     const std::function<bool(const octomap_rt::server_status_t&)>& pred, double timeout_s) {
   std::unique_lock lock(mutex_);
-  const bool ok = cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
-                               [&] { return latest_ && pred(*latest_); });
+  const bool ok =
+      cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return latest_ && pred(*latest_); });
   if (!ok) return std::nullopt;
   return latest_;
 }

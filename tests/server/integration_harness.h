@@ -21,8 +21,8 @@
 #include <thread>
 #include <vector>
 
-#include <lcm/lcm-cpp.hpp>
 #include <octomap/OcTree.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include "octomap_rt/server_status_t.hpp"
 #include "octomap_rt/wire_contract.hpp"

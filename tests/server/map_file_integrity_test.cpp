@@ -37,9 +37,7 @@ std::string map_bytes(size_t scans) {
   return daemon::serialize_map(*tree);
 }
 
-void write(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary) << bytes;
-}
+void write(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
 
 std::string read(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -55,7 +55,8 @@ struct Fixture {
   }
   bool wait_applied(pid_t pid, int64_t n, double s) {
     return status
-        ->wait_for([&](const auto& st) { return st.pid == pid && total_applied(st) == n && st.scan_queue_depth == 0; }, s)
+        ->wait_for([&](const auto& st) { return st.pid == pid && total_applied(st) == n && st.scan_queue_depth == 0; },
+                   s)
         .has_value();
   }
 };
@@ -149,9 +150,9 @@ std::unique_ptr<octomap::OcTree> stream_and_mirror(Fixture& f, ChildProcess& ser
   for (auto* m : mirrors) m->sync();
   std::vector<std::unique_ptr<ChildProcess>> producers;
   for (int i = 0; i < 3; ++i)
-    producers.push_back(f.replay("synthetic", "robot" + std::to_string(i),
-                                 {"--part", std::to_string(i) + "/3", "--repeat", std::to_string(scans_each / 2),
-                                  "--rate", "8"}));
+    producers.push_back(
+        f.replay("synthetic", "robot" + std::to_string(i),
+                 {"--part", std::to_string(i) + "/3", "--repeat", std::to_string(scans_each / 2), "--rate", "8"}));
   bool fetched = false;
   auto running = [&] {
     for (auto& p : producers)
@@ -209,12 +210,13 @@ TEST(MapServingIntegration, MirrorsFollowStreamingAndRecoverFromLoss) {
     client::MapClient c(f.client_url, o);
     lossy_fetch = c.fetch_snapshot(Chunk::FORMAT_OCTOMAP_FULL, 60);
   };
-  const auto final_map = stream_and_mirror(f, *server, 40, {&clean, &lossy, &no_resync}, {&clean, &lossy}, fetch_with_loss);
+  const auto final_map =
+      stream_and_mirror(f, *server, 40, {&clean, &lossy, &no_resync}, {&clean, &lossy}, fetch_with_loss);
   auto show = [](const char* name, const client::MapMirror& m, const ClassDiff& d) {
     const client::MirrorStats& s = m.stats();
     std::cout << name << ": version " << m.version() << ", " << s.deltas_applied << " deltas applied ("
-              << s.voxels_applied << " voxels), " << s.gaps << " gaps, " << s.snapshots << " snapshots; "
-              << d.differing << " of " << d.voxels << " voxels differ in class from the final snapshot\n";
+              << s.voxels_applied << " voxels), " << s.gaps << " gaps, " << s.snapshots << " snapshots; " << d.differing
+              << " of " << d.voxels << " voxels differ in class from the final snapshot\n";
   };
   show("clean", clean, compare_classes(clean.tree(), *final_map));
   show("lossy", lossy, compare_classes(lossy.tree(), *final_map));
@@ -286,12 +288,44 @@ TEST(MapServingIntegration, BadRequestsAreCountedAndMappingGoesOn) {
   good.client_id = "tester";
   good.reply_channel = "OCTOMAP_RT_MAP_REPLY_TESTER";
   int64_t bad = 0;
-  { auto r = good; r.format = 9; send(r); ++bad; }                                     // unknown format
-  { auto r = good; r.chunk_indices = {-4}; r.num_chunk_indices = 1; send(r); ++bad; }   // negative index
-  { auto r = good; r.chunk_indices = {100000}; r.num_chunk_indices = 1; send(r); ++bad; }  // out of range
-  { auto r = good; r.snapshot_id = 987654; send(r); ++bad; }                           // not kept
-  { auto r = good; r.client_id = "bad id!"; send(r); ++bad; }                           // bad string
-  { auto r = good; r.reply_channel = "OCTOMAP_RT_SCAN_X"; send(r); ++bad; }             // not a reply channel
+  {
+    auto r = good;
+    r.format = 9;
+    send(r);
+    ++bad;
+  }  // unknown format
+  {
+    auto r = good;
+    r.chunk_indices = {-4};
+    r.num_chunk_indices = 1;
+    send(r);
+    ++bad;
+  }  // negative index
+  {
+    auto r = good;
+    r.chunk_indices = {100000};
+    r.num_chunk_indices = 1;
+    send(r);
+    ++bad;
+  }  // out of range
+  {
+    auto r = good;
+    r.snapshot_id = 987654;
+    send(r);
+    ++bad;
+  }  // not kept
+  {
+    auto r = good;
+    r.client_id = "bad id!";
+    send(r);
+    ++bad;
+  }  // bad string
+  {
+    auto r = good;
+    r.reply_channel = "OCTOMAP_RT_SCAN_X";
+    send(r);
+    ++bad;
+  }  // not a reply channel
   {
     auto r = good;
     r.chunk_indices.assign(9000, 1);  // more than a request may name
@@ -312,7 +346,8 @@ TEST(MapServingIntegration, BadRequestsAreCountedAndMappingGoesOn) {
     send(r);
     ++bad;
   }
-  ASSERT_TRUE(f.status->wait_for([&](const auto& s) { return s.pid == server->pid() && s.requests_rejected >= bad; }, 60))
+  ASSERT_TRUE(
+      f.status->wait_for([&](const auto& s) { return s.pid == server->pid() && s.requests_rejected >= bad; }, 60))
       << "rejected " << (f.status->latest() ? f.status->latest()->requests_rejected : -1) << " of " << bad << "\n"
       << server->log();
   auto p = f.replay(graph, "alpha", {"--first", "0", "--count", "1"});

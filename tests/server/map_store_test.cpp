@@ -94,8 +94,8 @@ TEST(MapStore, SaveIsAtomicUnderSigkill) {
     killed_mid_save += std::filesystem::exists(path + ".tmp") ? 1 : 0;
     std::ifstream in(path, std::ios::binary);
     const std::string got((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    EXPECT_TRUE(got == bytes_a || got == bytes_b) << "kill " << i << ": the map file is neither complete map ("
-                                                  << got.size() << " bytes)";
+    EXPECT_TRUE(got == bytes_a || got == bytes_b)
+        << "kill " << i << ": the map file is neither complete map (" << got.size() << " bytes)";
     EXPECT_NO_THROW(daemon::load_map(path, 0.1));
   }
   // Evidence the kills landed inside saves (a .tmp was being written), not only between them.

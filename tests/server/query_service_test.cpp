@@ -132,8 +132,8 @@ TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
   server.with_map([&](const octomap::OcTree& t) {
     for (int i = 0; i < 50; ++i) {
       octomap::point3d end;
-      const bool hit = t.castRay(octomap::point3d(0.05f, 0.05f, 0.25f),
-                                 octomap::point3d(1.f, -0.5f + 0.02f * i, 0.f), end, false, 20);
+      const bool hit = t.castRay(octomap::point3d(0.05f, 0.05f, 0.25f), octomap::point3d(1.f, -0.5f + 0.02f * i, 0.f),
+                                 end, false, 20);
       EXPECT_EQ(rr.hit[i], hit);
       EXPECT_EQ(rr.end_xyz[3 * i], end.x());
     }
@@ -172,7 +172,8 @@ TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
     EXPECT_EQ(g.height, want.height);
     EXPECT_EQ(g.num_chunks, 1);
     int differing = 0;
-    for (int i = 0; i < g.num_cells && i < int(want.cells.size()); ++i) differing += g.cells[i] != int8_t(want.cells[i]);
+    for (int i = 0; i < g.num_cells && i < int(want.cells.size()); ++i)
+      differing += g.cells[i] != int8_t(want.cells[i]);
     EXPECT_EQ(differing, 0);
     return 0;
   });

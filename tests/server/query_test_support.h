@@ -56,7 +56,7 @@ void address(Q& q, int64_t id, const std::string& client = "tester") {
 }
 
 inline octomap_rt::occupancy_query_t point_query(int64_t id, const std::vector<float>& xyz,
-                                          const std::string& client = "tester") {
+                                                 const std::string& client = "tester") {
   octomap_rt::occupancy_query_t q{};
   address(q, id, client);
   q.xyz = xyz;

@@ -70,7 +70,7 @@ TEST(ScanDecode, RefusesWhatLcmRefuses) {
   auto wrong_hash = bytes;
   wrong_hash[0] ^= 1;
   EXPECT_LT(daemon::decode_scan(wrong_hash.data(), wrong_hash.size(), out), 0);
-  EXPECT_LT(daemon::decode_scan(bytes.data(), 50, out), 0);                     // header cut
+  EXPECT_LT(daemon::decode_scan(bytes.data(), 50, out), 0);                          // header cut
   EXPECT_LT(daemon::decode_scan(bytes.data(), daemon::kScanXyzOffset + 8, out), 0);  // array cut
 }
 

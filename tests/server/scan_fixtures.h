@@ -40,9 +40,9 @@ void expect_counts_balance(const std::vector<daemon::ProducerStats>& stats);
 
 // MapEngine (same options) applied to `scans` in `order`: the sequential reference.
 // `by_robot_seq(robot_id, seq)` returns the scan that (robot, seq) names.
-std::unique_ptr<octomap::OcTree> engine_reference(const daemon::ServerConfig& cfg,
-                                                  const std::vector<daemon::AppliedEntry>& order,
-                                                  const std::function<const PosedScan&(const std::string&, int64_t)>& by_robot_seq);
+std::unique_ptr<octomap::OcTree> engine_reference(
+    const daemon::ServerConfig& cfg, const std::vector<daemon::AppliedEntry>& order,
+    const std::function<const PosedScan&(const std::string&, int64_t)>& by_robot_seq);
 
 std::string temp_dir(const std::string& tag);
 

@@ -36,7 +36,7 @@ TEST(ScanValidation, FieldOffsetsAreTheDocumentedOnes) {
 
 TEST(ScanValidation, ValidScanPasses) {
   EXPECT_EQ(check(small_scan("alpha", 0)), Reject::kNone);
-  EXPECT_EQ(check(small_scan("ALPHA", 0)), Reject::kNone);  // robot ids compare case-insensitively
+  EXPECT_EQ(check(small_scan("ALPHA", 0)), Reject::kNone);     // robot ids compare case-insensitively
   EXPECT_EQ(check(small_scan("alpha", 0, 0)), Reject::kNone);  // no points is a valid (empty) scan
   auto m = small_scan("alpha", 0);
   m.sensor_orientation[0] *= 1.0005;  // within the 1e-3 tolerance

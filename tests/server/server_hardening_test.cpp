@@ -86,7 +86,8 @@ TEST(ServerHardening, StaleScansAreShedWithAReasonUnderOverload) {
     cv.wait(lock, [&] { return holding; });
   }
   const int n = 12;
-  for (int k = 0; k < n; ++k) lc.publish("OCTOMAP_RT_SCAN_BUSY", &static_cast<const octomap_rt::scan_t&>(small_scan("busy", k, 30)));
+  for (int k = 0; k < n; ++k)
+    lc.publish("OCTOMAP_RT_SCAN_BUSY", &static_cast<const octomap_rt::scan_t&>(small_scan("busy", k, 30)));
   while (server.producer_stats().empty() || server.producer_stats()[0].received < n)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   std::this_thread::sleep_for(std::chrono::milliseconds(50));  // every queued scan is now older than the bound

@@ -53,8 +53,8 @@ TEST(ServerLargeScansIntegration, ThreeProducersOf300kPointScansAt5HzLoseNothing
   const std::string dir = make_test_dir("large");
   ::unsetenv("LCM_DEFAULT_URL");  // the point: the daemon's own default URL
   const std::string plain_default = "udpm://239.255.76.67:7667?ttl=0";
-  std::printf("namespace: %s; net.core.rmem_max there: %lld bytes (read-only inside a namespace)\n",
-              ns.how().c_str(), (long long)ns.rmem_max());
+  std::printf("namespace: %s; net.core.rmem_max there: %lld bytes (read-only inside a namespace)\n", ns.how().c_str(),
+              (long long)ns.rmem_max());
 
   const std::string graph = dir + "/large.graph";
   save_scan_graph(make_large_scans(), graph);
@@ -86,16 +86,17 @@ TEST(ServerLargeScansIntegration, ThreeProducersOf300kPointScansAt5HzLoseNothing
       [&](const octomap_rt::server_status_t& s) {
         int64_t accounted = 0;
         for (const auto& r : s.robots) accounted += r.scans_applied + r.scans_rejected + r.scans_dropped;
-        return s.robots.size() >= static_cast<size_t>(kProducers) && accounted >= expected &&
-               s.scan_queue_depth == 0 && s.shot_queue_depth == 0;
+        return s.robots.size() >= static_cast<size_t>(kProducers) && accounted >= expected && s.scan_queue_depth == 0 &&
+               s.shot_queue_depth == 0;
       },
       300);
   std::optional<octomap_rt::server_status_t> last = settled ? settled : status.latest();
   ASSERT_TRUE(last);
-  std::printf("kernel UDP receive errors during the run (every socket in the namespace): %lld; drops on the "
-              "daemon's own socket: %lld; scans applied %lld of %lld\n",
-              (long long)(last->kernel_rcvbuf_errors - kernel_errors_before), (long long)last->socket_rcvbuf_drops,
-              (long long)total_applied(*last), (long long)expected);
+  std::printf(
+      "kernel UDP receive errors during the run (every socket in the namespace): %lld; drops on the "
+      "daemon's own socket: %lld; scans applied %lld of %lld\n",
+      (long long)(last->kernel_rcvbuf_errors - kernel_errors_before), (long long)last->socket_rcvbuf_drops,
+      (long long)total_applied(*last), (long long)expected);
   for (int i = 0; i < kProducers; ++i) {
     const auto* r = find_robot_ci(*last, "big" + std::to_string(i));
     ASSERT_NE(r, nullptr) << "no scan of producer " << i << " arrived\n" << server.log();

@@ -67,8 +67,8 @@ TEST(ServerLogReplayIntegration, ALoggedSessionReplaysIntoTheDaemonByReplayAndBy
   Session run{make_test_dir("logreplay"), test_lcm_url(3, ns.rmem_max()), &watcher};
   const std::string log = run.dir + "/robots.lcmlog";
   auto server_args = [&](const std::string& map) {
-    return std::vector<std::string>{server_program(), "-r", std::to_string(kResolution), "--map", map,
-                                    "--lcm-url", run.url, "--save-interval", "0"};
+    return std::vector<std::string>{server_program(), "-r",    std::to_string(kResolution), "--map", map,
+                                    "--lcm-url",      run.url, "--save-interval",           "0"};
   };
   auto started = [&](pid_t pid) {
     return watcher.wait_for([&](const auto& st) { return st.pid == pid; }, 60).has_value();
@@ -85,8 +85,8 @@ TEST(ServerLogReplayIntegration, ALoggedSessionReplaysIntoTheDaemonByReplayAndBy
     for (int i = 0; i < kProducers; ++i) {
       const std::string part = std::to_string(i) + "/" + std::to_string(kProducers);
       producers.push_back(std::make_unique<ChildProcess>(
-          std::vector<std::string>{client_program(), "replay", graph, "--robot", "prod" + std::to_string(i),
-                                   "--part", part, "--rate", "4", "--lcm-url", run.url},
+          std::vector<std::string>{client_program(), "replay", graph, "--robot", "prod" + std::to_string(i), "--part",
+                                   part, "--rate", "4", "--lcm-url", run.url},
           run.dir + "/producer" + std::to_string(i) + ".log"));
       cli::ScanSelection sel;
       cli::parse_part(part, sel);

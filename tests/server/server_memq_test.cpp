@@ -71,19 +71,61 @@ TEST(ServerMemq, CraftedBadMessagesAreCountedAndServingGoesOn) {
   };
   const auto good = encode(small_scan("alpha", 0, 10));
   int64_t sent = 0;
-  auto bad = [&](std::vector<uint8_t> b) { send(A, b); ++sent; };
-  bad(std::vector<uint8_t>(good.begin(), good.begin() + 50));                // truncated
-  { auto b = good; b[0] ^= 1; bad(b); }                                        // wrong fingerprint
-  { auto b = good; put_be32(b, daemon::kScanNumXyzOffset, -30); bad(b); }      // negative count
-  { auto b = good; put_be32(b, daemon::kScanNumXyzOffset, 0x7fffffff); bad(b); }  // huge count
-  { auto b = good; put_be32(b, daemon::kScanNumXyzOffset, 3000); bad(b); }     // count > data
-  { auto b = good; b.push_back(0); bad(b); }                                   // data > counts
-  { auto m = small_scan("alpha", 1, 10); m.xyz[2] = std::nanf(""); bad(encode(m)); }
-  { auto m = small_scan("alpha", 2, 10); for (double& q : m.sensor_orientation) q = 0; bad(encode(m)); }
-  { auto m = small_scan("alpha", 3, 10); m.sensor_orientation[0] = 0.5; bad(encode(m)); }
-  { auto m = small_scan("bravo", 4, 10); bad(encode(m)); }                     // robot != channel
+  auto bad = [&](std::vector<uint8_t> b) {
+    send(A, b);
+    ++sent;
+  };
+  bad(std::vector<uint8_t>(good.begin(), good.begin() + 50));  // truncated
+  {
+    auto b = good;
+    b[0] ^= 1;
+    bad(b);
+  }  // wrong fingerprint
+  {
+    auto b = good;
+    put_be32(b, daemon::kScanNumXyzOffset, -30);
+    bad(b);
+  }  // negative count
+  {
+    auto b = good;
+    put_be32(b, daemon::kScanNumXyzOffset, 0x7fffffff);
+    bad(b);
+  }  // huge count
+  {
+    auto b = good;
+    put_be32(b, daemon::kScanNumXyzOffset, 3000);
+    bad(b);
+  }  // count > data
+  {
+    auto b = good;
+    b.push_back(0);
+    bad(b);
+  }  // data > counts
+  {
+    auto m = small_scan("alpha", 1, 10);
+    m.xyz[2] = std::nanf("");
+    bad(encode(m));
+  }
+  {
+    auto m = small_scan("alpha", 2, 10);
+    for (double& q : m.sensor_orientation) q = 0;
+    bad(encode(m));
+  }
+  {
+    auto m = small_scan("alpha", 3, 10);
+    m.sensor_orientation[0] = 0.5;
+    bad(encode(m));
+  }
+  {
+    auto m = small_scan("bravo", 4, 10);
+    bad(encode(m));
+  }  // robot != channel
   // Unknown charset: channel and robot id agree, but '$' is not allowed.
-  { auto m = small_scan("r$2", 0, 10); send("OCTOMAP_RT_SCAN_R$2", encode(m)); ++sent; }
+  {
+    auto m = small_scan("r$2", 0, 10);
+    send("OCTOMAP_RT_SCAN_R$2", encode(m));
+    ++sent;
+  }
   // ... and the server goes on serving.
   for (int k : {10, 11, 14}) {  // 12 and 13 never come: 2 missed
     send(A, encode(small_scan("alpha", k, 10)));
@@ -98,8 +140,8 @@ TEST(ServerMemq, CraftedBadMessagesAreCountedAndServingGoesOn) {
   EXPECT_EQ(a->applied, 3);
   EXPECT_EQ(a->rejected, 10);
   for (Reject r : {Reject::kTruncated, Reject::kWrongFingerprint, Reject::kNegativeCount, Reject::kCountTooLarge,
-                   Reject::kCountExceedsData, Reject::kTrailingBytes, Reject::kNonFinitePoint,
-                   Reject::kZeroQuaternion, Reject::kNonUnitQuaternion, Reject::kRobotIdMismatch})
+                   Reject::kCountExceedsData, Reject::kTrailingBytes, Reject::kNonFinitePoint, Reject::kZeroQuaternion,
+                   Reject::kNonUnitQuaternion, Reject::kRobotIdMismatch})
     EXPECT_EQ(reason_count(*a, r), 1) << daemon::to_string(r);
   EXPECT_EQ(a->missed, 2);  // seq gaps are judged on valid scans only: 10, 11, 14
   const auto* bad_charset = find(stats, "OCTOMAP_RT_SCAN_R$2");

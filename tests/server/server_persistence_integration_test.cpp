@@ -67,10 +67,13 @@ TEST(ServerPersistenceIntegration, SigtermSavesAndARestartExtendsTheMap) {
 
   // Run 1: scan 0 from robot alpha, then SIGTERM.
   auto server = f.start_server(flags, "server1.log");
-  ASSERT_TRUE(f.wait_status(server->pid(), [](const auto&) { return true; }, 60)) << server->log();
+  ASSERT_TRUE(f.wait_status(
+      server->pid(), [](const auto&) { return true; }, 60))
+      << server->log();
   auto alpha = f.replay(graph, "alpha", {"--first", "0", "--count", "1"}, "alpha.log");
   EXPECT_EQ(alpha->wait(60), 0) << alpha->log();
-  ASSERT_TRUE(f.wait_status(server->pid(), [](const auto& s) { return total_applied(s) == 1; }, 120))
+  ASSERT_TRUE(f.wait_status(
+      server->pid(), [](const auto& s) { return total_applied(s) == 1; }, 120))
       << server->log();
   server->signal(SIGTERM);
   ASSERT_EQ(server->wait(120), 0) << server->log();
@@ -91,10 +94,13 @@ TEST(ServerPersistenceIntegration, SigtermSavesAndARestartExtendsTheMap) {
 
   // Run 2: loads the map; scans 1 and 2 from robot beta extend it.
   server = f.start_server(flags, "server2.log");
-  ASSERT_TRUE(f.wait_status(server->pid(), [](const auto&) { return true; }, 60)) << server->log();
+  ASSERT_TRUE(f.wait_status(
+      server->pid(), [](const auto&) { return true; }, 60))
+      << server->log();
   auto beta = f.replay(graph, "beta", {"--first", "1", "--count", "2"}, "beta.log");
   EXPECT_EQ(beta->wait(60), 0) << beta->log();
-  ASSERT_TRUE(f.wait_status(server->pid(), [](const auto& s) { return total_applied(s) == 2; }, 120))
+  ASSERT_TRUE(f.wait_status(
+      server->pid(), [](const auto& s) { return total_applied(s) == 2; }, 120))
       << server->log();
   server->signal(SIGTERM);
   ASSERT_EQ(server->wait(120), 0) << server->log();
@@ -131,12 +137,15 @@ TEST(ServerPersistenceIntegration, KillNineDuringSavesAlwaysLeavesALoadableMap) 
   double previous_volume = 0;
   for (int round = 0; round < kRounds; ++round) {
     auto server = f.start_server(flags, "server" + std::to_string(round) + ".log");
-    ASSERT_TRUE(f.wait_status(server->pid(), [](const auto&) { return true; }, 60))
-        << "round " << round << ": the daemon did not start from the map left by the kill\n" << server->log();
+    ASSERT_TRUE(f.wait_status(
+        server->pid(), [](const auto&) { return true; }, 60))
+        << "round " << round << ": the daemon did not start from the map left by the kill\n"
+        << server->log();
     auto robot = f.replay(graph, "r" + std::to_string(round), {"--repeat", "100", "--rate", "5"},
                           "robot" + std::to_string(round) + ".log");
     // Let it apply and save at least once.
-    ASSERT_TRUE(f.wait_status(server->pid(), [](const auto& s) { return s.map_saves >= 1; }, 120))
+    ASSERT_TRUE(f.wait_status(
+        server->pid(), [](const auto& s) { return s.map_saves >= 1; }, 120))
         << server->log();
     // Most rounds: kill the moment a save's temporary file appears (a save in progress);
     // the others at a random moment.

@@ -34,8 +34,8 @@ TEST(ServerProducersIntegration, ThreeProducersSplitRealScansGiveTheMapOfTheAppl
   ASSERT_TRUE(ns.ok()) << ns.error();
   const std::string dir = make_test_dir("producers");
   const std::string url = test_lcm_url(1, ns.rmem_max());
-  std::printf("namespace: %s, rmem_max %lld, url %s, dir %s\n", ns.how().c_str(), (long long)ns.rmem_max(),
-              url.c_str(), dir.c_str());
+  std::printf("namespace: %s, rmem_max %lld, url %s, dir %s\n", ns.how().c_str(), (long long)ns.rmem_max(), url.c_str(),
+              dir.c_str());
   StatusWatcher status(url);
   ASSERT_TRUE(status.good());
 
@@ -112,9 +112,9 @@ TEST(ServerProducersIntegration, ThreeProducersSplitRealScansGiveTheMapOfTheAppl
   // Reference 1: `octomap-rt build` of the same scans in that order.
   const std::string ordered_graph = dir + "/applied_order.graph";
   save_scan_graph(in_order, ordered_graph);
-  ChildProcess build({client_program(), "build", ordered_graph, "-r", std::to_string(kResolution), "-o",
-                      dir + "/build.ot", "-q"},
-                     dir + "/build.log");
+  ChildProcess build(
+      {client_program(), "build", ordered_graph, "-r", std::to_string(kResolution), "-o", dir + "/build.ot", "-q"},
+      dir + "/build.log");
   ASSERT_EQ(build.wait(240), 0) << build.log();
 
   const auto served = load_ot(map_path);

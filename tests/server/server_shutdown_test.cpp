@@ -134,8 +134,7 @@ TEST(ServerShutdown, AFailedFinalSaveIsReportedNotThrown) {
     {  // the disk fills up while the server runs
       std::ofstream filler(dir + "/filler", std::ios::binary);
       const std::string block(4096, 'x');
-      while (filler.write(block.data(), block.size())) {
-      }
+      while (filler.write(block.data(), block.size())) {}
     }
     const bool saved = server.stop();  // used to throw here (SIGABRT, exit 134)
     if (saved) return 4;
@@ -146,7 +145,8 @@ TEST(ServerShutdown, AFailedFinalSaveIsReportedNotThrown) {
     return summary.str().find("FINAL SAVE FAILED") != std::string::npos ? 0 : 7;
   });
   if (rc < 0) GTEST_SKIP() << "no user/mount namespaces here";
-  EXPECT_EQ(rc, 0) << "3: not applied, 4: save reported ok on a full disk, 5: wrong error, 6: .tmp left, 7: no summary line";
+  EXPECT_EQ(rc, 0)
+      << "3: not applied, 4: save reported ok on a full disk, 5: wrong error, 6: .tmp left, 7: no summary line";
   std::filesystem::remove_all(dir);
 }
 

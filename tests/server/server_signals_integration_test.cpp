@@ -20,8 +20,8 @@ namespace ort::test {
 namespace {
 
 std::vector<std::string> server_args(const std::string& map) {
-  return {server_program(), "-r", "0.1", "--backend", "cpu", "--lcm-url", "memq://", "--map", map,
-          "--status-period", "0.2"};
+  return {server_program(), "-r",    "0.1", "--backend",       "cpu", "--lcm-url",
+          "memq://",        "--map", map,   "--status-period", "0.2"};
 }
 
 bool wait_for_log(const ChildProcess& p, const std::string& text, double timeout_s) {
@@ -68,8 +68,7 @@ TEST(ServerSignals, AFailedFinalSavePrintsTheSummaryAndExitsNonZero) {
     {
       std::ofstream filler(dir + "/filler", std::ios::binary);
       const std::string block(4096, 'x');
-      while (filler.write(block.data(), block.size())) {
-      }
+      while (filler.write(block.data(), block.size())) {}
     }
     server.signal(SIGTERM);
     const auto code = server.wait(60);
@@ -83,7 +82,8 @@ TEST(ServerSignals, AFailedFinalSavePrintsTheSummaryAndExitsNonZero) {
   std::ifstream in(logs + "/server.log");
   const std::string log((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_EQ(rc, 0) << "3: never listened, 4: did not exit, 10+N: exit status N (144: aborted), 5: no summary, "
-                      "6: no FINAL SAVE FAILED line\n" << log;
+                      "6: no FINAL SAVE FAILED line\n"
+                   << log;
   std::filesystem::remove_all(dir);
   std::filesystem::remove_all(logs);
 }

@@ -78,13 +78,14 @@ TEST(ServerStatusCounts, SlowestScansAreAppliedScansWithTheirParts) {
     char robot[32] = {};
     double at = 0, e2e = 0, decode = 0, queue = 0, stage1 = 0, up = 0, prep = 0, shoot = 0, compact = 0, handoff = 0,
            stage2 = 0, lock = 0, octree = 0, deltas = 0;
-    ASSERT_EQ(std::sscanf(line.c_str(),
-                          "    #%lld %31s seq %lld at +%lf s: %lf ms = decode %lf + queue %lf + stage 1 %lf (upload %lf, "
-                          "prepare %lf, shoot %lf, compact %lf) + hand-off %lf + stage 2 %lf (lock wait %lf, octree "
-                          "%lf, deltas %lf); %lld voxels, %lld new nodes",
-                          &index, robot, &seq, &at, &e2e, &decode, &queue, &stage1, &up, &prep, &shoot, &compact,
-                          &handoff, &stage2, &lock, &octree, &deltas, &voxels, &new_nodes),
-              19)
+    ASSERT_EQ(
+        std::sscanf(line.c_str(),
+                    "    #%lld %31s seq %lld at +%lf s: %lf ms = decode %lf + queue %lf + stage 1 %lf (upload %lf, "
+                    "prepare %lf, shoot %lf, compact %lf) + hand-off %lf + stage 2 %lf (lock wait %lf, octree "
+                    "%lf, deltas %lf); %lld voxels, %lld new nodes",
+                    &index, robot, &seq, &at, &e2e, &decode, &queue, &stage1, &up, &prep, &shoot, &compact, &handoff,
+                    &stage2, &lock, &octree, &deltas, &voxels, &new_nodes),
+        19)
         << line;
     EXPECT_GE(index, 1);
     EXPECT_LE(index, sent);

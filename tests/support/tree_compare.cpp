@@ -8,8 +8,8 @@ namespace {
 // Checks every leaf of `from` against the node of `to` that contains its key. A voxel that
 // differs lies in one leaf of each tree; the check from the side with the smaller leaf
 // finds it, so running this both ways covers every finest voxel.
-void one_way(const octomap::OcTree& from, const octomap::OcTree& to, bool count_logodds, TreeDiff& d,
-             uint64_t& leaves, const char* from_name) {
+void one_way(const octomap::OcTree& from, const octomap::OcTree& to, bool count_logodds, TreeDiff& d, uint64_t& leaves,
+             const char* from_name) {
   const unsigned max_depth = from.getTreeDepth();
   for (auto it = from.begin_leafs(), end = from.end_leafs(); it != end; ++it) {
     ++leaves;
@@ -77,13 +77,13 @@ std::string compare_structure(const octomap::OcTree& a, const octomap::OcTree& b
   auto ia = a.begin_tree(), ea = a.end_tree();
   auto ib = b.begin_tree(), eb = b.end_tree();
   for (; ia != ea && ib != eb; ++ia, ++ib) {
-    if (ia.getDepth() != ib.getDepth() || !(ia.getKey() == ib.getKey()) ||
-        ia->getLogOdds() != ib->getLogOdds() || a.nodeHasChildren(&*ia) != b.nodeHasChildren(&*ib)) {
+    if (ia.getDepth() != ib.getDepth() || !(ia.getKey() == ib.getKey()) || ia->getLogOdds() != ib->getLogOdds() ||
+        a.nodeHasChildren(&*ia) != b.nodeHasChildren(&*ib)) {
       std::ostringstream os;
       os << "node at depth " << ia.getDepth() << " key " << ia.getKey()[0] << "," << ia.getKey()[1] << ","
          << ia.getKey()[2] << " value " << ia->getLogOdds() << (a.nodeHasChildren(&*ia) ? " inner" : " leaf")
-         << " vs depth " << ib.getDepth() << " key " << ib.getKey()[0] << "," << ib.getKey()[1] << ","
-         << ib.getKey()[2] << " value " << ib->getLogOdds() << (b.nodeHasChildren(&*ib) ? " inner" : " leaf");
+         << " vs depth " << ib.getDepth() << " key " << ib.getKey()[0] << "," << ib.getKey()[1] << "," << ib.getKey()[2]
+         << " value " << ib->getLogOdds() << (b.nodeHasChildren(&*ib) ? " inner" : " leaf");
       return os.str();
     }
   }

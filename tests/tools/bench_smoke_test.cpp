@@ -21,10 +21,14 @@ std::vector<std::string> split(const std::string& line) {
   bool q = false;
   for (size_t i = 0; i < line.size(); ++i) {
     const char c = line[i];
-    if (q && c == '"' && i + 1 < line.size() && line[i + 1] == '"') f.back() += '"', ++i;
-    else if (c == '"') q = !q;
-    else if (c == ',' && !q) f.emplace_back();
-    else f.back() += c;
+    if (q && c == '"' && i + 1 < line.size() && line[i + 1] == '"')
+      f.back() += '"', ++i;
+    else if (c == '"')
+      q = !q;
+    else if (c == ',' && !q)
+      f.emplace_back();
+    else
+      f.back() += c;
   }
   return f;
 }
@@ -62,17 +66,18 @@ TEST(BenchSmoke, TinyPresetGivesAWellFormedCsv) {
   const std::string csv = dir + "/bench.csv", md = dir + "/bench.md";
   const std::string cmd = std::string(OCTOMAP_RT_CLI) +
                           " bench --preset fr079 --scale ci --resolutions 0.2,0.8 --backends cpu,cpu-grid,vulkan"
-                          " --traversals octomap,exact --csv " + csv + " --markdown " + md + " --png " + dir +
-                          "/charts 2> " + dir + "/stderr.txt";
+                          " --traversals octomap,exact --csv " +
+                          csv + " --markdown " + md + " --png " + dir + "/charts 2> " + dir + "/stderr.txt";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd << "\n(see " << dir << "/stderr.txt)";
 
   std::vector<std::string> header;
   const auto rows = read(csv, header);
-  for (const char* col : {"dataset", "scans", "points", "resolution", "backend", "device", "traversal", "octree",
-                          "status", "prepare_ms", "upload_ms", "shoot_ms", "compact_ms", "octree_ms", "total_ms",
-                          "octomap_total_ms", "speedup", "points_per_s", "free_voxels", "occupied_voxels",
-                          "octomap_free", "octomap_occupied", "free_diff_pct", "occupied_diff_pct", "counts_equal",
-                          "map_identical", "tree_bytes", "rss_bytes", "peak_rss_bytes", "gpu_grid_bytes"})
+  for (const char* col :
+       {"dataset",      "scans",           "points",       "resolution",       "backend",        "device",
+        "traversal",    "octree",          "status",       "prepare_ms",       "upload_ms",      "shoot_ms",
+        "compact_ms",   "octree_ms",       "total_ms",     "octomap_total_ms", "speedup",        "points_per_s",
+        "free_voxels",  "occupied_voxels", "octomap_free", "octomap_occupied", "free_diff_pct",  "occupied_diff_pct",
+        "counts_equal", "map_identical",   "tree_bytes",   "rss_bytes",        "peak_rss_bytes", "gpu_grid_bytes"})
     EXPECT_NE(std::find(header.begin(), header.end(), col), header.end()) << "column " << col << " missing";
   // 2 resolutions x (OctoMap + 3 back ends x 2 traversals)
   ASSERT_EQ(rows.size(), 2u * (1 + 3 * 2));

@@ -5,8 +5,8 @@
 // that puts every point outside the key range gets a warning.
 #include <sys/wait.h>
 
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>

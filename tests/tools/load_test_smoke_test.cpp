@@ -14,8 +14,9 @@ namespace {
 
 TEST(LoadTestSmoke, EveryScanIsAccountedFor) {
   const std::string log = testing::TempDir() + "/loadtest-smoke-server.log";
-  const std::string cmd = std::string(OCTOMAP_RT_LOADTEST) + " --producers 2 --rate 2 --duration 3 --points 2000 --log " +
-                          log + " -- -r 0.2 --backend cpu 2>&1";
+  const std::string cmd = std::string(OCTOMAP_RT_LOADTEST) +
+                          " --producers 2 --rate 2 --duration 3 --points 2000 --log " + log +
+                          " -- -r 0.2 --backend cpu 2>&1";
   FILE* p = ::popen(cmd.c_str(), "r");
   ASSERT_NE(p, nullptr);
   std::string out;

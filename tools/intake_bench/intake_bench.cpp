@@ -57,7 +57,8 @@ double median(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"octomap-rt-intake-bench: the daemon's host work on a scan message (decode, checks, the points' copies)"};
+  CLI::App app{
+      "octomap-rt-intake-bench: the daemon's host work on a scan message (decode, checks, the points' copies)"};
   std::string graph;
   int rounds = 5;
   app.add_option("graph", graph, "ScanGraph file (e.g. from octomap-rt-scenegen)")->required();

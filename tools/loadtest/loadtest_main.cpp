@@ -8,14 +8,19 @@
 #include "load_test.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"octomap-rt-loadtest: N producers at a rate for a bounded time against octomap-rt-server, in a "
-               "private network namespace; reports scans accounted, peak memory, latency p99 and drops"};
+  CLI::App app{
+      "octomap-rt-loadtest: N producers at a rate for a bounded time against octomap-rt-server, in a "
+      "private network namespace; reports scans accounted, peak memory, latency p99 and drops"};
   ort::cli::LoadTestConfig cfg;
   cfg.server = OCTOMAP_RT_SERVER;
   std::vector<std::string> server_args;
   app.add_option("--producers", cfg.producers, "producers (robots), each on its own channel")->capture_default_str();
-  app.add_option("--rate", cfg.rate_hz, "scans per second per producer")->check(CLI::Range(0.01, 1000.0))->capture_default_str();
-  app.add_option("--duration", cfg.duration_s, "seconds of publishing")->check(CLI::Range(0.1, 86400.0))->capture_default_str();
+  app.add_option("--rate", cfg.rate_hz, "scans per second per producer")
+      ->check(CLI::Range(0.01, 1000.0))
+      ->capture_default_str();
+  app.add_option("--duration", cfg.duration_s, "seconds of publishing")
+      ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
   app.add_option("--points", cfg.points, "points per scan")->check(CLI::Range(1, 4'000'000))->capture_default_str();
   app.add_option("--settle", cfg.settle_s, "seconds to wait afterwards for the queue to empty")->capture_default_str();
   app.add_option("--server", cfg.server, "octomap-rt-server program")->capture_default_str();

@@ -17,8 +17,8 @@
 
 #include <sys/resource.h>
 
-#include <CLI/CLI.hpp>
 #include <octomap/OcTree.h>
+#include <CLI/CLI.hpp>
 
 #include "core/backend_kind.h"
 #include "core/clock.h"
@@ -173,9 +173,10 @@ int main(int argc, char** argv) {
         }
         standard = std::min(standard, ms_since(t));
       }
-      std::printf("  Morton order per pass: std::sort %.2f ms; buckets + bucket sorts, 1 thread %.2f ms (%.1fx, "
-                  "%.1f ns/voxel); bucketing alone on %u threads %.2f ms\n",
-                  standard, one, standard / one, one * 1e6 / double(d.voxels), hw, bucket_all);
+      std::printf(
+          "  Morton order per pass: std::sort %.2f ms; buckets + bucket sorts, 1 thread %.2f ms (%.1fx, "
+          "%.1f ns/voxel); bucketing alone on %u threads %.2f ms\n",
+          standard, one, standard / one, one * 1e6 / double(d.voxels), hw, bucket_all);
     }
 
     std::vector<std::unique_ptr<ort::BatchedOctreeUpdater>> batched;
@@ -237,12 +238,13 @@ int main(int argc, char** argv) {
                   octomap_time.best_ms * 1e6 / passes_voxels, nodes);
     for (size_t i = 0; i < threads.size(); ++i) {
       const Timing& b = batched_time[i];
-      std::printf("  batched, %2u thread(s):   %9.1f ms  (%.0f ns/voxel)  %6.1fx   [buckets %.1f, top %.1f, "
-                  "subtrees %.1f (of which bucket sorts %.1f thread-ms) ms; %zu buckets at depth %u, %lld nodes "
-                  "counted in]\n",
-                  threads[i], b.best_ms, b.best_ms * 1e6 / passes_voxels, batched_only ? 0.0 : octomap_time.best_ms / b.best_ms,
-                  b.stats.bucket_ms, b.stats.top_ms, b.stats.subtrees_ms, b.stats.sort_cpu_ms, b.stats.subtrees,
-                  b.stats.bucket_depth, b.stats.node_count_change);
+      std::printf(
+          "  batched, %2u thread(s):   %9.1f ms  (%.0f ns/voxel)  %6.1fx   [buckets %.1f, top %.1f, "
+          "subtrees %.1f (of which bucket sorts %.1f thread-ms) ms; %zu buckets at depth %u, %lld nodes "
+          "counted in]\n",
+          threads[i], b.best_ms, b.best_ms * 1e6 / passes_voxels, batched_only ? 0.0 : octomap_time.best_ms / b.best_ms,
+          b.stats.bucket_ms, b.stats.top_ms, b.stats.subtrees_ms, b.stats.sort_cpu_ms, b.stats.subtrees,
+          b.stats.bucket_depth, b.stats.node_count_change);
       std::printf("      first run (fresh memory): %9.1f ms, %ld page faults, %.1f ms in the kernel\n", b.first_ms,
                   b.first_faults, b.first_sys_ms);
     }

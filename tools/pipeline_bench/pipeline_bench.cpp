@@ -87,11 +87,12 @@ RunResult run(const daemon::ServerConfig& base, bool pipelined, const ScanSet& s
 
 void print(const char* name, const RunResult& r) {
   const auto& s = r.status;
-  std::printf("  %-12s %7.2f s  %7.2f scans/s  %10.0f points/s  applied %lld/%lld  shoot p50 %.1f ms  octree p50 %.1f ms"
-              "  busy: stage1 %.2f s, stage2 %.2f s, both %.2f s (%lld scans overlapped)\n",
-              name, r.seconds, r.scans / r.seconds, r.points / r.seconds, (long long)s.scans_applied,
-              (long long)r.scans, s.shoot_ms_p50, s.octree_ms_p50, s.stage1_busy_s, s.stage2_busy_s, s.overlap_busy_s,
-              (long long)s.overlapped_scans);
+  std::printf(
+      "  %-12s %7.2f s  %7.2f scans/s  %10.0f points/s  applied %lld/%lld  shoot p50 %.1f ms  octree p50 %.1f ms"
+      "  busy: stage1 %.2f s, stage2 %.2f s, both %.2f s (%lld scans overlapped)\n",
+      name, r.seconds, r.scans / r.seconds, r.points / r.seconds, (long long)s.scans_applied, (long long)r.scans,
+      s.shoot_ms_p50, s.octree_ms_p50, s.stage1_busy_s, s.stage2_busy_s, s.overlap_busy_s,
+      (long long)s.overlapped_scans);
 }
 
 }  // namespace

@@ -164,9 +164,12 @@ class Ledger {
     auto it = open_.find(id);
     if (it == open_.end()) return;
     Kind& k = kinds_[it->second.first];
-    if (status == Reply::REPLY_OK) k.ms.push_back(std::chrono::duration<double, std::milli>(now - it->second.second).count());
-    else if (status == Reply::REPLY_BUSY) k.busy++;
-    else k.errors++, k.last_error = error;
+    if (status == Reply::REPLY_OK)
+      k.ms.push_back(std::chrono::duration<double, std::milli>(now - it->second.second).count());
+    else if (status == Reply::REPLY_BUSY)
+      k.busy++;
+    else
+      k.errors++, k.last_error = error;
     open_.erase(it);
   }
   size_t open() {
@@ -204,14 +207,13 @@ std::string num(double v) {
 
 void report(const std::vector<Kind>& kinds, const Options& o, double seconds, int64_t sent) {
   if (o.json) {
-    std::cout << "{\"seconds\":" << num(seconds) << ",\"queries\":" << sent
-              << ",\"rate_per_s\":" << num(sent / seconds) << ",\"kinds\":{";
+    std::cout << "{\"seconds\":" << num(seconds) << ",\"queries\":" << sent << ",\"rate_per_s\":" << num(sent / seconds)
+              << ",\"kinds\":{";
     for (size_t i = 0; i < kinds.size(); ++i) {
       const Kind& k = kinds[i];
       std::cout << (i ? "," : "") << "\"" << k.name << "\":{\"sent\":" << k.sent << ",\"answered\":" << k.ms.size()
                 << ",\"p50_ms\":" << num(percentile(k.ms, 50)) << ",\"p99_ms\":" << num(percentile(k.ms, 99))
-                << ",\"max_ms\":" << num(percentile(k.ms, 100)) << ",\"busy\":" << k.busy
-                << ",\"errors\":" << k.errors
+                << ",\"max_ms\":" << num(percentile(k.ms, 100)) << ",\"busy\":" << k.busy << ",\"errors\":" << k.errors
                 << ",\"unanswered\":" << k.sent - int64_t(k.ms.size()) - k.busy - k.errors << "}";
     }
     std::cout << "}}\n";
@@ -241,8 +243,10 @@ int64_t send_all(lcm::LCM& lc, Queries& make, Ledger& ledger, const Options& o) 
     ledger.sent(sent + 1, kind, SteadyClock::now());
     make.publish(lc, kind, sent + 1);
     next += period;
-    if (next > SteadyClock::now()) std::this_thread::sleep_until(next);
-    else next = SteadyClock::now();  // behind (publishing took longer): no burst to catch up
+    if (next > SteadyClock::now())
+      std::this_thread::sleep_until(next);
+    else
+      next = SteadyClock::now();  // behind (publishing took longer): no burst to catch up
   }
   return sent;
 }
@@ -250,8 +254,9 @@ int64_t send_all(lcm::LCM& lc, Queries& make, Ledger& ledger, const Options& o) 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"octomap-rt-query-bench: latency of point, ray and box queries against a running octomap-rt-server, "
-               "sent open loop at a fixed rate (docs/BENCHMARKS.md \"Queries (issue 11)\")"};
+  CLI::App app{
+      "octomap-rt-query-bench: latency of point, ray and box queries against a running octomap-rt-server, "
+      "sent open loop at a fixed rate (docs/BENCHMARKS.md \"Queries (issue 11)\")"};
   Options o;
   app.add_option("--graph", o.graph, "scan graph the queries are drawn from (the producers' scans)")->required();
   app.add_option("--lcm-url", o.lcm_url, "LCM URL")->capture_default_str();

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <octomap/OcTree.h>
+#include <CLI/CLI.hpp>
 
 #include "core/clock.h"
 #include "core/prepare_scan.h"
@@ -117,8 +117,9 @@ int main(int argc, char** argv) {
   std::vector<ort::ScanSet> sets;
   for (const auto& path : inputs) sets.push_back(ort::load_scan_graph(path));
 
-  std::printf("| data | res [m] | back end | k | shared space [voxels] | TLAS instances | windows/scan | "
-              "BVH build host / GPU [ms] | BLAS + TLAS [MB] | ms/scan (shoot only) | vs vulkan | OctoMap ms/scan |\n");
+  std::printf(
+      "| data | res [m] | back end | k | shared space [voxels] | TLAS instances | windows/scan | "
+      "BVH build host / GPU [ms] | BLAS + TLAS [MB] | ms/scan (shoot only) | vs vulkan | OctoMap ms/scan |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::string device_name;
   for (const ort::ScanSet& set : sets) {
@@ -174,8 +175,8 @@ int main(int argc, char** argv) {
         auto vulkan = ort::make_backend(vo);
         device_name = vulkan->device_name();
         vk = run(*vulkan, scans, reps);
-        std::printf("| %s | %.1f | vulkan | - | - | - | %.2f | - | - | %.3f (%.3f) | 1.00 | %.1f |\n", name.c_str(), res,
-                    vk.windows, vk.per_scan_ms, vk.trace_ms, octomap_ms);
+        std::printf("| %s | %.1f | vulkan | - | - | - | %.2f | - | - | %.3f (%.3f) | 1.00 | %.1f |\n", name.c_str(),
+                    res, vk.windows, vk.per_scan_ms, vk.trace_ms, octomap_ms);
       } catch (const std::exception& e) {
         have_vk = false;
         std::printf("| %s | %.1f | vulkan | unavailable: %s |\n", name.c_str(), res, one_line(e.what()).c_str());
@@ -196,16 +197,17 @@ int main(int argc, char** argv) {
           if (have_vk)
             for (size_t i = 0; i < scans.size(); ++i) equal = equal && same(t.lists[i], vk.lists[i]);
           if (!equal) {
-            std::printf("| %s | %.1f | rt | %d | DIFFERENT VOXELS FROM VULKAN: no time reported |\n", name.c_str(), res, k);
+            std::printf("| %s | %.1f | rt | %d | DIFFERENT VOXELS FROM VULKAN: no time reported |\n", name.c_str(), res,
+                        k);
             continue;
           }
-          std::printf("| %s | %.1f | rt | %d | %dx%dx%d | %llu | %.2f | %.1f / %.1f | %.3f + %.2f | %.3f (%.3f) | %s | %.1f |\n",
-                      name.c_str(), res, k, info.block_grid.voxels(0), info.block_grid.voxels(1), info.block_grid.voxels(2),
-                      (unsigned long long)info.block_grid.instance_count(), t.windows, info.build_ms, info.gpu_build_ms,
-                      double(info.blas_bytes) / (1024.0 * 1024.0), double(info.tlas_bytes) / (1024.0 * 1024.0),
-                      t.per_scan_ms, t.trace_ms,
-                      have_vk ? (std::to_string(t.per_scan_ms / vk.per_scan_ms).substr(0, 5) + "x").c_str() : "-",
-                      octomap_ms);
+          std::printf(
+              "| %s | %.1f | rt | %d | %dx%dx%d | %llu | %.2f | %.1f / %.1f | %.3f + %.2f | %.3f (%.3f) | %s | %.1f |\n",
+              name.c_str(), res, k, info.block_grid.voxels(0), info.block_grid.voxels(1), info.block_grid.voxels(2),
+              (unsigned long long)info.block_grid.instance_count(), t.windows, info.build_ms, info.gpu_build_ms,
+              double(info.blas_bytes) / (1024.0 * 1024.0), double(info.tlas_bytes) / (1024.0 * 1024.0), t.per_scan_ms,
+              t.trace_ms, have_vk ? (std::to_string(t.per_scan_ms / vk.per_scan_ms).substr(0, 5) + "x").c_str() : "-",
+              octomap_ms);
         } catch (const std::exception& e) {
           std::printf("| %s | %.1f | rt | %d | unavailable: %s |\n", name.c_str(), res, k, one_line(e.what()).c_str());
         }

@@ -8,7 +8,8 @@
 namespace ort::rt {
 
 BlockGrid choose_block_grid(int block, const int wanted[3], const BlockGridLimits& limits) {
-  if (block < 2 || block > 8) throw std::invalid_argument("rt: BLAS block size k must be 2..8, got " + std::to_string(block));
+  if (block < 2 || block > 8)
+    throw std::invalid_argument("rt: BLAS block size k must be 2..8, got " + std::to_string(block));
   BlockGrid s;
   s.block = block;
   const int max_blocks = std::max(1, std::min(limits.max_side, 65536) / block);
@@ -19,7 +20,8 @@ BlockGrid choose_block_grid(int block, const int wanted[3], const BlockGridLimit
     for (int i = 1; i < 3; ++i)
       if (s.blocks[i] > s.blocks[axis]) axis = i;
     if (s.blocks[axis] == 1) {
-      throw std::invalid_argument("rt: the block-grid limits cannot hold one block of " + std::to_string(block) + "^3 voxels");
+      throw std::invalid_argument("rt: the block-grid limits cannot hold one block of " + std::to_string(block) +
+                                  "^3 voxels");
     }
     s.blocks[axis] = (s.blocks[axis] + 1) / 2;
   }

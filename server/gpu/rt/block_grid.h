@@ -40,8 +40,8 @@ struct Aabb {  // layout of VkAabbPositionsKHR
 static_assert(sizeof(Aabb) == 24);
 
 struct BlockGrid {
-  int block = 4;                  // k: voxels along each edge of the BLAS block (2..8)
-  int blocks[3] = {1, 1, 1};      // TLAS instances along x, y, z
+  int block = 4;              // k: voxels along each edge of the BLAS block (2..8)
+  int blocks[3] = {1, 1, 1};  // TLAS instances along x, y, z
   int voxels(int axis) const { return blocks[axis] * block; }
   uint64_t instance_count() const { return uint64_t(blocks[0]) * blocks[1] * blocks[2]; }
   uint64_t voxel_count() const { return instance_count() * uint64_t(block) * block * block; }

@@ -3,8 +3,8 @@
 #include <chrono>
 #include <cstring>
 #include <optional>
-#include <vector>
 #include <utility>
+#include <vector>
 
 #include "core/clock.h"
 #include "gpu/rt/rt_functions.h"
@@ -32,10 +32,10 @@ struct Scratch {
 };
 
 void build_barrier(VkCommandBuffer cmd) {
-  vk::memory_barrier(cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
-                     VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR,
-                     VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR,
-                     VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR);
+  vk::memory_barrier(
+      cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR,
+      VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR,
+      VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR);
 }
 
 }  // namespace
@@ -43,9 +43,9 @@ void build_barrier(VkCommandBuffer cmd) {
 AccelerationStructure::AccelerationStructure(const vk::Context& ctx, const RtFunctions& fn,
                                              VkAccelerationStructureTypeKHR type, VkDeviceSize size)
     : fn_(&fn), device_(ctx.device()), size_(size) {
-  buffer_ = vk::Buffer(ctx, size,
-                       VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
-                       VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  buffer_ = vk::Buffer(
+      ctx, size, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+      VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   VkAccelerationStructureCreateInfoKHR ci{};
   ci.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR;
   ci.buffer = buffer_.handle();
@@ -192,9 +192,9 @@ SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const 
   const std::vector<Aabb> boxes = block_aabbs(grid.block, aabb_margin);
   vk::Buffer box_buffer(ctx, boxes.size() * sizeof(Aabb), input_usage, host);
   std::memcpy(box_buffer.mapped(), boxes.data(), boxes.size() * sizeof(Aabb));
-  LevelBuild blas = prepare_level(ctx, fn, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, VK_GEOMETRY_TYPE_AABBS_KHR,
-                                  box_data(box_buffer.device_address()), uint32_t(boxes.size()), scratch_align,
-                                  bvh.blas);
+  LevelBuild blas =
+      prepare_level(ctx, fn, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, VK_GEOMETRY_TYPE_AABBS_KHR,
+                    box_data(box_buffer.device_address()), uint32_t(boxes.size()), scratch_align, bvh.blas);
 
   // TLAS: one instance of the BLAS per block.
   bvh.instance_bytes = grid.instance_count() * sizeof(VkAccelerationStructureInstanceKHR);

@@ -7,8 +7,8 @@
 
 #include <vulkan/vulkan.h>
 
-#include "gpu/rt/rt_functions.h"
 #include "gpu/rt/block_grid.h"
+#include "gpu/rt/rt_functions.h"
 #include "gpu/vk/vk_buffer.h"
 #include "gpu/vk/vk_commands.h"
 #include "gpu/vk/vk_context.h"
@@ -41,12 +41,12 @@ class AccelerationStructure {
 };
 
 struct SharedBvh {
-  AccelerationStructure blas;  // k^3 AABBs
-  AccelerationStructure tlas;  // one instance per block of the grid
-  double build_ms = 0;         // host wall clock: instance records, buffers, both builds
-  double gpu_build_ms = 0;     // device timestamps around the two build commands
-  uint64_t scratch_bytes = 0;  // freed after the build
-  uint64_t instance_bytes = 0; // freed after the build
+  AccelerationStructure blas;   // k^3 AABBs
+  AccelerationStructure tlas;   // one instance per block of the grid
+  double build_ms = 0;          // host wall clock: instance records, buffers, both builds
+  double gpu_build_ms = 0;      // device timestamps around the two build commands
+  uint64_t scratch_bytes = 0;   // freed after the build
+  uint64_t instance_bytes = 0;  // freed after the build
 };
 
 // Builds the BLAS and the TLAS for this block grid and waits for them. The AABB, instance and

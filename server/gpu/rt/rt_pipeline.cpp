@@ -79,8 +79,9 @@ void RayTracingPipeline::create_pipeline(const RtFunctions& fn, const BlockGrid&
   ci.pGroups = groups.data();
   ci.maxPipelineRayRecursionDepth = 1;
   ci.layout = objects_.layout;
-  vk::check(fn.create_ray_tracing_pipelines(device, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &ci, nullptr, &objects_.pipeline),
-            "vkCreateRayTracingPipelinesKHR");
+  vk::check(
+      fn.create_ray_tracing_pipelines(device, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &ci, nullptr, &objects_.pipeline),
+      "vkCreateRayTracingPipelinesKHR");
 }
 
 // Shader binding table: one record per group, each region on its own base alignment.
@@ -91,9 +92,9 @@ void RayTracingPipeline::create_binding_table(const vk::Context& ctx, const RtFu
   const uint32_t stride = align_up(handle, rp.shaderGroupHandleAlignment);
   const uint32_t region = align_up(stride, rp.shaderGroupBaseAlignment);
   std::vector<uint8_t> handles(size_t(handle) * group_count);
-  vk::check(fn.get_shader_group_handles(objects_.device, objects_.pipeline, 0, group_count, handles.size(),
-                                        handles.data()),
-            "vkGetRayTracingShaderGroupHandlesKHR");
+  vk::check(
+      fn.get_shader_group_handles(objects_.device, objects_.pipeline, 0, group_count, handles.size(), handles.data()),
+      "vkGetRayTracingShaderGroupHandlesKHR");
   sbt_ = vk::Buffer(ctx, VkDeviceSize(region) * group_count + rp.shaderGroupBaseAlignment,
                     VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
                     VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,

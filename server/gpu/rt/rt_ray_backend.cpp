@@ -32,7 +32,7 @@ constexpr const char* kNeeded =
     "VK_KHR_acceleration_structure, VK_KHR_ray_tracing_pipeline, VK_KHR_deferred_host_operations, "
     "bufferDeviceAddress and shaderFloat64";
 constexpr uint32_t kLaunchWidth = 1u << 15;  // 2-D launches: width x ceil(rays / width)
-constexpr int kWindowMargin = 1;  // a segment that ends on a voxel face touches the voxel beyond
+constexpr int kWindowMargin = 1;             // a segment that ends on a voxel face touches the voxel beyond
 
 std::shared_ptr<vk::Context> make_context(const BackendOptions& opts) {
   VkPhysicalDeviceRayTracingPipelineFeaturesKHR rt_features{};
@@ -52,8 +52,8 @@ std::shared_ptr<vk::Context> make_context(const BackendOptions& opts) {
   try {
     return std::make_shared<vk::Context>(co);
   } catch (const Unsupported& e) {  // no device or no ray tracing; other failures surface as they are
-    throw Unsupported(std::string("unsupported: the rt back end needs a Vulkan device with ") + kNeeded +
-                             "; " + e.what());
+    throw Unsupported(std::string("unsupported: the rt back end needs a Vulkan device with ") + kNeeded + "; " +
+                      e.what());
   }
 }
 
@@ -69,7 +69,8 @@ BlockGridLimits device_limits(const vk::Context& ctx, const BackendOptions& opts
 
 BlockGrid block_grid_for(const vk::Context& ctx, const BackendOptions& opts, const RtOptions& rt) {
   int wanted[3] = {rt.wanted[0], rt.wanted[1], rt.wanted[2]};
-  if (wanted[0] <= 0 || wanted[1] <= 0 || wanted[2] <= 0) wanted_from_range(opts.resolution, opts.max_range, 512, wanted);
+  if (wanted[0] <= 0 || wanted[1] <= 0 || wanted[2] <= 0)
+    wanted_from_range(opts.resolution, opts.max_range, 512, wanted);
   return choose_block_grid(rt.block, wanted, device_limits(ctx, opts, rt.limits));
 }
 

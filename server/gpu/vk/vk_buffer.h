@@ -34,7 +34,9 @@ class Buffer {
   // Host pointer to the whole buffer; nullptr unless host-visible.
   void* mapped() const { return mapped_; }
   template <class T>
-  T* as() const { return static_cast<T*>(mapped_); }
+  T* as() const {
+    return static_cast<T*>(mapped_);
+  }
   // For non-coherent host-visible memory: make host writes visible to the device, and
   // device writes visible to the host. No-ops on coherent memory.
   void flush(VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) const;

@@ -66,8 +66,9 @@ std::string check_device(VkPhysicalDevice pd, const ContextOptions& opts) {
   vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, ext.data());
   std::string missing;
   for (const char* want : opts.device_extensions) {
-    const bool have = std::any_of(ext.begin(), ext.end(),
-                                  [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, want) == 0; });
+    const bool have = std::any_of(ext.begin(), ext.end(), [&](const VkExtensionProperties& e) {
+      return std::strcmp(e.extensionName, want) == 0;
+    });
     if (!have) missing += std::string(missing.empty() ? "" : ", ") + want;
   }
   if (!missing.empty()) return "lacks " + missing;
@@ -106,8 +107,8 @@ namespace {
 std::string describe_devices(const std::vector<DeviceInfo>& devices) {
   std::string s;
   for (const DeviceInfo& d : devices) {
-    s += "\n  [" + std::to_string(d.index) + "] " + d.name + " (" + device_type_name(d.type) + "): " +
-         (d.unusable.empty() ? "usable" : d.unusable);
+    s += "\n  [" + std::to_string(d.index) + "] " + d.name + " (" + device_type_name(d.type) +
+         "): " + (d.unusable.empty() ? "usable" : d.unusable);
   }
   return s;
 }
@@ -127,7 +128,8 @@ int choose_device(const std::vector<DeviceInfo>& devices, const std::string& wan
   }
   if (all_digits(wanted)) {
     const unsigned long idx = std::stoul(wanted);
-    if (idx >= devices.size()) throw Unsupported("no Vulkan device with index " + wanted + ":" + describe_devices(devices));
+    if (idx >= devices.size())
+      throw Unsupported("no Vulkan device with index " + wanted + ":" + describe_devices(devices));
     if (!devices[idx].unusable.empty())
       throw Unsupported("Vulkan device " + wanted + " (" + devices[idx].name + ") " + devices[idx].unusable);
     return int(idx);
@@ -239,7 +241,8 @@ void Context::create_device(const ContextOptions& opts) {
   const VkResult dr = vkCreateDevice(physical_, &dci, nullptr, &device_);
   if (dr != VK_SUCCESS) {
     device_ = VK_NULL_HANDLE;
-    throw std::runtime_error(std::string("vkCreateDevice on ") + properties_.deviceName + " failed: " + result_name(dr));
+    throw std::runtime_error(std::string("vkCreateDevice on ") + properties_.deviceName +
+                             " failed: " + result_name(dr));
   }
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
 }
@@ -255,7 +258,8 @@ Context::~Context() {
 uint64_t Context::device_local_bytes() const {
   uint64_t best = 0;
   for (uint32_t i = 0; i < memory_.memoryHeapCount; ++i) {
-    if (memory_.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) best = std::max<uint64_t>(best, memory_.memoryHeaps[i].size);
+    if (memory_.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+      best = std::max<uint64_t>(best, memory_.memoryHeaps[i].size);
   }
   return best;
 }

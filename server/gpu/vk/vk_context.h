@@ -18,10 +18,10 @@
 namespace ort::vk {
 
 struct ContextOptions {
-  std::string device;                         // index or name substring; empty: automatic
-  std::vector<const char*> device_extensions; // extra extensions the device must have (all enabled)
-  bool need_float64 = true;                   // shaderFloat64 (OctoMap's double tMax/tDelta)
-  bool need_int64 = false;                    // shaderInt64
+  std::string device;                          // index or name substring; empty: automatic
+  std::vector<const char*> device_extensions;  // extra extensions the device must have (all enabled)
+  bool need_float64 = true;                    // shaderFloat64 (OctoMap's double tMax/tDelta)
+  bool need_int64 = false;                     // shaderInt64
   // Vulkan 1.2 features to enable (sType/pNext are set here). A back end that wants, say,
   // bufferDeviceAddress sets it; the device must support every feature set to VK_TRUE.
   VkPhysicalDeviceVulkan12Features features12{};

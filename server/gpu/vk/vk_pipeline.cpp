@@ -36,7 +36,8 @@ namespace {
 
 std::vector<VkDescriptorSetLayoutBinding> storage_bindings(uint32_t count) {
   std::vector<VkDescriptorSetLayoutBinding> b(count);
-  for (uint32_t i = 0; i < count; ++i) b[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  for (uint32_t i = 0; i < count; ++i)
+    b[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
   return b;
 }
 
