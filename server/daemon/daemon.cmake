@@ -2,12 +2,12 @@
 # The daemon's logic is a library (octomap_rt_daemon) so tests run it in-process over
 # memq://; the executable adds only flag parsing, signals and the summary.
 set(DAEMON_DIR ${CMAKE_CURRENT_LIST_DIR})
-file(GLOB DAEMON_SOURCES CONFIGURE_DEPENDS ${DAEMON_DIR}/*.cpp)
+file(GLOB_RECURSE DAEMON_SOURCES CONFIGURE_DEPENDS ${DAEMON_DIR}/*.cpp)
 list(FILTER DAEMON_SOURCES EXCLUDE REGEX "/(server_main|server_cli)\\.cpp$")
 add_library(octomap_rt_daemon STATIC ${DAEMON_SOURCES})
 target_include_directories(octomap_rt_daemon PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
 target_link_libraries(octomap_rt_daemon PUBLIC octomap_rt_engine octomap_rt_protocol octomap_rt_query octomap_rt_lcmtypes octomap_rt_lcm Threads::Threads)
-octomap_rt_lcm_handler_sources(octomap_rt_daemon ${DAEMON_DIR}/lcm_loop.cpp)
+octomap_rt_lcm_handler_sources(octomap_rt_daemon ${DAEMON_DIR}/transport/lcm_loop.cpp)
 
 # The engine flags (-r, sensor model, back end, ...) come from engine/engine_flags, shared so
 # that `octomap-rt build` and the server take the same names and defaults.

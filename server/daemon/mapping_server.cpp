@@ -8,10 +8,10 @@
 #include <optional>
 
 #include "core/clock.h"
-#include "daemon/map_snapshot.h"
-#include "daemon/map_store.h"
-#include "daemon/run_summary.h"
-#include "daemon/server_lcm_url.h"
+#include "daemon/persistence/map_store.h"
+#include "daemon/serving/map_snapshot.h"
+#include "daemon/status/run_summary.h"
+#include "daemon/transport/server_lcm_url.h"
 #include "engine/engine_warm_up.h"
 
 namespace ort::daemon {

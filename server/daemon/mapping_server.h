@@ -15,20 +15,20 @@
 
 #include <lcm/lcm-cpp.hpp>
 
-#include "daemon/degraded_causes.h"
-#include "daemon/delta_publisher.h"
-#include "daemon/lcm_loop.h"
-#include "daemon/map_service.h"
-#include "daemon/map_state.h"
-#include "daemon/octomap_raw_publisher.h"
-#include "daemon/pipeline_metrics.h"
-#include "daemon/producer_registry.h"
-#include "daemon/query_service.h"
-#include "daemon/scan_intake.h"
-#include "daemon/scan_pipeline.h"
-#include "daemon/scan_queue.h"
+#include "daemon/intake/producer_registry.h"
+#include "daemon/intake/scan_intake.h"
+#include "daemon/intake/scan_queue.h"
+#include "daemon/map/map_state.h"
+#include "daemon/pipeline/pipeline_metrics.h"
+#include "daemon/pipeline/scan_pipeline.h"
+#include "daemon/queries/query_service.h"
 #include "daemon/server_config.h"
-#include "daemon/status_message.h"
+#include "daemon/serving/delta_publisher.h"
+#include "daemon/serving/map_service.h"
+#include "daemon/serving/octomap_raw_publisher.h"
+#include "daemon/status/degraded_causes.h"
+#include "daemon/status/status_message.h"
+#include "daemon/transport/lcm_loop.h"
 #include "octomap_rt/server_status_t.hpp"
 
 namespace ort::daemon {

@@ -7,8 +7,8 @@
 #include <thread>
 
 #include "core/clock.h"
-#include "daemon/kernel_udp_stats.h"
 #include "daemon/mapping_server.h"
+#include "daemon/transport/kernel_udp_stats.h"
 
 namespace ort::daemon {
 

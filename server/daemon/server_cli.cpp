@@ -5,8 +5,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "daemon/query_answers.h"
-#include "daemon/scan_validation.h"
+#include "daemon/intake/scan_validation.h"
+#include "daemon/queries/query_answers.h"
 
 namespace ort::daemon {
 

@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "daemon/producer_registry.h"
+#include "daemon/intake/producer_registry.h"
 
 namespace ort::daemon {
 

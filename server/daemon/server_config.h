@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "daemon/query_config.h"
+#include "daemon/queries/query_config.h"
 #include "engine/map_engine.h"
 #include "octomap_rt/wire_contract.hpp"
 

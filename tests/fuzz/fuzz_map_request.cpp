@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <exception>
 
-#include "daemon/map_request_rules.h"
+#include "daemon/serving/map_request_rules.h"
 #include "protocol/wire_checks.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -12,8 +12,8 @@
 
 #include <octomap/OcTree.h>
 
-#include "daemon/query_answers.h"
-#include "daemon/query_wire.h"
+#include "daemon/queries/query_answers.h"
+#include "daemon/queries/query_wire.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/grid_query_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"

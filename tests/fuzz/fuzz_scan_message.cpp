@@ -9,8 +9,8 @@
 #include <cstring>
 #include <exception>
 
-#include "daemon/scan_decode.h"
-#include "daemon/scan_validation.h"
+#include "daemon/intake/scan_decode.h"
+#include "daemon/intake/scan_validation.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ort::daemon;

@@ -1,7 +1,7 @@
 // The rule behind DEGRADED: counters that grew since the last status period and trouble
 // that lasts are causes; a quiet period after trouble clears them; the first kernel count
 // is a baseline, not drops of the server's own.
-#include "daemon/degraded_causes.h"
+#include "daemon/status/degraded_causes.h"
 
 #include <gtest/gtest.h>
 

@@ -21,7 +21,7 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
-#include "daemon/delta_changes.h"
+#include "daemon/map/delta_changes.h"
 #include "engine/map_engine.h"
 #include "octomap_rt/map_delta_t.hpp"
 #include "protocol/delta_codec.h"

@@ -13,7 +13,7 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/lcm_loop.h"
+#include "daemon/transport/lcm_loop.h"
 
 namespace ort::test {
 namespace {

@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 
 #include "core/octree_file_check.h"
-#include "daemon/map_store.h"
 #include "daemon/mapping_server.h"
+#include "daemon/persistence/map_store.h"
 #include "engine/map_engine.h"
 #include "scene/synthetic_scene.h"
 #include "server/scan_fixtures.h"

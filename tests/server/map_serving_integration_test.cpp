@@ -16,8 +16,8 @@
 #include <set>
 #include <sstream>
 
-#include "daemon/applied_order.h"
-#include "daemon/kernel_udp_stats.h"
+#include "daemon/persistence/applied_order.h"
+#include "daemon/transport/kernel_udp_stats.h"
 #include "integration_harness.h"
 #include "map_client/map_mirror.h"
 #include "octomap_rt/map_request_t.hpp"

@@ -11,10 +11,10 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/applied_order.h"
-#include "daemon/kernel_udp_stats.h"
-#include "daemon/map_store.h"
-#include "daemon/server_lcm_url.h"
+#include "daemon/persistence/applied_order.h"
+#include "daemon/persistence/map_store.h"
+#include "daemon/transport/kernel_udp_stats.h"
+#include "daemon/transport/server_lcm_url.h"
 #include "engine/map_engine.h"
 #include "scene/synthetic_scene.h"
 #include "server/scan_fixtures.h"

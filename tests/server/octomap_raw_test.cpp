@@ -6,7 +6,7 @@
 #include <random>
 #include <sstream>
 
-#include "daemon/octomap_raw_map.h"
+#include "daemon/serving/octomap_raw_map.h"
 #include "libbot_copy/raw_t.hpp"
 
 namespace ort::daemon {

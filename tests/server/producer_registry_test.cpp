@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/producer_registry.h"
+#include "daemon/intake/producer_registry.h"
 
 namespace ort::daemon {
 namespace {

@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/query_wire.h"
+#include "daemon/queries/query_wire.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/box_reply_t.hpp"
 #include "octomap_rt/grid_query_t.hpp"

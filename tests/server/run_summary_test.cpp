@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/run_summary.h"
-#include "daemon/slowest_scans.h"
+#include "daemon/pipeline/slowest_scans.h"
+#include "daemon/status/run_summary.h"
 
 namespace ort::daemon {
 namespace {

@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/scan_decode.h"
-#include "daemon/scan_validation.h"
+#include "daemon/intake/scan_decode.h"
+#include "daemon/intake/scan_validation.h"
 #include "server/scan_fixtures.h"
 
 namespace ort::test {

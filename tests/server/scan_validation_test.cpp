@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/scan_validation.h"
+#include "daemon/intake/scan_validation.h"
 #include "server/scan_fixtures.h"
 
 namespace ort::test {

@@ -8,7 +8,7 @@
 
 #include <filesystem>
 
-#include "daemon/applied_order.h"
+#include "daemon/persistence/applied_order.h"
 #include "integration_harness.h"
 #include "lcm_log_scans.h"
 #include "octomap_rt/scan_t.hpp"

@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/map_store.h"
-#include "daemon/scan_validation.h"
+#include "daemon/intake/scan_validation.h"
+#include "daemon/persistence/map_store.h"
 #include "octomap_rt/server_status_t.hpp"
 #include "octomap_rt/wire_contract.hpp"
 #include "scene/synthetic_scene.h"

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/map_store.h"
+#include "daemon/persistence/map_store.h"
 #include "scene/synthetic_scene.h"
 #include "server/scan_fixtures.h"
 #include "support/tree_compare.h"

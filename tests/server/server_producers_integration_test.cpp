@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <map>
 
-#include "daemon/applied_order.h"
+#include "daemon/persistence/applied_order.h"
 #include "integration_harness.h"
 #include "scan_selection.h"
 #include "scene/scan_set.h"

@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/map_store.h"
+#include "daemon/persistence/map_store.h"
 #include "server/scan_fixtures.h"
 #include "support/small_filesystem.h"
 

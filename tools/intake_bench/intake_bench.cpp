@@ -21,8 +21,8 @@
 #include <CLI/CLI.hpp>
 
 #include "core/clock.h"
-#include "daemon/scan_to_map.h"
-#include "daemon/scan_validation.h"
+#include "daemon/intake/scan_to_map.h"
+#include "daemon/intake/scan_validation.h"
 #include "scene/scan_set.h"
 
 namespace {

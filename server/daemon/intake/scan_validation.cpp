@@ -1,0 +1,105 @@
+#include "daemon/intake/scan_validation.h"
+
+#include <cctype>
+#include <cmath>
+#include <exception>
+
+#include "core/prepare_scan.h"
+#include "daemon/intake/scan_decode.h"
+#include "protocol/wire_layout.h"
+
+namespace ort::daemon {
+namespace {
+
+// protocol::check_wire's fault as the daemon's reject reason (a string without its NUL has a
+// length that does not match it: a bad string length).
+Reject reject_of(protocol::WireFault fault) {
+  using F = protocol::WireFault;
+  switch (fault) {
+    case F::kNone: return Reject::kNone;
+    case F::kTruncated: return Reject::kTruncated;
+    case F::kWrongFingerprint: return Reject::kWrongFingerprint;
+    case F::kNegativeCount: return Reject::kNegativeCount;
+    case F::kCountTooLarge: return Reject::kCountTooLarge;
+    case F::kCountExceedsData: return Reject::kCountExceedsData;
+    case F::kBadStringLength:
+    case F::kStringNotTerminated: return Reject::kBadStringLength;
+    case F::kTrailingBytes: return Reject::kTrailingBytes;
+  }
+  return Reject::kTruncated;
+}
+
+}  // namespace
+
+bool valid_robot_id(const std::string& id) {
+  if (id.empty() || id.size() > kMaxRobotIdLength) return false;
+  for (char c : id) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) return false;
+  }
+  return true;
+}
+
+bool same_robot_id(const std::string& a, const std::string& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (std::toupper(static_cast<unsigned char>(a[i])) != std::toupper(static_cast<unsigned char>(b[i]))) return false;
+  }
+  return true;
+}
+
+Reject check_scan_wire(const uint8_t* data, size_t size, const ScanLimits& limits) {
+  // Largest legal message: header, max points, two strings of the longest allowed length.
+  const uint64_t max_size = kScanXyzOffset + 12 * limits.max_points + 8 + kMaxRobotIdLength + kMaxMapFrameLength + 2;
+  if (size > max_size) return Reject::kTooLarge;
+  // scan_t's layout (lcmtypes/octomap_rt_scan_t.lcm): the fixed fields, num_xyz, xyz[], robot_id, map_frame.
+  namespace p = protocol;
+  return reject_of(
+      p::check_wire(data, size, octomap_rt::scan_t::getHash(),
+                    {p::wire_fixed(kScanNumXyzOffset - 8), p::wire_count(3 * static_cast<int64_t>(limits.max_points)),
+                     p::wire_array(4), p::wire_string(kMaxRobotIdLength), p::wire_string(kMaxMapFrameLength)})
+          .fault);
+}
+
+Reject check_scan_content(const octomap_rt::scan_t& m, const std::string& expected_robot_id, const ScanLimits& limits) {
+  if (m.num_xyz % 3 != 0) return Reject::kCountNotMultipleOf3;
+  if (!all_finite(m.xyz)) return Reject::kNonFinitePoint;
+  for (double v : m.sensor_position) {
+    if (!std::isfinite(v)) return Reject::kNonFinitePose;
+  }
+  double norm2 = 0;
+  for (double v : m.sensor_orientation) {
+    if (!std::isfinite(v)) return Reject::kNonFinitePose;
+    norm2 += v * v;
+  }
+  if (norm2 == 0.0) return Reject::kZeroQuaternion;
+  // The pose is used as sent (OctoMap's transform does not normalize either), so it must
+  // already be a rotation: a scaled quaternion would scale the scan.
+  if (std::abs(std::sqrt(norm2) - 1.0) > 1e-3) return Reject::kNonUnitQuaternion;
+  if (!std::isfinite(m.max_range)) return Reject::kBadMaxRange;
+  if (m.points_frame != octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME &&
+      m.points_frame != octomap_rt::scan_t::POINTS_IN_MAP_FRAME)
+    return Reject::kUnknownPointsFrame;
+  if (!valid_robot_id(m.robot_id)) return Reject::kBadRobotId;
+  if (!same_robot_id(m.robot_id, expected_robot_id)) return Reject::kRobotIdMismatch;
+  // The ray origin is the position rounded to float, as OctoMap's pose6d holds it.
+  const octomap::point3d origin(static_cast<float>(m.sensor_position[0]), static_cast<float>(m.sensor_position[1]),
+                                static_cast<float>(m.sensor_position[2]));
+  octomap::OcTreeKey key;
+  if (!coord_to_key_checked(origin, limits.resolution, key)) return Reject::kOriginOutsideMap;
+  return Reject::kNone;
+}
+
+Reject validate_scan(const uint8_t* data, size_t size, const std::string& expected_robot_id, const ScanLimits& limits,
+                     octomap_rt::scan_t& out) {
+  if (Reject r = check_scan_wire(data, size, limits); r != Reject::kNone) return r;
+  try {
+    const int used = decode_scan(data, size, out);  // = out.decode(), the point array vectorized
+    if (used < 0) return Reject::kDecodeFailed;
+    if (static_cast<size_t>(used) != size) return Reject::kTrailingBytes;
+  } catch (const std::exception&) {
+    return Reject::kDecodeFailed;
+  }
+  return check_scan_content(out, expected_robot_id, limits);
+}
+
+}  // namespace ort::daemon

@@ -1,0 +1,171 @@
+#include "daemon/persistence/map_store.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "core/octree_file_check.h"
+
+namespace ort::daemon {
+namespace {
+
+using Kind = MapStoreError::Kind;
+
+MapStoreError sys_error(Kind kind, const std::string& what, const std::string& path) {
+  return MapStoreError(kind, what + " '" + path + "': " + std::strerror(errno));
+}
+
+struct Fd {
+  int fd = -1;
+  ~Fd() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+std::string directory_of(const std::string& path) {
+  std::string dir = std::filesystem::path(path).parent_path().string();
+  return dir.empty() ? "." : dir;
+}
+
+void write_all(int fd, std::string_view bytes, const std::string& path) {
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw sys_error(Kind::kWrite, "cannot write", path);
+    done += static_cast<size_t>(n);
+  }
+}
+
+// Writes, fsyncs and closes `path` (created new or truncated).
+void write_and_sync(const std::string& path, std::string_view bytes, int extra_flags) {
+  Fd f;
+  f.fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | extra_flags, 0644);
+  if (f.fd < 0) throw sys_error(Kind::kWrite, "cannot create", path);
+  write_all(f.fd, bytes, path);
+  if (::fsync(f.fd) != 0) throw sys_error(Kind::kSync, "cannot fsync", path);
+  const int fd = f.fd;
+  f.fd = -1;
+  if (::close(fd) != 0) throw sys_error(Kind::kWrite, "cannot close", path);
+}
+
+void sync_directory(const std::string& dir) {
+  Fd d;
+  d.fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (d.fd < 0 || ::fsync(d.fd) != 0) throw sys_error(Kind::kSync, "cannot fsync directory", dir);
+}
+
+std::string utc_stamp() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y%m%dT%H%M%SZ", &tm);
+  return buf;
+}
+
+}  // namespace
+
+const char* to_string(MapStoreError::Kind kind) {
+  switch (kind) {
+    case Kind::kOpen: return "cannot open";
+    case Kind::kRead: return "cannot read";
+    case Kind::kCorrupt: return "corrupt map file";
+    case Kind::kWrongType: return "not an OcTree";
+    case Kind::kWrongResolution: return "wrong resolution";
+    case Kind::kWrite: return "write failed";
+    case Kind::kSync: return "fsync failed";
+    case Kind::kRename: return "rename failed";
+    case Kind::kNotWritable: return "map directory not writable";
+    case Kind::kSerialize: return "cannot serialize";
+  }
+  return "unknown";
+}
+
+std::string serialize_map(const octomap::OcTree& tree) {
+  std::ostringstream out(std::ios::binary);
+  if (!tree.write(out)) throw MapStoreError(Kind::kSerialize, "could not serialize the map");
+  return std::move(out).str();
+}
+
+std::unique_ptr<octomap::OcTree> load_map(const std::string& path, double resolution) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw sys_error(Kind::kOpen, "cannot open map", path);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw sys_error(Kind::kRead, "cannot read map", path);
+  const OctreeFileCheck check = check_octree_file(bytes, /*inner_is_max=*/true);
+  if (!check.ok) {
+    const bool other_tree = !check.tree_type.empty() && check.tree_type != "OcTree";
+    const Kind kind = other_tree ? Kind::kWrongType : Kind::kCorrupt;
+    throw MapStoreError(kind, "map '" + path + "' is not a complete OctoMap .ot file: " + check.error);
+  }
+  if (check.format != OctreeFileFormat::kFull)
+    throw MapStoreError(Kind::kWrongType, "map '" + path + "' is a .bt file (no log-odds); the server keeps .ot maps");
+  std::unique_ptr<octomap::OcTree> tree;
+  try {
+    tree = read_octree_file_bytes(bytes, "map '" + path + "'", /*inner_is_max=*/true);
+  } catch (const std::runtime_error& e) {
+    throw MapStoreError(Kind::kCorrupt, e.what());
+  }
+  const double file_res = tree->getResolution();
+  // The .ot header prints the resolution as text (6 significant digits), so allow for that
+  // rounding, and then use the requested value bit for bit.
+  if (std::abs(file_res - resolution) > 1e-6 * resolution) {
+    std::ostringstream msg;
+    msg << "map '" << path << "' has resolution " << file_res << " m but the server was started with -r " << resolution
+        << "; start with -r " << file_res << " or use another --map file";
+    throw MapStoreError(Kind::kWrongResolution, msg.str());
+  }
+  if (file_res != resolution) tree->setResolution(resolution);
+  return tree;
+}
+
+std::string move_map_aside(const std::string& path) {
+  const std::string aside = path + ".corrupt-" + utc_stamp();
+  if (::rename(path.c_str(), aside.c_str()) != 0) throw sys_error(Kind::kRename, "cannot move aside", path);
+  return aside;
+}
+
+void check_map_directory_writable(const std::string& map_path) {
+  const std::string dir = directory_of(map_path);
+  const std::string probe = map_path + ".probe-" + std::to_string(::getpid());
+  try {
+    write_and_sync(probe, std::string(4096, '\0'), O_EXCL);
+    ::unlink(probe.c_str());
+    sync_directory(dir);
+  } catch (const MapStoreError& e) {
+    ::unlink(probe.c_str());
+    throw MapStoreError(Kind::kNotWritable, "the map cannot be saved in '" + dir + "' (" + e.what() +
+                                                "); fix the directory or choose another --map");
+  }
+  const std::string stale = map_path + ".tmp";
+  std::error_code ec;
+  std::filesystem::remove(stale, ec);  // an interrupted save's leftover; the map itself is intact
+}
+
+void write_file_atomically(const std::string& path, std::string_view bytes) {
+  const std::string tmp = path + ".tmp";
+  try {
+    write_and_sync(tmp, bytes, O_TRUNC);
+  } catch (const MapStoreError&) {
+    ::unlink(tmp.c_str());
+    throw;
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const MapStoreError e = sys_error(Kind::kRename, "cannot rename over", path);
+    ::unlink(tmp.c_str());
+    throw e;
+  }
+  sync_directory(directory_of(path));
+}
+
+}  // namespace ort::daemon

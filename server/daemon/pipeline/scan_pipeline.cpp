@@ -1,0 +1,212 @@
+#include "daemon/pipeline/scan_pipeline.h"
+
+#include <algorithm>
+#include <cctype>
+#include <ostream>
+
+#include "core/clock.h"
+#include "daemon/intake/scan_to_map.h"
+
+namespace ort::daemon {
+namespace {
+std::string lower_case(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+}  // namespace
+
+ScanPipeline::ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, ProducerRegistry& producers,
+                           PipelineMetrics& metrics, std::ostream& log, bool pipelined,
+                           std::chrono::duration<double> max_queue_age)
+    : engine_(engine),
+      map_(map),
+      queue_(queue),
+      producers_(producers),
+      metrics_(metrics),
+      log_(log),
+      pipelined_(pipelined),
+      max_queue_age_(max_queue_age) {}
+
+void ScanPipeline::set_busy(int stage, bool busy) {
+  busy_since_ns_[stage] = busy ? std::max<int64_t>(1, Clock::now().time_since_epoch().count()) : 0;
+}
+
+Clock::duration ScanPipeline::longest_busy(Clock::time_point now) const {
+  Clock::duration longest = Clock::duration::zero();
+  for (const auto& since : busy_since_ns_) {
+    const int64_t t = since;
+    if (t) longest = std::max(longest, now - Clock::time_point(Clock::duration(t)));
+  }
+  return longest;
+}
+
+bool ScanPipeline::shed_if_stale(const QueuedScan& item) {
+  if (max_queue_age_.count() <= 0 || Clock::now() - item.received <= max_queue_age_) return false;
+  producers_.count_dropped_in_flight(item.producer, Reject::kOverLatencyBound);
+  shed_++;
+  return true;
+}
+
+ScanPipeline::~ScanPipeline() {
+  queue_.close();
+  join();
+}
+
+void ScanPipeline::start() {
+  if (pipelined_) {
+    stage1_ = std::thread([this] { run_stage1(); });
+    stage2_ = std::thread([this] { run_stage2(); });
+  } else {
+    stage1_ = std::thread([this] { run_sequential(); });
+  }
+}
+
+void ScanPipeline::join() {
+  if (stage1_.joinable()) stage1_.join();
+  if (stage2_.joinable()) stage2_.join();
+}
+
+void ScanPipeline::reject(size_t producer, Reject why, const char* what) {
+  if (why == Reject::kEngineError && engine_errors_++ < 10) log_ << "octomap-rt-server: engine error: " << what << "\n";
+  producers_.count_rejected_in_flight(producer, why);
+}
+
+bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
+  if (item.edit) {  // edits pass stage 1 untouched
+    job.edit = std::move(item.edit);
+    return true;
+  }
+  set_busy(0, true);
+  const double token = metrics_.overlap().begin(0);
+  const auto t0 = Clock::now();
+  const Clock::time_point decoded = item.decoded == Clock::time_point{} ? item.received : item.decoded;
+  job.waits.decode_ms = ms_between(item.received, decoded);
+  job.waits.queue_ms = ms_between(decoded, t0);
+  bool ok = true;
+  try {
+    const double max_range = effective_max_range(item.msg.max_range, engine_.options().max_range);
+    if (item.msg.points_frame == octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME) {
+      // The message's floats as they are: a back end preparing on its device copies them
+      // straight into its upload buffer (transformed on the GPU where it can).
+      const octomap::pose6d pose = scan_pose(item.msg);
+      const std::span<const float> xyz(item.msg.xyz.data(), item.msg.xyz.size() - item.msg.xyz.size() % 3);
+      engine_.shoot_posed_xyz(pose, pose.trans(), xyz, max_range, job.shot);
+    } else {
+      const PosedMessageScan scan = to_posed_scan(item.msg);
+      const std::span<const octomap::point3d> pts(scan.points.size() ? &scan.points[0] : nullptr, scan.points.size());
+      engine_.shoot(scan.origin, pts, max_range, job.shot);
+    }
+    if (!job.shot.prepare.origin_ok) {
+      reject(item.producer, Reject::kOriginOutsideMap, "");
+      ok = false;
+    } else if (job.shot.shoot.walk_overruns && overrun_warnings_++ < 10) {
+      // The shaders' step guard stopped a ray: the scan is applied, but this must never happen.
+      log_ << "octomap-rt-server: " << job.shot.shoot.walk_overruns << " ray walks hit the GPU step guard\n";
+    }
+    if (ok && job.shot.refusal != ShotRefusal::kNone) {
+      reject(item.producer, job.shot.refusal == ShotRefusal::kRayTooLong ? Reject::kRayTooLong : Reject::kTooMuchWork,
+             "");
+      ok = false;
+    }
+  } catch (const std::exception& e) {
+    reject(item.producer, Reject::kEngineError, e.what());
+    ok = false;
+  }
+  metrics_.overlap().end(0, token);
+  set_busy(0, false);
+  job.producer = item.producer;
+  job.robot_id = item.msg.robot_id;
+  job.seq = item.msg.seq;
+  job.utime = item.msg.utime;
+  job.points = item.msg.num_xyz / 3;
+  job.received = item.received;
+  job.shot_at = Clock::now();
+  job.shoot_ms = ms_between(t0, job.shot_at);
+  return ok;
+}
+
+void ScanPipeline::apply_edit(MapEditItem& edit) {
+  MapEditResult r;
+  try {
+    std::unique_lock lock(map_.mutex);
+    r = apply_map_edit(map_, edit);
+  } catch (const std::exception& e) {
+    r.ok = false;
+    r.error = e.what();
+  }
+  map_.changed.notify_all();
+  if (edit.done) edit.done(r);
+}
+
+void ScanPipeline::apply(ShotJob& job) {
+  if (job.edit) return apply_edit(*job.edit);
+  const double token = metrics_.overlap().begin(1);
+  const auto t0 = Clock::now();
+  job.waits.handoff_ms = ms_between(job.shot_at, t0);
+  set_busy(1, true);
+  Stage2Parts parts;
+  int64_t new_nodes = 0;
+  try {
+    std::lock_guard lock(map_.mutex);
+    const auto locked = Clock::now();
+    const auto nodes_before = static_cast<int64_t>(map_.tree->size());
+    engine_.apply(job.shot, *map_.tree, map_.observer ? &changes_ : nullptr);
+    new_nodes = static_cast<int64_t>(map_.tree->size()) - nodes_before;
+    map_.order.append(AppliedEntry{job.robot_id, job.seq, job.utime});
+    map_.version++;
+    map_.last_scan_utime = std::max(map_.last_scan_utime, job.utime);
+    const auto updated = Clock::now();
+    if (map_.observer) map_.observer->applied(changes_, *map_.tree, map_.version);
+    map_.applied_seq[lower_case(job.robot_id)] = job.seq;
+    parts = {ms_between(t0, locked), ms_between(locked, updated), ms_between(updated, Clock::now())};
+  } catch (const std::exception& e) {
+    set_busy(1, false);
+    metrics_.overlap().end(1, token);
+    reject(job.producer, Reject::kEngineError, e.what());
+    return;
+  }
+  set_busy(1, false);
+  map_.changed.notify_all();
+  const auto t1 = Clock::now();
+  const double overlap_s = metrics_.overlap().end(1, token);
+  AppliedTiming t;
+  t.shoot_ms = job.shoot_ms;
+  t.octree_ms = ms_between(t0, t1);
+  t.end_to_end_ms = ms_between(job.received, t1);
+  t.points = job.points;
+  t.overlapped = overlap_s > 0;
+  t.waits = job.waits;
+  t.stage1 = job.shot.shoot.times;
+  t.stage1.octree_ms = 0;  // stage 2's
+  t.stage2 = parts;
+  t.robot_id = job.robot_id;
+  t.seq = job.seq;
+  t.received = job.received;
+  t.voxels = job.shot.free_voxels + job.shot.occupied_voxels;
+  t.new_nodes = new_nodes;
+  metrics_.record(t);
+  producers_.count_applied(job.producer, job.points, t.end_to_end_ms);
+}
+
+void ScanPipeline::run_stage1() {
+  while (auto item = queue_.pop()) {
+    if (shed_if_stale(*item)) continue;
+    ShotJob job;
+    if (shoot(*item, job)) handoff_.push(std::move(job));
+  }
+  handoff_.close();
+}
+
+void ScanPipeline::run_stage2() {
+  while (auto job = handoff_.pop()) apply(*job);
+}
+
+void ScanPipeline::run_sequential() {
+  while (auto item = queue_.pop()) {
+    if (shed_if_stale(*item)) continue;
+    ShotJob job;
+    if (shoot(*item, job)) apply(job);
+  }
+}
+
+}  // namespace ort::daemon

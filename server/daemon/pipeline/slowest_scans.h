@@ -1,0 +1,38 @@
+// The few scans with the longest end-to-end time over the whole run, each with where its time
+// went (waits, stage 1's parts, stage 2's parts) and when it came: the run summary lists them,
+// so a p99 over a run says which scans made it (the first ones of a fresh daemon, a burst of
+// three, a slow octree update) and which part of them was slow.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "daemon/pipeline/applied_timing.h"
+
+namespace ort::daemon {
+
+struct SlowScan {
+  int64_t applied_index = 0;  // 1 = the first scan the daemon applied
+  double received_s = 0;      // receipt, seconds after the first scan's receipt
+  AppliedTiming timing;
+};
+
+class SlowestScans {
+ public:
+  explicit SlowestScans(size_t kept = 5) : kept_(kept) {}
+  // Every applied scan, in applied order.
+  void add(const AppliedTiming& t);
+  // The kept scans, slowest first (end to end).
+  const std::vector<SlowScan>& slowest() const { return slowest_; }
+
+ private:
+  size_t kept_;
+  int64_t applied_ = 0;
+  bool have_first_ = false;
+  std::chrono::steady_clock::time_point first_received_;
+  std::vector<SlowScan> slowest_;
+};
+
+}  // namespace ort::daemon

@@ -1,0 +1,43 @@
+// The query service's answers: validation of a decoded query (what the server refuses and
+// why), and the reply messages, computed with server/query/ on the map under the caller's
+// (shared) map lock and encoded ready to publish (split where one datagram is not enough).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "daemon/queries/query_clients.h"
+
+namespace ort::daemon {
+
+// Common to every query message.
+struct QueryHeader {
+  int64_t request_id = 0, min_snapshot_id = 0, wait_seq = -1;
+  int32_t wait_timeout_ms = 0;
+  std::string client_id, reply_channel, wait_robot_id;
+};
+QueryHeader header_of(const QueryMessage& q);
+
+// "" when the query can be answered; else why not (non-finite numbers, counts, depth, ...).
+std::string validate_query(const QueryMessage& q, double resolution);
+
+struct MapStamp {
+  int64_t snapshot_id = 0, map_utime = 0;
+};
+
+struct EncodedReplies {
+  std::string channel;
+  std::vector<std::vector<uint8_t>> messages;  // in order; several for regions and grids
+};
+
+// Under the map lock. Throws query::QueryError (the caller replies BAD_REQUEST with it).
+EncodedReplies answer_query(const octomap::OcTree& tree, const QueryMessage& q, const MapStamp& stamp,
+                            const std::string& server_id);
+// A reply of q's type with `status` (occupancy_reply_t.REPLY_*) and `error`, no results.
+EncodedReplies error_reply(const QueryMessage& q, int8_t status, const std::string& error, const MapStamp& stamp,
+                           const std::string& server_id);
+
+}  // namespace ort::daemon

@@ -1,0 +1,297 @@
+#include "daemon/queries/query_service.h"
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+
+#include "daemon/queries/query_wire.h"
+#include "octomap_rt/map_edit_ack_t.hpp"
+#include "octomap_rt/map_edit_t.hpp"
+#include "octomap_rt/occupancy_reply_t.hpp"
+#include "octomap_rt/wire_contract.hpp"
+#include "query/query_types.h"
+
+namespace ort::daemon {
+namespace {
+
+using Reply = octomap_rt::occupancy_reply_t;
+using Count = QueryClients::Count;
+constexpr size_t kMaxMessage = 65536;
+const std::string kNoClient = "?";
+constexpr size_t kMaxParked = 256;  // queries waiting for their map state, all clients
+// Longest a batch of queries holds the map for reading (stage 2 may be waiting to write).
+constexpr auto kReadTurn = std::chrono::milliseconds(10);
+
+bool id_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.'; }
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+int64_t now_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+QueryService::QueryService(const QueryServiceConfig& cfg, MapState& map, ScanQueue& scans, LcmLoop& loop,
+                           std::string server_id, double resolution)
+    : cfg_(cfg),
+      map_(map),
+      scans_(scans),
+      loop_(loop),
+      server_id_(std::move(server_id)),
+      resolution_(resolution),
+      clients_(cfg.per_client_queue, cfg.max_clients),
+      grids_(cfg.grid, map, loop, server_id_) {}
+
+QueryService::~QueryService() { stop(); }
+
+void QueryService::open() {
+  using namespace octomap_rt;
+  subs_.push_back(loop_.subscribe(cfg_.points_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
+    on_query<occupancy_query_t>(rb, check_occupancy_query);
+  }));
+  subs_.push_back(loop_.subscribe(cfg_.rays_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
+    on_query<ray_query_t>(rb, check_ray_query);
+  }));
+  subs_.push_back(loop_.subscribe(cfg_.boxes_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
+    on_query<box_query_t>(rb, check_box_query);
+  }));
+  subs_.push_back(loop_.subscribe(cfg_.grid_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
+    on_query<grid_query_t>(rb, check_grid_query);
+  }));
+  subs_.push_back(
+      loop_.subscribe(cfg_.edit_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) { on_edit(rb); }));
+}
+
+QueryServiceStats QueryService::service_stats() const {
+  QueryServiceStats s;
+  s.clients = clients_.snapshot();
+  s.refusal_reasons = clients_.refusal_reasons();
+  s.grids_published = grids_.published();
+  return s;
+}
+
+void QueryService::start() {
+  worker_ = std::thread([this] { run(); });
+  grids_.start();
+}
+
+void QueryService::stop() {
+  {
+    std::lock_guard lock(wake_mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  map_.changed.notify_all();
+  if (worker_.joinable()) worker_.join();
+  grids_.stop();
+}
+
+std::string QueryService::check_addressing(const std::string& client, const std::string& channel) const {
+  if (client.empty() || client.size() > 64) return "client_id must have 1..64 characters";
+  for (char c : client)
+    if (!id_char(c)) return "client_id may hold only letters, digits, '_', '-', '.'";
+  if (channel.empty() || channel.size() > 128) return "reply_channel must have 1..128 characters";
+  for (char c : channel)
+    if (!std::isgraph(static_cast<unsigned char>(c))) return "reply_channel may hold only printable characters";
+  // Replies must not land on the server's own inputs.
+  for (const std::string* own :
+       {&cfg_.points_channel, &cfg_.rays_channel, &cfg_.boxes_channel, &cfg_.grid_channel, &cfg_.edit_channel})
+    if (channel == *own) return "reply_channel is one of the server's request channels";
+  if (channel == cfg_.grid.channel) return "reply_channel is the server's grid channel";
+  if (channel.rfind(octomap_rt::wire::kScanChannelPrefix, 0) == 0 || channel == octomap_rt::wire::kStatusChannel)
+    return "reply_channel is one of the server's scan or status channels";
+  return "";
+}
+
+template <class Message>
+void QueryService::on_query(const lcm::ReceiveBuffer& rb, std::string (*check)(const uint8_t*, size_t)) {
+  const auto* data = static_cast<const uint8_t*>(rb.data);
+  const size_t size = rb.data_size;
+  std::string why = size > kMaxMessage ? "message over 64 KiB" : check(data, size);
+  Message msg;
+  if (why.empty()) {
+    try {
+      if (msg.decode(data, 0, static_cast<int>(size)) < 0) why = "decode failed";
+    } catch (const std::exception& e) {
+      why = std::string("decode failed: ") + e.what();
+    }
+  }
+  if (!why.empty()) {  // nobody to answer: the addressing cannot be trusted
+    clients_.count(kNoClient, Count::kDropped, why);
+    return;
+  }
+  if (std::string bad = check_addressing(msg.client_id, msg.reply_channel); !bad.empty()) {
+    clients_.count(kNoClient, Count::kDropped, bad);
+    return;
+  }
+  clients_.received(msg.client_id, msg.reply_channel, now_us());
+  PendingQuery q{QueryMessage(std::move(msg)), Clock::now(), {}};
+  const QueryHeader h = header_of(q.msg);
+  std::string bad = validate_query(q.msg, resolution_);
+  if (bad.empty() && (h.wait_timeout_ms < 0 || h.wait_timeout_ms > cfg_.max_wait_ms))
+    bad = "wait_timeout_ms must be in 0.." + std::to_string(cfg_.max_wait_ms);
+  if (!bad.empty()) {
+    clients_.count(h.client_id, Count::kBad, bad);
+    publish(error_reply(q.msg, Reply::REPLY_BAD_REQUEST, bad, {}, server_id_));
+    return;
+  }
+  q.deadline = q.received + std::chrono::milliseconds(h.wait_timeout_ms);
+  QueryMessage copy_for_busy = q.msg;
+  if (!clients_.push(h.client_id, std::move(q))) {
+    publish(error_reply(copy_for_busy, Reply::REPLY_BUSY,
+                        "busy: " + std::to_string(cfg_.per_client_queue) + " queries of this client are queued", {},
+                        server_id_));
+    return;
+  }
+  wake_.notify_one();
+}
+
+void QueryService::on_edit(const lcm::ReceiveBuffer& rb) {
+  using Edit = octomap_rt::map_edit_t;
+  const auto* data = static_cast<const uint8_t*>(rb.data);
+  std::string why = rb.data_size > kMaxMessage ? "message over 64 KiB" : check_map_edit(data, rb.data_size);
+  Edit msg;
+  if (why.empty()) {
+    try {
+      if (msg.decode(data, 0, static_cast<int>(rb.data_size)) < 0) why = "decode failed";
+    } catch (const std::exception& e) {
+      why = std::string("decode failed: ") + e.what();
+    }
+  }
+  if (why.empty()) why = check_addressing(msg.client_id, msg.reply_channel);
+  if (!why.empty()) {
+    clients_.count(kNoClient, Count::kDropped, "map edit: " + why);
+    return;
+  }
+  clients_.received(msg.client_id, msg.reply_channel, now_us());
+  auto ack = [this, msg](const MapEditResult& r, int8_t status, const std::string& error) {
+    octomap_rt::map_edit_ack_t a;
+    a.utime = now_us();
+    a.request_id = msg.request_id;
+    a.snapshot_id = static_cast<int64_t>(r.version);
+    a.map_utime = r.map_utime;
+    a.status = status;
+    a.op = msg.op;
+    a.voxels = r.voxels;
+    a.server_id = server_id_;
+    a.client_id = msg.client_id;
+    a.error = error;
+    clients_.count(msg.client_id, status == Reply::REPLY_OK ? Count::kEditApplied : Count::kEditRefused, error);
+    loop_.publish(msg.reply_channel, a);
+  };
+  std::string refuse;
+  if (cfg_.control_token.empty())
+    refuse = "map edits are off: the server was started without --control-token";
+  else if (msg.token != cfg_.control_token)
+    refuse = "wrong control token";
+  int8_t status = Reply::REPLY_REFUSED;
+  if (refuse.empty() && msg.op != Edit::OP_CLEAR_TO_FREE && msg.op != Edit::OP_CLEAR_TO_UNKNOWN &&
+      msg.op != Edit::OP_RESET)
+    refuse = "unknown op " + std::to_string(msg.op), status = Reply::REPLY_BAD_REQUEST;
+  if (refuse.empty() && msg.op != Edit::OP_RESET) {
+    for (int a = 0; a < 3 && refuse.empty(); ++a)
+      if (!std::isfinite(msg.box_min[a]) || !std::isfinite(msg.box_max[a]) || msg.box_min[a] > msg.box_max[a])
+        refuse = "box corners must be finite with min <= max", status = Reply::REPLY_BAD_REQUEST;
+  }
+  if (!refuse.empty()) return ack(MapEditResult{}, status, refuse);
+  auto item = std::make_shared<MapEditItem>();
+  item->op = msg.op;
+  std::copy(std::begin(msg.box_min), std::end(msg.box_min), item->box_min);
+  std::copy(std::begin(msg.box_max), std::end(msg.box_max), item->box_max);
+  item->done = [ack](const MapEditResult& r) { ack(r, r.ok ? Reply::REPLY_OK : Reply::REPLY_BAD_REQUEST, r.error); };
+  if (!scans_.push_edit(item)) ack(MapEditResult{}, Reply::REPLY_NOT_READY, "the server is stopping");
+}
+
+bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& out) {
+  const QueryHeader h = header_of(q.msg);
+  const MapStamp stamp{static_cast<int64_t>(map_.version), map_.last_scan_utime};
+  // The robot id keys the wait: "" = no wait, whatever wait_seq holds (a default message
+  // has wait_seq 0), so a plain query is never parked for a robot that does not exist.
+  const bool waits_for_scan = !h.wait_robot_id.empty();
+  int64_t applied = -1;
+  if (waits_for_scan) {
+    auto it = map_.applied_seq.find(lower(h.wait_robot_id));
+    if (it != map_.applied_seq.end()) applied = it->second;
+  }
+  const bool ready = stamp.snapshot_id >= h.min_snapshot_id && (!waits_for_scan || applied >= h.wait_seq);
+  if (!ready) {
+    if (Clock::now() < q.deadline) return false;
+    const std::string why = "map state " + std::to_string(stamp.snapshot_id) + " (robot '" + h.wait_robot_id +
+                            "' applied seq " + std::to_string(applied) + ") did not reach min_snapshot_id " +
+                            std::to_string(h.min_snapshot_id) + " / wait_seq " + std::to_string(h.wait_seq) +
+                            " within " + std::to_string(h.wait_timeout_ms) + " ms";
+    clients_.count(h.client_id, Count::kNotReady, why);
+    out.push_back(error_reply(q.msg, Reply::REPLY_NOT_READY, why, stamp, server_id_));
+    return true;
+  }
+  try {
+    out.push_back(answer_query(*map_.tree, q.msg, stamp, server_id_));
+  } catch (const std::exception& e) {  // query::QueryError: a query the map cannot answer
+    clients_.count(h.client_id, Count::kBad, e.what());
+    out.push_back(error_reply(q.msg, Reply::REPLY_BAD_REQUEST, e.what(), stamp, server_id_));
+    return true;
+  }
+  clients_.count(h.client_id, Count::kAnswered);
+  return true;
+}
+
+void QueryService::publish(const EncodedReplies& r) {
+  for (size_t i = 0; i < r.messages.size(); ++i) {
+    // Paced: a burst of 60 KB datagrams overruns default receive buffers (lcm-1.3.1 notes §3.3).
+    if (i > 0) std::this_thread::sleep_for(std::chrono::microseconds(500));
+    loop_.publish(r.channel, r.messages[i].data(), r.messages[i].size());
+  }
+}
+
+void QueryService::run() {
+  std::vector<PendingQuery> parked;
+  for (;;) {
+    {
+      std::unique_lock lock(wake_mutex_);
+      if (stopping_) return;
+      if (clients_.queued() == 0)
+        wake_.wait_for(lock, parked.empty() ? std::chrono::milliseconds(100) : std::chrono::milliseconds(2),
+                       [&] { return stopping_ || clients_.queued() > 0; });
+      if (stopping_) return;
+    }
+    if (parked.empty() && clients_.queued() == 0) continue;
+    std::vector<EncodedReplies> out;
+    {
+      // One turn at the map for every query ready now (within a budget): under a scan
+      // backlog a reader gets the lock about once per scan, so each query taking it alone
+      // waited a scan per query (on dev: ~20 answered a second, the rest BUSY).
+      std::shared_lock lock(map_.mutex);
+      const auto turn_end = Clock::now() + kReadTurn;
+      for (size_t i = 0; i < parked.size();) {
+        if (answer_locked(parked[i], out)) {
+          parked[i] = std::move(parked.back());
+          parked.pop_back();
+        } else {
+          ++i;
+        }
+      }
+      while (Clock::now() < turn_end) {
+        auto q = clients_.pop();
+        if (!q) break;
+        if (answer_locked(*q, out)) continue;
+        if (parked.size() < kMaxParked) {
+          parked.push_back(std::move(*q));
+        } else {  // waiting queries are bounded too
+          const QueryHeader h = header_of(q->msg);
+          clients_.count(h.client_id, Count::kBusy, "busy: too many queries wait for their map state");
+          out.push_back(error_reply(q->msg, Reply::REPLY_BUSY, "busy: too many queries wait for their map state", {},
+                                    server_id_));
+        }
+      }
+    }
+    for (const EncodedReplies& r : out) publish(r);
+  }
+}
+
+}  // namespace ort::daemon

@@ -1,0 +1,75 @@
+// The query service: planners' occupancy queries (points, rays, boxes, regions, 2D grids)
+// and map edits over LCM, answered on the server from one consistent map state.
+//
+// LCM thread (handlers on the server's LcmLoop): wire bounds before decode, decode, checks;
+// a query that names a usable client and reply channel and fails a check gets a
+// BAD_REQUEST reply saying why; one that does not is dropped; both are counted. Valid
+// queries go to their client's bounded queue (full: BUSY reply). Edits are checked against
+// --control-token and queued into the scan pipeline, so they apply in order with the scans.
+//
+// Worker thread: clients in turn; a query waits (parked, up to its timeout) until the map
+// state is >= min_snapshot_id and the robot's wait_seq was applied (read-your-writes), then
+// is answered under a shared map lock, with every other query ready then (a turn of at most
+// 10 ms: stage 2 may be waiting), and its replies are published after the lock, each naming
+// the map state (snapshot_id = MapState::version).
+// With --grid-rate, its GridPublisher also publishes the 2D grid on OCTOMAP_RT_GRID.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "daemon/intake/scan_queue.h"
+#include "daemon/map/map_state.h"
+#include "daemon/queries/query_answers.h"
+#include "daemon/queries/query_clients.h"
+#include "daemon/queries/query_config.h"
+#include "daemon/serving/grid_publisher.h"
+#include "daemon/transport/lcm_loop.h"
+
+namespace ort::daemon {
+
+class QueryService {
+ public:
+  QueryService(const QueryServiceConfig& cfg, MapState& map, ScanQueue& scans, LcmLoop& loop, std::string server_id,
+               double resolution);
+  ~QueryService();
+  // Subscribes (call before the loop starts), then start() the worker (and the grid
+  // publisher); stop() joins them.
+  void open();
+  void start();
+  void stop();
+  std::vector<QueryClientStats> stats() const { return clients_.snapshot(); }
+  QueryServiceStats service_stats() const;
+
+ private:
+  template <class Message>
+  void on_query(const lcm::ReceiveBuffer& rb, std::string (*check)(const uint8_t*, size_t));
+  void on_edit(const lcm::ReceiveBuffer& rb);
+  // "" when client_id and reply_channel are usable for a reply.
+  std::string check_addressing(const std::string& client, const std::string& channel) const;
+  void run();
+  // Under the map lock (shared): true when answered or refused for good, its replies added to
+  // `out` (published after the lock is released); false: not ready yet, within its deadline.
+  bool answer_locked(PendingQuery& q, std::vector<EncodedReplies>& out);
+  void publish(const EncodedReplies& r);
+
+  QueryServiceConfig cfg_;
+  MapState& map_;
+  ScanQueue& scans_;
+  LcmLoop& loop_;
+  std::string server_id_;
+  double resolution_;
+  QueryClients clients_;
+  std::vector<LcmLoop::SubscriptionId> subs_;
+  std::thread worker_;
+  GridPublisher grids_;
+  std::mutex wake_mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;
+};
+
+}  // namespace ort::daemon

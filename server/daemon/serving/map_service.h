@@ -1,0 +1,89 @@
+// The map service: answers map_request_t on OCTOMAP_RT_MAP_REQUEST with the chunks of a
+// snapshot (or only the chunks named, for re-sends), paced so that a client with the
+// default socket receive buffer keeps up, and announces the map on OCTOMAP_RT_MAP_INFO at
+// 1 Hz and after each new snapshot (docs/PROTOCOL.md).
+//
+// Threads: its handler on the LCM loop only checks and queues a request (bounded; a flood
+// is counted as busy); the service's own thread takes snapshots (copy under the map lock,
+// serialize and compress outside it), sends the paced chunks and the info messages.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <ostream>
+#include <string>
+#include <thread>
+
+#include "daemon/map/map_state.h"
+#include "daemon/serving/map_request_rules.h"
+#include "daemon/serving/snapshot_store.h"
+#include "daemon/transport/lcm_loop.h"
+#include "octomap_rt/map_request_t.hpp"
+
+namespace ort::daemon {
+
+struct MapServiceConfig {
+  std::string request_channel = "OCTOMAP_RT_MAP_REQUEST";
+  std::string info_channel = "OCTOMAP_RT_MAP_INFO";
+  SnapshotPolicy snapshots;
+  double chunk_interval_ms = 1.5;  // between two chunks sent (pacing)
+  double info_period_s = 1.0;
+  size_t request_queue = 32;  // requests waiting; more are refused as busy
+  std::string server_id, map_frame = "map";
+  double resolution = 0;
+  double region_min[3] = {0, 0, 0}, region_max[3] = {0, 0, 0};  // set by the server
+};
+
+struct MapServiceStats {
+  int64_t requests_served = 0, requests_rejected = 0, snapshots_taken = 0, chunks_sent = 0;
+  int64_t latest_snapshot_id = -1;
+  std::array<int64_t, kRequestRefusalCount> refusals{};
+  double last_copy_lock_ms = 0, max_copy_lock_ms = 0, last_serialize_ms = 0, last_compress_ms = 0;
+  int64_t last_raw_size = 0, last_size = 0;
+};
+
+class MapService {
+ public:
+  // `last_delta_seq` (may be empty) tells map_info_t the newest delta sent.
+  MapService(LcmLoop& loop, MapState& map, MapServiceConfig cfg, std::function<int64_t()> last_delta_seq,
+             std::ostream& log);
+  ~MapService();
+  MapService(const MapService&) = delete;
+  MapService& operator=(const MapService&) = delete;
+
+  void open();   // subscribes on the loop (before it starts)
+  void start();  // the service's thread
+  void stop();   // unsubscribes, ends the thread (queued requests are dropped). Idempotent.
+  MapServiceStats stats() const;
+
+ private:
+  void on_request(const lcm::ReceiveBuffer& rbuf);
+  void run();
+  void serve(const octomap_rt::map_request_t& req);
+  void refuse(const octomap_rt::map_request_t* req, RequestRefusal why, const std::string& detail);
+  void send_chunks(const octomap_rt::map_request_t& req, const SnapshotBlob& blob);
+  void publish_info();
+  void note_blob(const SnapshotBlob& b);
+
+  LcmLoop& loop_;
+  MapState& map_;
+  MapServiceConfig cfg_;
+  std::function<int64_t()> last_delta_seq_;
+  std::ostream& log_;
+  SnapshotStore store_;
+  LcmLoop::SubscriptionId sub_ = 0;
+
+  mutable std::mutex mutex_;  // queue_, stop_, stats_
+  std::condition_variable cv_;
+  std::deque<octomap_rt::map_request_t> queue_;
+  bool stop_ = false;
+  MapServiceStats stats_;
+  std::thread thread_;
+};
+
+}  // namespace ort::daemon

@@ -1,0 +1,76 @@
+#include "daemon/serving/octomap_raw_publisher.h"
+
+#include <fstream>
+
+#include "daemon/serving/map_snapshot.h"
+#include "daemon/serving/octomap_raw_map.h"
+
+namespace ort::daemon {
+
+size_t octomap_raw_default_cap() {
+  std::ifstream in("/proc/sys/net/core/rmem_default");
+  size_t rmem_default = 0;
+  if (!(in >> rmem_default) || rmem_default == 0) return 190 * 1024;
+  return rmem_default / 10 * 9;
+}
+
+OctomapRawPublisher::OctomapRawPublisher(const OctomapRawConfig& cfg, MapState& map, LcmLoop& loop, std::ostream& log)
+    : cfg_(cfg), map_(map), loop_(loop), log_(log) {
+  if (cfg_.max_bytes == 0) cfg_.max_bytes = octomap_raw_default_cap();
+}
+
+OctomapRawPublisher::~OctomapRawPublisher() { stop(); }
+
+void OctomapRawPublisher::start() {
+  if (cfg_.rate_hz <= 0 || thread_.joinable()) return;
+  log_ << "octomap-rt-server: publishing the map as octomap.raw_t on " << cfg_.channel << " at " << cfg_.rate_hz
+       << " Hz (cap " << cfg_.max_bytes / 1024 << " KiB)\n";
+  thread_ = std::thread([this] { run(); });
+}
+
+void OctomapRawPublisher::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+std::string OctomapRawPublisher::note() const {
+  std::lock_guard lock(note_mutex_);
+  return note_;
+}
+
+void OctomapRawPublisher::encode_if_changed() {
+  auto copy = copy_map_if_changed(map_, encoded_version_);
+  if (!copy) return;
+  encoded_version_ = copy->version;
+  const RawMap raw = make_raw_map(*copy->tree, copy->last_scan_utime, RawMapOptions{cfg_.max_bytes, cfg_.min_depth});
+  encoded_.clear();
+  if (raw.message) {
+    encoded_.resize(static_cast<size_t>(raw.message->getEncodedSize()));
+    raw.message->encode(encoded_.data(), 0, static_cast<int>(encoded_.size()));
+  }
+  std::lock_guard lock(note_mutex_);
+  if (raw.note != note_ && !raw.note.empty()) log_ << "octomap-rt-server: " << raw.note << "\n";
+  note_ = raw.note;
+}
+
+void OctomapRawPublisher::run() {
+  const auto period = std::chrono::duration<double>(1.0 / cfg_.rate_hz);
+  std::unique_lock lock(mutex_);
+  while (!stop_) {
+    lock.unlock();
+    try {
+      encode_if_changed();
+      if (!encoded_.empty() && loop_.publish(cfg_.channel, encoded_.data(), encoded_.size()) == 0) ++published_;
+    } catch (const std::exception& e) {  // a failed encoding must not end the server
+      log_ << "octomap-rt-server: " << cfg_.channel << " not published: " << e.what() << "\n";
+    }
+    lock.lock();
+    wake_.wait_for(lock, period, [&] { return stop_; });
+  }
+}
+
+}  // namespace ort::daemon

@@ -1,0 +1,62 @@
+// Publishes the map as `octomap.raw_t` on OCTOMAP (--octomap-raw-rate HZ, off by default),
+// for the viewers LCM users already run (libbot's octomap renderer, Director's vtkOctomap,
+// lcmoctomap.py). A thread of its own: every period it copies the map if it changed (under
+// the map lock, as saves do), encodes it outside the lock within the size cap (see
+// octomap_raw_map.h), and publishes the newest encoding, so a viewer that starts later still
+// gets the map at the next period.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <mutex>
+#include <ostream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "daemon/map/map_state.h"
+#include "daemon/server_config.h"
+#include "daemon/transport/lcm_loop.h"
+
+namespace ort::daemon {
+
+// 90 % of net.core.rmem_default: a receiver that keeps the default UDP buffer (Java's LCM
+// cannot raise it; most C programs don't) gets a message only if all of its fragments fit
+// at once (measured: 3 datagrams of 65 KB fit in the default 208 KiB, a 4th is dropped).
+// 190 KiB when rmem_default cannot be read.
+size_t octomap_raw_default_cap();
+
+class OctomapRawPublisher {
+ public:
+  OctomapRawPublisher(const OctomapRawConfig& cfg, MapState& map, LcmLoop& loop, std::ostream& log);
+  ~OctomapRawPublisher();
+  OctomapRawPublisher(const OctomapRawPublisher&) = delete;
+  OctomapRawPublisher& operator=(const OctomapRawPublisher&) = delete;
+
+  void start();
+  void stop();  // idempotent
+  // For the status: "" while the whole map goes out; else what was cut or why nothing is sent.
+  std::string note() const;
+  int64_t published() const { return published_; }
+
+ private:
+  void run();
+  void encode_if_changed();
+
+  OctomapRawConfig cfg_;
+  MapState& map_;
+  LcmLoop& loop_;
+  std::ostream& log_;
+  std::thread thread_;
+  std::mutex mutex_;  // stop_
+  std::condition_variable wake_;
+  bool stop_ = false;
+  uint64_t encoded_version_ = UINT64_MAX;
+  std::vector<uint8_t> encoded_;  // newest message; empty when the map is too large
+  mutable std::mutex note_mutex_;
+  std::string note_;
+  std::atomic<int64_t> published_{0};
+};
+
+}  // namespace ort::daemon

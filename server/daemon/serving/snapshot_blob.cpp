@@ -1,0 +1,70 @@
+#include "daemon/serving/snapshot_blob.h"
+
+#include <chrono>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/clock.h"
+#include "daemon/persistence/map_store.h"
+#include "octomap_rt/map_chunk_t.hpp"
+#include "protocol/map_protocol.h"
+#include "protocol/zstd_codec.h"
+
+namespace ort::daemon {
+namespace {
+
+using Chunk = octomap_rt::map_chunk_t;
+
+std::string serialize(const octomap::OcTree& tree, int8_t format) {
+  if (format == Chunk::FORMAT_OCTOMAP_FULL) return serialize_map(tree);
+  if (format != Chunk::FORMAT_OCTOMAP_BINARY) throw std::invalid_argument("unknown snapshot format");
+  // OcTree::writeBinary (what OctoMap's .bt files are) first turns the tree to maximum
+  // likelihood and prunes it: do that on a copy, the served copy stays as it is.
+  octomap::OcTree ml(tree);
+  std::ostringstream out;
+  ml.writeBinary(out);
+  return std::move(out).str();
+}
+
+}  // namespace
+
+SnapshotContents describe_snapshot(const octomap::OcTree& tree, const std::vector<AppliedEntry>& order) {
+  SnapshotContents c;
+  c.scans = order.size();
+  std::map<std::string, int64_t> last;
+  for (const AppliedEntry& e : order) {
+    last[e.robot_id] = e.seq;
+    c.map_utime = std::max(c.map_utime, e.utime);
+  }
+  c.producer_last_seq.assign(last.begin(), last.end());
+  if (tree.size() > 0) {
+    tree.getMetricMin(c.bbox_min[0], c.bbox_min[1], c.bbox_min[2]);
+    tree.getMetricMax(c.bbox_max[0], c.bbox_max[1], c.bbox_max[2]);
+  }
+  return c;
+}
+
+SnapshotBlob make_snapshot_blob(const octomap::OcTree& tree, const SnapshotContents& contents, int8_t format,
+                                int zstd_level) {
+  SnapshotBlob b;
+  b.contents = contents;
+  b.format = format;
+  auto t0 = std::chrono::steady_clock::now();
+  std::string raw = serialize(tree, format);
+  b.serialize_ms = ms_since(t0);
+  b.raw_size = static_cast<int64_t>(raw.size());
+  t0 = std::chrono::steady_clock::now();
+  if (zstd_level > 0) {
+    b.bytes = protocol::zstd_compress(raw, zstd_level);
+    b.compression = Chunk::COMPRESSION_ZSTD;
+  } else {
+    b.bytes = std::move(raw);
+    b.compression = Chunk::COMPRESSION_NONE;
+  }
+  b.compress_ms = ms_since(t0);
+  b.hash = protocol::blob_hash(b.bytes.data(), b.bytes.size());
+  return b;
+}
+
+}  // namespace ort::daemon

@@ -1,0 +1,50 @@
+// One served snapshot in one format: the map copy serialized (.ot or .bt), compressed with
+// zstd, hashed, with what it contains (map state id, scans, newest seq per producer).
+// Built outside the map lock from a MapCopy, so mapping goes on meanwhile.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "daemon/persistence/applied_order.h"
+
+namespace ort::daemon {
+
+struct SnapshotContents {
+  uint64_t snapshot_id = 0;  // map state id of the copy
+  size_t scans = 0;
+  int64_t map_utime = 0;
+  double bbox_min[3] = {0, 0, 0}, bbox_max[3] = {0, 0, 0};
+  std::vector<std::pair<std::string, int64_t>> producer_last_seq;  // robot id, newest seq in it
+  double copy_lock_ms = 0;                                         // how long taking the copy held the map lock
+};
+
+struct SnapshotBlob {
+  SnapshotContents contents;
+  int8_t format = 0;       // map_chunk_t::FORMAT_*
+  int8_t compression = 0;  // map_chunk_t::COMPRESSION_*
+  int64_t raw_size = 0;
+  std::string bytes;  // compressed
+  int64_t hash = 0;   // protocol::blob_hash(bytes)
+  double serialize_ms = 0, compress_ms = 0;
+  int32_t num_chunks(size_t chunk_bytes) const {
+    return static_cast<int32_t>((bytes.size() + chunk_bytes - 1) / chunk_bytes);
+  }
+};
+
+// What a copy at `scans` applied scans contains: bbox and each producer's newest seq.
+SnapshotContents describe_snapshot(const octomap::OcTree& tree, const std::vector<AppliedEntry>& order);
+
+// Serializes `tree` (FORMAT_OCTOMAP_FULL: AbstractOcTree::write; FORMAT_OCTOMAP_BINARY:
+// OcTree::writeBinary as OctoMap's own .bt, i.e. of a max-likelihood pruned copy) and
+// compresses it at `zstd_level` (0: no compression). Throws std::invalid_argument on an
+// unknown format.
+SnapshotBlob make_snapshot_blob(const octomap::OcTree& tree, const SnapshotContents& contents, int8_t format,
+                                int zstd_level);
+
+}  // namespace ort::daemon

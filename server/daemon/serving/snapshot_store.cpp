@@ -1,0 +1,66 @@
+#include "daemon/serving/snapshot_store.h"
+
+#include <stdexcept>
+#include <thread>
+
+#include "daemon/serving/map_snapshot.h"
+
+namespace ort::daemon {
+
+std::shared_ptr<const SnapshotBlob> SnapshotStore::latest(MapState& map, int8_t format, bool fresh, bool& took_new) {
+  took_new = false;
+  const auto min_interval = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(policy_.min_interval_s));
+  if (fresh && !kept_.empty()) std::this_thread::sleep_until(taken_at_ + min_interval);
+  const auto now = std::chrono::steady_clock::now();
+  const bool old_enough = kept_.empty() || now - taken_at_ >= min_interval;
+  if (old_enough) {
+    uint64_t version;
+    {
+      std::lock_guard lock(map.mutex);
+      version = map.version;
+    }
+    if (kept_.empty() || version != kept_.back().contents.snapshot_id) {
+      take(map);
+      took_new = true;
+    }
+  }
+  return blob_of(kept_.back(), format);
+}
+
+std::shared_ptr<const SnapshotBlob> SnapshotStore::find(uint64_t id, int8_t format) {
+  for (Entry& e : kept_)
+    if (e.contents.snapshot_id == id) {
+      if (e.blob[format] || e.tree) return blob_of(e, format);
+      return nullptr;  // an older snapshot never made in this format
+    }
+  return nullptr;
+}
+
+void SnapshotStore::take(MapState& map) {
+  MapCopy copy = copy_map(map);
+  Entry e;
+  e.contents = describe_snapshot(*copy.tree, map.order.entries(copy.scans));
+  e.contents.snapshot_id = copy.version;
+  e.contents.copy_lock_ms = copy.lock_ms;
+  e.tree = std::move(copy.tree);
+  if (!kept_.empty()) kept_.back().tree.reset();
+  kept_.push_back(std::move(e));
+  while (kept_.size() > std::max<size_t>(policy_.kept, 1)) kept_.pop_front();
+  taken_at_ = std::chrono::steady_clock::now();
+  latest_id_ = static_cast<int64_t>(kept_.back().contents.snapshot_id);
+  taken_++;
+}
+
+std::shared_ptr<const SnapshotBlob> SnapshotStore::blob_of(Entry& e, int8_t format) {
+  if (format < 1 || format > 2) throw std::invalid_argument("unknown snapshot format");
+  if (!e.blob[format]) {
+    if (!e.tree) return nullptr;
+    e.blob[format] =
+        std::make_shared<const SnapshotBlob>(make_snapshot_blob(*e.tree, e.contents, format, policy_.zstd_level));
+    last_made_ = e.blob[format];
+  }
+  return e.blob[format];
+}
+
+}  // namespace ort::daemon

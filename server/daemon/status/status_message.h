@@ -1,0 +1,43 @@
+// Assembles the server_status_t heartbeat from plain values the server gathers.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "daemon/intake/producer_registry.h"
+#include "daemon/pipeline/pipeline_metrics.h"
+#include "daemon/queries/query_clients.h"
+#include "octomap_rt/server_status_t.hpp"
+
+namespace ort::daemon {
+
+struct StatusInputs {
+  int64_t utime = 0, seq = 0, start_utime = 0;
+  int32_t pid = 0;
+  double uptime_s = 0;
+  int8_t state = octomap_rt::server_status_t::STATE_STARTING;
+  std::string message;
+  std::string server_id, host, backend, device, map_path, queue_policy;
+  bool pipelined = true;
+  double resolution = 0;
+  int64_t num_nodes = 0, num_leaf_nodes = 0, memory_bytes = 0;
+  int32_t queue_depth = 0, shot_depth = 0;
+  int64_t queue_bytes = 0, queue_budget_bytes = 0;
+  int64_t kernel_rcvbuf_errors = -1, socket_rcvbuf_drops = -1;
+  int64_t map_saves = 0, last_save_utime = 0;
+  int64_t map_version = 0, latest_snapshot_id = 0, requests_served = 0, requests_rejected = 0;
+  int64_t snapshots_taken = 0, chunks_sent = 0, deltas_sent = 0, last_delta_seq = -1;
+  MetricsSnapshot metrics;
+  std::vector<ProducerStats> producers;
+  std::vector<int64_t> producer_queue_bytes;  // parallel to producers
+  QueryServiceStats queries;
+};
+
+// Clients listed in server_status_t.query_clients (those heard from most recently); the
+// totals count every client.
+constexpr size_t kStatusQueryClients = 64;
+
+octomap_rt::server_status_t make_status(const StatusInputs& in);
+
+}  // namespace ort::daemon
