@@ -7,6 +7,7 @@ repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 packages=(cmake ninja-build g++ pkg-config
   liblcm-dev liblcm-bin liblcm-java default-jdk-headless libjchart2d-java
   liboctomap-dev libeigen3-dev libvulkan-dev mesa-vulkan-drivers glslang-tools
+  libdynamicedt3d-dev  # OctoMap's DynamicEDTOctomap: the distance tests compare with it (tests/distance)
   libjemalloc-dev libzstd-dev libgtest-dev libcli11-dev libpng-dev iproute2 bzip2 gnuplot-nox
   python3 python3-numpy python3-zstandard  # the Python client and its tests (client/python, tests/python)
   default-jre xvfb xdotool   # lcm-spy needs a JRE with AWT (not headless); Xvfb+xdotool: docs/lcm-spy.png

@@ -1,0 +1,78 @@
+// The distance transform against OctoMap's own DynamicEDTOctomap (libdynamicedt3d-dev
+// 1.9.7) on real maps. Where the definitions agree: DynamicEDTOctomap sees only the
+// obstacles inside its bounding box, so it is given our padded grid as its box and compared
+// on the requested cells; it clamps at (int(max / resolution) + 1) cells, we at max_distance,
+// so below our clamp the squared distances must be equal, above it theirs must be above too.
+#include <gtest/gtest.h>
+
+#include <dynamicEDT3D/dynamicEDTOctomap.h>
+
+#include <cmath>
+#include <random>
+
+#include "distance/distance_queries.h"
+#include "distance/squared_edt.h"
+#include "query/query_test_maps.h"
+
+namespace ort::test {
+namespace {
+
+TEST(DistanceAgainstDynamicEDT, EqualSquaredDistancesInsideItsBox) {
+  std::mt19937 rng(1927);
+  int64_t compared = 0, differ = 0;
+  for (const NamedMap& map : query_test_maps()) {
+    SCOPED_TRACE(map.name);
+    octomap::OcTree tree(*map.tree);  // DynamicEDTOctomap turns on the tree's change detection
+    const double res = tree.getResolution();
+    std::vector<octomap::OcTreeKey> keys;
+    for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it)
+      if (tree.isNodeOccupied(*it)) keys.push_back(it.getKey());
+    for (distance::UnknownAs unknown : {distance::UnknownAs::kFree, distance::UnknownAs::kOccupied})
+      for (int b = 0; b < 2; ++b) {
+        const auto key = keys[std::uniform_int_distribution<size_t>(0, keys.size() - 1)(rng)];
+        distance::DistanceOptions opt;
+        opt.max_distance = 5.45 * res, opt.unknown = unknown;
+        double lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = tree.keyToCoord(octomap::key_type(key[a] - 10));
+          hi[a] = tree.keyToCoord(octomap::key_type(key[a] + 10));
+        }
+        const distance::BoxRead read = distance::read_box(tree, lo, hi, opt, {});
+        const distance::BoxDistances ours = distance::answer_box(read, distance::cpu_edt(2), false);
+        // Their box: our padded grid, corners at voxel centres.
+        const auto& g = read.grid.box;
+        const int n[3] = {g.dims.nx, g.dims.ny, g.dims.nz};
+        octomap::point3d bmin, bmax;
+        for (int a = 0; a < 3; ++a) {
+          bmin(a) = float(tree.keyToCoord(octomap::key_type(g.key_lo[a])));
+          bmax(a) = float(tree.keyToCoord(octomap::key_type(g.key_lo[a] + n[a] - 1)));
+        }
+        DynamicEDTOctomap edt(float(opt.max_distance), &tree, bmin, bmax, unknown == distance::UnknownAs::kOccupied);
+        edt.update();
+        const int theirs_clamp = edt.getSquaredMaxDistCells();
+        const double our_clamp_sq = (opt.max_distance / res) * (opt.max_distance / res);
+        size_t c = 0;
+        const auto& d = ours.cells.dims;
+        for (int k = 0; k < d.nz; ++k)
+          for (int j = 0; j < d.ny; ++j)
+            for (int i = 0; i < d.nx; ++i, ++c) {
+              const octomap::point3d p(float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[0] + i))),
+                                       float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[1] + j))),
+                                       float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[2] + k))));
+              const int theirs = edt.getSquaredDistanceInCells(p);
+              ++compared;
+              const bool agree = ours.squared[c] == distance::kNoObstacle
+                                     ? theirs > our_clamp_sq || theirs == theirs_clamp
+                                     : int64_t(ours.squared[c]) == theirs;
+              if (!agree && ++differ < 10)
+                ADD_FAILURE() << "cell " << i << "," << j << "," << k << ": ours " << ours.squared[c] << ", theirs "
+                              << theirs;
+            }
+      }
+  }
+  EXPECT_EQ(differ, 0) << "of " << compared;
+  EXPECT_GT(compared, 50000);
+}
+
+}  // namespace
+}  // namespace ort::test
