@@ -13,3 +13,7 @@ octomap_rt_add_test(octree_test
           ${CMAKE_CURRENT_LIST_DIR}/worker_pool_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp
   TIMEOUT 900)
+
+# Regions, the subtrees at one depth that decay, clearing and eviction work on (octree/region.h),
+# against OctoMap's own leaf iterator on its real FR-079 map.
+octomap_rt_add_test(region_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/region_test.cpp TIMEOUT 120)
