@@ -6,3 +6,6 @@ octomap_rt_embed_shader(shoot_exact.comp shoot_exact_spv)
 octomap_rt_embed_shader(compact_touched.comp compact_touched_spv)
 octomap_rt_embed_shader(prepare_rays.comp prepare_rays_spv)
 include(${CMAKE_CURRENT_LIST_DIR}/rt_shaders.cmake OPTIONAL)
+# The exact distance transform's passes (server/gpu/distance_transform.cpp).
+octomap_rt_embed_shader(edt_rows.comp edt_rows_spv)
+octomap_rt_embed_shader(edt_envelope.comp edt_envelope_spv)

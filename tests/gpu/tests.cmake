@@ -27,3 +27,8 @@ add_dependencies(gpu_rt_cli_test octomap-rt)
 # GPU scan preparation (issue 12) against the CPU's, bit for bit.
 octomap_rt_add_test(gpu_prepare_test SOURCES ${GPU_TEST_DIR}/gpu_prepare_test.cpp
                     LIBS octomap_rt_gpu_test_support TIMEOUT 600)
+
+# The Vulkan distance transform (issue 27) against the CPU one, bit for bit.
+octomap_rt_add_test(gpu_distance_test SOURCES ${GPU_TEST_DIR}/gpu_distance_test.cpp
+                    ${CMAKE_CURRENT_SOURCE_DIR}/query/query_test_maps.cpp
+                    LIBS octomap_rt_gpu octomap_rt_distance TIMEOUT 600)
