@@ -4,27 +4,25 @@
 #include <stdexcept>
 #include <string>
 
-#include "octree/node_access.h"
-
 namespace ort {
 namespace {
 
 // Post-order decay of `node`'s subtree; true when the caller must delete `node` (a leaf
 // below the threshold, or an inner node left without children).
 bool decay_node(octomap::OcTree& tree, octomap::OcTreeNode* node, unsigned depth, const DecayRule& rule,
-                DecayStats& st) {
-  ++st.nodes_visited;
+                uint64_t& visited, uint64_t& decayed, uint64_t& deleted) {
+  ++visited;
   if (!tree.nodeHasChildren(node)) {
-    ++st.leaves_decayed;
+    ++decayed;
     const float l = node->getLogOdds() * rule.factor;
     node->setLogOdds(l);
     return std::fabs(l) < rule.delete_below;
   }
   for (unsigned i = 0; i < 8; ++i) {
     if (!tree.nodeChildExists(node, i)) continue;
-    if (decay_node(tree, tree.getNodeChild(node, i), depth + 1, rule, st)) {
+    if (decay_node(tree, tree.getNodeChild(node, i), depth + 1, rule, visited, decayed, deleted)) {
       delete_subtree(tree, node, i);
-      ++st.nodes_deleted;
+      ++deleted;
     }
   }
   if (!tree.nodeHasChildren(node)) {
@@ -34,20 +32,6 @@ bool decay_node(octomap::OcTree& tree, octomap::OcTreeNode* node, unsigned depth
   node->updateOccupancyChildren();
   if (depth > 0) tree.pruneNode(node);  // OctoMap's prune() never prunes the root
   return false;
-}
-
-// The nodes above the region depth, post-order: inner values, then OctoMap's prune.
-void settle_top(octomap::OcTree& tree, octomap::OcTreeNode* node, unsigned depth, unsigned region_depth) {
-  if (depth >= region_depth || !tree.nodeHasChildren(node)) return;
-  for (unsigned i = 0; i < 8; ++i)
-    if (tree.nodeChildExists(node, i)) settle_top(tree, tree.getNodeChild(node, i), depth + 1, region_depth);
-  node->updateOccupancyChildren();
-  if (depth > 0) tree.pruneNode(node);
-}
-
-unsigned child_index_at(const octomap::OcTreeKey& key, unsigned depth) {
-  const unsigned bit = 15 - depth;
-  return ((key[0] >> bit) & 1) | ((key[1] >> bit) & 1) << 1 | ((key[2] >> bit) & 1) << 2;
 }
 
 }  // namespace
@@ -60,82 +44,24 @@ float decay_factor(double step_s, double half_life_s) {
   return static_cast<float>(std::exp2(-step_s / half_life_s));
 }
 
-void free_empty_child_array(octomap::OcTreeNode* node) {
-  octomap::AbstractOcTreeNode**& children = detail::ChildArrayAccess::of(*node);
-  if (children == nullptr) return;
-  for (unsigned i = 0; i < 8; ++i)
-    if (children[i] != nullptr) return;
-  delete[] children;
-  children = nullptr;
-}
-
-void delete_subtree(octomap::OcTree& tree, octomap::OcTreeNode* parent, unsigned i) {
-  octomap::OcTreeNode* child = tree.getNodeChild(parent, i);
-  octomap::AbstractOcTreeNode**& children = detail::ChildArrayAccess::of(*child);
-  if (children != nullptr) {
-    for (unsigned c = 0; c < 8; ++c)
-      if (children[c] != nullptr) delete_subtree(tree, child, c);
-    delete[] children;
-    children = nullptr;
-  }
-  tree.deleteNodeChild(parent, i);  // the node itself, counted
-}
-
 DecaySweep::DecaySweep(const octomap::OcTree& tree, const RegionGrid& grid, const DecayRule& rule)
-    : grid_(grid), rule_(rule) {
-  for_each_region(tree, grid, [&](RegionId id, const RegionNode& r) {
-    octomap::OcTreeKey k = region_min_key(grid, id);
-    const uint16_t mask = r.depth == 0 ? 0 : static_cast<uint16_t>(~((1u << (16 - r.depth)) - 1));
-    for (unsigned a = 0; a < 3; ++a) k[a] = static_cast<uint16_t>(k[a] & mask);
-    units_.push_back(Unit{k, r.depth});
-  });
-}
-
-void DecaySweep::decay_unit(octomap::OcTree& tree, const Unit& unit) {
-  octomap::OcTreeNode* root = tree.getRoot();
-  if (root == nullptr) return;
-  octomap::OcTreeNode* path[17];
-  unsigned index[17];
-  path[0] = root;
-  unsigned depth = 0;
-  for (; depth < unit.depth; ++depth) {
-    octomap::OcTreeNode* node = path[depth];
-    if (!tree.nodeHasChildren(node)) return;  // merged into a coarser leaf since the listing
-    const unsigned i = child_index_at(unit.min_key, depth);
-    if (!tree.nodeChildExists(node, i)) return;  // deleted since
-    index[depth + 1] = i;
-    path[depth + 1] = tree.getNodeChild(node, i);
-  }
-  ++stats_.regions;
-  if (!decay_node(tree, path[depth], depth, rule_, stats_)) {
-    for (unsigned d = depth; d-- > 0;) path[d]->updateOccupancyChildren();
-    return;
-  }
-  // The unit's node goes, and every ancestor it leaves without children.
-  while (depth > 0) {
-    delete_subtree(tree, path[depth - 1], index[depth]);
-    ++stats_.nodes_deleted;
-    --depth;
-    if (tree.nodeHasChildren(path[depth])) {
-      for (unsigned d = depth + 1; d-- > 0;) path[d]->updateOccupancyChildren();
-      return;
-    }
-    free_empty_child_array(path[depth]);
-  }
-  tree.clear();  // nothing left: the root goes too (an empty tree, as OctoMap's after clear())
-}
+    : sweep_(tree, grid), rule_(rule) {}
 
 bool DecaySweep::run_slice(octomap::OcTree& tree, uint64_t node_budget) {
-  if (finished_) return true;
-  const uint64_t start = stats_.nodes_visited;
-  do {
-    if (next_ == units_.size()) break;
-    decay_unit(tree, units_[next_++]);
-  } while (stats_.nodes_visited - start < node_budget);
-  if (next_ < units_.size()) return false;
-  if (octomap::OcTreeNode* root = tree.getRoot()) settle_top(tree, root, 0, grid_.depth);
-  finished_ = true;
-  return true;
+  return sweep_.run_slice(tree, node_budget,
+                          [this](octomap::OcTree& t, octomap::OcTreeNode* node, unsigned depth,
+                                 const octomap::OcTreeKey&, uint64_t& visited) {
+                            return decay_node(t, node, depth, rule_, visited, leaves_decayed_, leaves_deleted_);
+                          });
+}
+
+DecayStats DecaySweep::stats() const {
+  DecayStats st;
+  st.nodes_visited = sweep_.nodes_visited();
+  st.leaves_decayed = leaves_decayed_;
+  st.nodes_deleted = leaves_deleted_ + sweep_.nodes_deleted();
+  st.regions = sweep_.regions_visited();
+  return st;
 }
 
 DecayStats decay_tree(octomap::OcTree& tree, const RegionGrid& grid, const DecayRule& rule) {

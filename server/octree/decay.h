@@ -14,25 +14,17 @@
 // and order-free, and the result is what OctoMap's own tree would hold after setting every
 // leaf, updateInnerOccupancy() and prune() (the test builds it that way).
 //
-// A sweep applies one step region by region (octree/region.h) in slices of bounded work, so
-// a caller holding the map lock per slice never stalls for a time that grows with the map.
-// Between slices other updates may run; the regions of a sweep are listed when it starts,
-// and each is decayed once by it:
-// - a region a later update expanded below a coarse leaf is decayed whole (the space once);
-// - a region that a later update merged into a coarser leaf is skipped by this sweep (the
-//   update wrote that leaf's value after the sweep began);
-// - space first stored after the sweep began waits for the next sweep.
-// Nodes above the region depth are pruned at the end of the sweep, not per slice, so that
-// no slice merges a decayed region with one still to come.
+// A sweep applies one step region by region in slices of bounded work
+// (octree/region_sweep.h, which says what an update between two slices does to it).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <vector>
 
 #include <octomap/OcTree.h>
 
 #include "octree/region.h"
+#include "octree/region_sweep.h"
 
 namespace ort {
 
@@ -53,40 +45,19 @@ struct DecayStats {
   uint64_t regions = 0;        // regions decayed
 };
 
-// Deletes child `i` of `parent` and its whole subtree, freeing every node and child array,
-// with the tree's node counter kept. The parent's own child array stays (even if empty).
-void delete_subtree(octomap::OcTree& tree, octomap::OcTreeNode* parent, unsigned i);
-
-// Frees `node`'s child array when no child is left in it (OctoMap's destructor asserts it is
-// gone; its own deleteNode leaves it behind).
-void free_empty_child_array(octomap::OcTreeNode* node);
-
+// One step as a sweep in slices.
 class DecaySweep {
  public:
-  // Lists the regions of `tree` to decay by `rule`.
   DecaySweep(const octomap::OcTree& tree, const RegionGrid& grid, const DecayRule& rule);
-
-  // Decays listed regions until `node_budget` nodes were visited (at least one region) or
-  // none is left; then, once, prunes the nodes above the region depth. True when the sweep
-  // is done. The tree must be the one listed (changed by other updates in between is fine).
+  // RegionSweep::run_slice with the decay: true when the step is done.
   bool run_slice(octomap::OcTree& tree, uint64_t node_budget);
-  bool done() const { return finished_; }
-  const DecayStats& stats() const { return stats_; }
-  size_t regions_left() const { return units_.size() - next_; }
+  bool done() const { return sweep_.done(); }
+  DecayStats stats() const;
 
  private:
-  struct Unit {
-    octomap::OcTreeKey min_key;
-    unsigned depth;
-  };
-  void decay_unit(octomap::OcTree& tree, const Unit& unit);
-
-  RegionGrid grid_;
+  RegionSweep sweep_;
   DecayRule rule_;
-  std::vector<Unit> units_;
-  size_t next_ = 0;
-  bool finished_ = false;
-  DecayStats stats_;
+  uint64_t leaves_decayed_ = 0, leaves_deleted_ = 0;
 };
 
 // One whole step at once (a sweep with no slice limit).

@@ -18,7 +18,10 @@ octomap_rt_add_test(octree_test
 # against OctoMap's own leaf iterator on its real FR-079 map.
 octomap_rt_add_test(region_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/region_test.cpp TIMEOUT 120)
 
-# Decay (octree/decay.h) against its rule computed on OctoMap's own tree: the real FR-079 map
-# and real scans with decay steps between them, whole sweeps and sweeps in slices.
-octomap_rt_add_test(decay_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/decay_test.cpp ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp
+# Forgetting: decay (octree/decay.h) and clearing by distance (octree/distance_clearing.h)
+# against their rules computed on OctoMap's own tree: the real FR-079 map and real scans with
+# decay steps between them, whole sweeps and sweeps in slices.
+octomap_rt_add_test(forgetting_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/decay_test.cpp ${CMAKE_CURRENT_LIST_DIR}/distance_clearing_test.cpp
+          ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp
   TIMEOUT 300)

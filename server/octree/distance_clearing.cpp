@@ -1,0 +1,78 @@
+#include "octree/distance_clearing.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace ort {
+
+DistanceClearingSweep::DistanceClearingSweep(const octomap::OcTree& tree, const RegionGrid& grid,
+                                             std::vector<octomap::point3d> centres, double radius)
+    : sweep_(tree, grid), centres_(std::move(centres)), radius_sq_(radius * radius) {
+  if (!std::isfinite(radius) || radius <= 0)
+    throw std::invalid_argument("clearing radius " + std::to_string(radius) + " m is not a positive number");
+}
+
+DistanceClearingSweep::Reach DistanceClearingSweep::reach(const octomap::OcTree& tree,
+                                                          const octomap::OcTreeKey& min_key, unsigned depth) const {
+  const double res = tree.getResolution();
+  const double size = res * double(1u << (16 - depth));
+  double lo[3], hi[3];
+  for (unsigned a = 0; a < 3; ++a) {
+    lo[a] = tree.keyToCoord(min_key[a]) - res / 2;
+    hi[a] = lo[a] + size;
+  }
+  bool beyond = true;
+  for (const octomap::point3d& c : centres_) {
+    double near_sq = 0, far_sq = 0;
+    for (unsigned a = 0; a < 3; ++a) {
+      const double p = c(a);
+      const double d_near = std::max({lo[a] - p, 0.0, p - hi[a]});
+      const double d_far = std::max(std::fabs(p - lo[a]), std::fabs(hi[a] - p));
+      near_sq += d_near * d_near;
+      far_sq += d_far * d_far;
+    }
+    if (far_sq <= radius_sq_) return Reach::kWithin;
+    if (near_sq <= radius_sq_) beyond = false;
+  }
+  return beyond ? Reach::kBeyond : Reach::kStraddles;
+}
+
+bool DistanceClearingSweep::visit(octomap::OcTree& tree, octomap::OcTreeNode* node, unsigned depth,
+                                  const octomap::OcTreeKey& min_key, uint64_t& visited) {
+  ++visited;
+  const Reach r = reach(tree, min_key, depth);
+  if (r == Reach::kBeyond) return true;
+  if (r == Reach::kWithin || !tree.nodeHasChildren(node)) return false;
+  for (unsigned i = 0; i < 8; ++i) {
+    if (!tree.nodeChildExists(node, i)) continue;
+    if (visit(tree, tree.getNodeChild(node, i), depth + 1, child_min_key(min_key, depth, i), visited)) {
+      delete_subtree(tree, node, i);
+      ++deleted_;
+    }
+  }
+  if (!tree.nodeHasChildren(node)) {
+    free_empty_child_array(node);
+    return true;
+  }
+  node->updateOccupancyChildren();
+  return false;
+}
+
+bool DistanceClearingSweep::run_slice(octomap::OcTree& tree, uint64_t node_budget) {
+  if (centres_.empty()) return true;  // no robot seen lately: nothing to clear
+  return sweep_.run_slice(
+      tree, node_budget,
+      [this](octomap::OcTree& t, octomap::OcTreeNode* node, unsigned depth, const octomap::OcTreeKey& min_key,
+             uint64_t& visited) { return visit(t, node, depth, min_key, visited); });
+}
+
+uint64_t clear_beyond(octomap::OcTree& tree, const RegionGrid& grid, std::vector<octomap::point3d> centres,
+                      double radius) {
+  DistanceClearingSweep sweep(tree, grid, std::move(centres), radius);
+  sweep.run_slice(tree, UINT64_MAX);
+  return sweep.nodes_deleted();
+}
+
+}  // namespace ort

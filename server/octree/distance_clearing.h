@@ -1,0 +1,47 @@
+// Clearing by distance (nvblox's map_clearing_radius_m habit): everything farther than a
+// radius from every one of a set of centres (the robots seen lately) is deleted and freed.
+// The rule: a stored leaf (finest or pruned) is deleted when its whole cube lies farther
+// than `radius` from every centre (Euclidean distance from the centre to the nearest point
+// of the cube); a leaf that reaches within the radius is kept whole. Inner nodes left
+// without children go too, the others hold the max of their children (OctoMap's
+// updateInnerOccupancy). No centre: nothing is cleared. Applied region by region in slices
+// (octree/region_sweep.h); whole regions wholly beyond the radius go in one step.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "octree/region.h"
+#include "octree/region_sweep.h"
+
+namespace ort {
+
+class DistanceClearingSweep {
+ public:
+  // Throws std::invalid_argument for a radius that is not a positive finite number.
+  DistanceClearingSweep(const octomap::OcTree& tree, const RegionGrid& grid, std::vector<octomap::point3d> centres,
+                        double radius);
+  bool run_slice(octomap::OcTree& tree, uint64_t node_budget);
+  bool done() const { return centres_.empty() || sweep_.done(); }
+  uint64_t nodes_deleted() const { return deleted_ + sweep_.nodes_deleted(); }
+  uint64_t nodes_visited() const { return sweep_.nodes_visited(); }
+
+ private:
+  enum class Reach { kBeyond, kWithin, kStraddles };
+  Reach reach(const octomap::OcTree& tree, const octomap::OcTreeKey& min_key, unsigned depth) const;
+  bool visit(octomap::OcTree& tree, octomap::OcTreeNode* node, unsigned depth, const octomap::OcTreeKey& min_key,
+             uint64_t& visited);
+
+  RegionSweep sweep_;
+  std::vector<octomap::point3d> centres_;
+  double radius_sq_;
+  uint64_t deleted_ = 0;
+};
+
+// The whole clearing at once.
+uint64_t clear_beyond(octomap::OcTree& tree, const RegionGrid& grid, std::vector<octomap::point3d> centres,
+                      double radius);
+
+}  // namespace ort

@@ -1,0 +1,72 @@
+// A sweep over a tree's regions in slices of bounded work: the regions are listed when the
+// sweep starts, and each slice visits listed regions until it has visited a node budget. A
+// caller holding the map lock per slice never stalls for a time that grows with the map.
+// Decay (octree/decay.h) and clearing by distance (octree/distance_clearing.h) run on it.
+//
+// Between slices other updates may run; each listed region is visited once:
+// - a region a later update expanded below a coarse leaf is visited whole (the space once);
+// - a region that a later update merged into a coarser leaf is skipped (that update wrote
+//   the leaf after the sweep began);
+// - space first stored after the sweep began waits for the next sweep.
+// The nodes above the region depth get their values (max of children) on the path of every
+// visited region; they are pruned only when the sweep ends, as OctoMap's prune() does (every
+// node but the root), so that no slice merges a visited region with one still to come.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "octree/region.h"
+
+namespace ort {
+
+// What a sweep does to one region: `node` at `depth` (the region's root, or a coarse leaf
+// above it) with its min-corner key. Changes the subtree below `node` (deleting children
+// with delete_subtree, keeping inner values and pruning below `node` consistent), returns
+// true when `node` itself must go. Adds the nodes it visited to `visited`.
+using RegionVisit = std::function<bool(octomap::OcTree& tree, octomap::OcTreeNode* node, unsigned depth,
+                                       const octomap::OcTreeKey& min_key, uint64_t& visited)>;
+
+// Deletes child `i` of `parent` and its whole subtree, freeing every node and child array,
+// with the tree's node counter kept. The parent's own child array stays (even if empty).
+void delete_subtree(octomap::OcTree& tree, octomap::OcTreeNode* parent, unsigned i);
+
+// Frees `node`'s child array when no child is left in it (OctoMap's destructor asserts it is
+// gone; its own deleteNode leaves it behind).
+void free_empty_child_array(octomap::OcTreeNode* node);
+
+// The min-corner key of child `i` of a node at `depth` whose min corner is `min_key`.
+octomap::OcTreeKey child_min_key(const octomap::OcTreeKey& min_key, unsigned depth, unsigned i);
+
+class RegionSweep {
+ public:
+  RegionSweep(const octomap::OcTree& tree, const RegionGrid& grid);
+
+  // Visits listed regions until `node_budget` nodes were visited (at least one region) or
+  // none is left; then, once, prunes the nodes above the region depth. True when done.
+  bool run_slice(octomap::OcTree& tree, uint64_t node_budget, const RegionVisit& visit);
+  bool done() const { return finished_; }
+  size_t regions_left() const { return units_.size() - next_; }
+  uint64_t nodes_visited() const { return visited_; }
+  uint64_t nodes_deleted() const { return deleted_; }  // region nodes and ancestors left empty
+  uint64_t regions_visited() const { return regions_; }
+
+ private:
+  struct Unit {
+    octomap::OcTreeKey min_key;
+    unsigned depth;
+  };
+  void visit_unit(octomap::OcTree& tree, const Unit& unit, const RegionVisit& visit);
+
+  RegionGrid grid_;
+  std::vector<Unit> units_;
+  size_t next_ = 0;
+  bool finished_ = false;
+  uint64_t visited_ = 0, deleted_ = 0, regions_ = 0;
+};
+
+}  // namespace ort
