@@ -135,6 +135,8 @@ void MappingServer::start() {
   pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, log_, cfg_.pipeline,
                                              std::chrono::duration<double>(cfg_.latency_bound_s));
   pipeline_->start();
+  upkeep_ = std::make_unique<MapUpkeep>(map_, cfg_.upkeep, log_to(log_));
+  upkeep_->start();
   intake_ =
       std::make_unique<ScanIntake>(*loop_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
   intake_->open();  // services subscribe before the loop starts: 1.3.1's subscribe races with handle
@@ -212,6 +214,7 @@ bool MappingServer::stop() {
   drain_until_deadline();
   pipeline_->join();
   pipeline_drained_ = true;
+  if (upkeep_) upkeep_->stop();  // ends a sweep at its current slice (the map stays whole)
   if (deltas_) deltas_->stop();  // sends the last change set
   map_.observer = nullptr;
   {

@@ -19,6 +19,7 @@
 #include "daemon/intake/scan_intake.h"
 #include "daemon/intake/scan_queue.h"
 #include "daemon/map/map_state.h"
+#include "daemon/map/map_upkeep.h"
 #include "daemon/pipeline/pipeline_metrics.h"
 #include "daemon/pipeline/scan_pipeline.h"
 #include "daemon/queries/query_service.h"
@@ -67,6 +68,8 @@ class MappingServer {
     return f(static_cast<const octomap::OcTree&>(*map_.tree));
   }
   const std::string& lcm_url() const { return url_; }
+  // Decay and clearing (null before start()); tests in manual mode step it through this.
+  MapUpkeep* upkeep() { return upkeep_.get(); }
   // The server's one LCM thread: services register their raw handlers on it before start().
   LcmLoop& lcm_loop() { return *loop_; }
   // Human-readable end-of-run summary (per producer, stage times, overlap, map, files).
@@ -98,6 +101,7 @@ class MappingServer {
   PipelineMetrics metrics_;
   std::unique_ptr<ScanIntake> intake_;
   std::unique_ptr<ScanPipeline> pipeline_;
+  std::unique_ptr<MapUpkeep> upkeep_;                   // decay, clearing by distance
   std::unique_ptr<QueryService> queries_;               // planners' queries and map edits
   std::unique_ptr<OctomapRawPublisher> raw_publisher_;  // the map for LCM viewers (off by default)
   std::unique_ptr<DeltaPublisher> deltas_;

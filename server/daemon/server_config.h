@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/map/map_upkeep.h"
 #include "daemon/queries/query_config.h"
 #include "engine/map_engine.h"
 #include "octomap_rt/wire_contract.hpp"
@@ -64,6 +65,8 @@ struct ServerConfig {
   double drain_timeout_s = 5.0;
   // DEGRADED when a pipeline stage has been on one scan for longer than this.
   double stuck_stage_s = 30.0;
+  // The long-lived map: decay, clearing by distance (daemon/map/map_upkeep.h).
+  UpkeepConfig upkeep;
 };
 
 struct ProducerPolicy;

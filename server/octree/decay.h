@@ -53,6 +53,7 @@ class DecaySweep {
   bool run_slice(octomap::OcTree& tree, uint64_t node_budget);
   bool done() const { return sweep_.done(); }
   DecayStats stats() const;
+  uint64_t nodes_deleted() const { return stats().nodes_deleted; }
 
  private:
   RegionSweep sweep_;

@@ -38,3 +38,6 @@ octomap_rt_add_test(server_query_status_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/q
 # look-up path, on the real data sets (issue 12).
 octomap_rt_add_test(server_delta_changes_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/delta_changes_test.cpp
                     LIBS octomap_rt_daemon TIMEOUT 600)
+# The long-lived map's upkeep in the daemon: decay steps and clearing passes between scans.
+octomap_rt_add_test(map_upkeep_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_upkeep_test.cpp ${SERVER_TEST_FIXTURES}
+                    LIBS octomap_rt_daemon TIMEOUT 120)

@@ -3,6 +3,7 @@
 // scans. Stage 2 holds the lock for one scan's octree update at a time.
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <map>
@@ -45,6 +46,15 @@ struct MapState {
   uint64_t version = 0;
   int64_t last_scan_utime = 0;            // utime of the newest applied scan
   MapChangeObserver* observer = nullptr;  // set before the pipeline starts
+  // Where each robot's newest applied scan was taken from and when it was applied (the
+  // daemon's steady clock): clearing by distance keeps what is near the robots seen lately
+  // (daemon/map/map_upkeep.h). At most kMaxRobotsSeen entries (the stalest goes first).
+  struct RobotSeen {
+    octomap::point3d origin;
+    std::chrono::steady_clock::time_point applied;
+  };
+  static constexpr size_t kMaxRobotsSeen = 256;
+  std::map<std::string, RobotSeen> robots_seen;
   // Newest applied seq per robot (lower-case id), for queries that wait for their own scan.
   std::map<std::string, int64_t> applied_seq;
   // Notified (without the lock held) after every applied scan or edit.

@@ -13,6 +13,15 @@ std::string lower_case(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
 }
+// Keeps the robots_seen table within its bound: the stalest robot goes first.
+void note_robot_seen(MapState& map, const std::string& robot, const octomap::point3d& origin) {
+  map.robots_seen[robot] = MapState::RobotSeen{origin, Clock::now()};
+  if (map.robots_seen.size() <= MapState::kMaxRobotsSeen) return;
+  auto stalest = map.robots_seen.begin();
+  for (auto it = map.robots_seen.begin(); it != map.robots_seen.end(); ++it)
+    if (it->second.applied < stalest->second.applied) stalest = it;
+  map.robots_seen.erase(stalest);
+}
 }  // namespace
 
 ScanPipeline::ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, ProducerRegistry& producers,
@@ -90,10 +99,12 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
       // straight into its upload buffer (transformed on the GPU where it can).
       const octomap::pose6d pose = scan_pose(item.msg);
       const std::span<const float> xyz(item.msg.xyz.data(), item.msg.xyz.size() - item.msg.xyz.size() % 3);
+      job.origin = pose.trans();
       engine_.shoot_posed_xyz(pose, pose.trans(), xyz, max_range, job.shot);
     } else {
       const PosedMessageScan scan = to_posed_scan(item.msg);
       const std::span<const octomap::point3d> pts(scan.points.size() ? &scan.points[0] : nullptr, scan.points.size());
+      job.origin = scan.origin;
       engine_.shoot(scan.origin, pts, max_range, job.shot);
     }
     if (!job.shot.prepare.origin_ok) {
@@ -157,7 +168,9 @@ void ScanPipeline::apply(ShotJob& job) {
     map_.last_scan_utime = std::max(map_.last_scan_utime, job.utime);
     const auto updated = Clock::now();
     if (map_.observer) map_.observer->applied(changes_, *map_.tree, map_.version);
-    map_.applied_seq[lower_case(job.robot_id)] = job.seq;
+    const std::string robot = lower_case(job.robot_id);
+    map_.applied_seq[robot] = job.seq;
+    note_robot_seen(map_, robot, job.origin);
     parts = {ms_between(t0, locked), ms_between(locked, updated), ms_between(updated, Clock::now())};
   } catch (const std::exception& e) {
     set_busy(1, false);

@@ -26,6 +26,7 @@ struct ShotJob {
   Clock::time_point shot_at;  // when stage 1 finished it
   ScanWaits waits;            // decode and queue wait so far; stage 2 adds its hand-off wait
   double shoot_ms = 0;
+  octomap::point3d origin;  // the sensor's, in the map frame
   ShotScan shot;
   std::shared_ptr<MapEditItem> edit;  // set: apply this edit instead of a scan
 };
