@@ -2,7 +2,8 @@
 // point. The same steps as the CPU's (server/engine/map_frame.h + prepare_scan.cpp), with
 // OctoMap's float arithmetic, so every ray end is the CPU's bit for bit:
 //   Pose6D::transform (quaternion products, float), drop non-finite points, cut rays longer
-//   than max range (Vector3::normalized, float), drop ends outside the key range.
+//   than max range (Vector3::normalized, float), drop ends outside the key range and rays
+//   whose walk would have no length (prepare_scan.h's degenerate_ray).
 // Every product and sum is `precise` (no contraction, no reassociation). Where OctoMap
 // divides floats, the division is done in double and rounded to float: NVIDIA's fp32
 // division is not IEEE, double division rounded once more gives the IEEE float quotient.
@@ -30,7 +31,7 @@ layout(std430, binding = 2) buffer Result {
   uint nonfinite;
   uint out_of_range;
   uint cut_at_max_range;
-  uint pad;
+  uint degenerate;  // prepare_scan.h's degenerate_ray: end key != origin key at a float length of 0
 };
 
 layout(push_constant) uniform PrepareParams {
@@ -46,7 +47,7 @@ layout(push_constant) uniform PrepareParams {
   float zero;           // 0.0f, as a run-time value: the compiler may not fold 0 * x away
 };
 
-shared uint s_lo[3], s_hi[3], s_nonfinite, s_out_of_range, s_cut;
+shared uint s_lo[3], s_hi[3], s_nonfinite, s_out_of_range, s_cut, s_degenerate;
 
 bool finite(float f) { return (floatBitsToUint(f) & 0x7f800000u) != 0x7f800000u; }
 bool finite3(vec3 v) { return finite(v.x) && finite(v.y) && finite(v.z); }
@@ -94,6 +95,15 @@ bool apply_max_range(inout vec3 end, vec3 origin) {
   return true;
 }
 
+// Whether computeRayKeys' length, (float)(end - origin).norm(), is above 0 (prepare_scan.h's
+// degenerate_ray: a walk of length 0 between two keys never stops).
+bool ray_has_length(vec3 end, vec3 origin) {
+  precise vec3 d = end - origin;
+  precise float norm_sq = d.x * d.x + d.y * d.y;
+  norm_sq = norm_sq + d.z * d.z;
+  return float(sqrt(double(norm_sq))) > 0.0;
+}
+
 void main() {
   const uint lid = gl_LocalInvocationID.x;
   if (lid == 0u) {
@@ -104,6 +114,7 @@ void main() {
     s_nonfinite = 0u;
     s_out_of_range = 0u;
     s_cut = 0u;
+    s_degenerate = 0u;
   }
   barrier();
 
@@ -118,8 +129,12 @@ void main() {
     } else {
       const bool cut = apply_max_range(end, vec3(origin_x, origin_y, origin_z));
       if (cut) atomicAdd(s_cut, 1u);
+      uvec3 origin_key;
       if (!coord_to_key_checked(end, key)) {
         atomicAdd(s_out_of_range, 1u);
+      } else if (coord_to_key_checked(vec3(origin_x, origin_y, origin_z), origin_key) && key != origin_key &&
+                 !ray_has_length(end, vec3(origin_x, origin_y, origin_z))) {
+        atomicAdd(s_degenerate, 1u);
       } else {
         ray = RayEnd(end.x, end.y, end.z, cut ? 0u : kRayEndOccupied);
         for (int k = 0; k < 3; ++k) {
@@ -140,5 +155,6 @@ void main() {
     if (s_nonfinite != 0u) atomicAdd(nonfinite, s_nonfinite);
     if (s_out_of_range != 0u) atomicAdd(out_of_range, s_out_of_range);
     if (s_cut != 0u) atomicAdd(cut_at_max_range, s_cut);
+    if (s_degenerate != 0u) atomicAdd(degenerate, s_degenerate);
   }
 }

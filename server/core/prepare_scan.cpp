@@ -25,8 +25,9 @@ struct PreparedChunk {
 
 // OctoMap's rules for one point: false when it gives no ray (counted in `report`), else its
 // ray end and end key.
-bool prepare_point(const octomap::point3d& origin, const octomap::point3d& p, double max_range, double resolution,
-                   PrepareReport& report, RayEnd& ray, octomap::OcTreeKey& end_key) {
+bool prepare_point(const octomap::point3d& origin, const octomap::OcTreeKey& origin_key, const octomap::point3d& p,
+                   double max_range, double resolution, PrepareReport& report, RayEnd& ray,
+                   octomap::OcTreeKey& end_key) {
   if (!finite(p)) {
     ++report.nonfinite;
     return false;
@@ -45,27 +46,33 @@ bool prepare_point(const octomap::point3d& origin, const octomap::point3d& p, do
     ++report.out_of_range;
     return false;
   }
+  if (degenerate_ray(origin, end, origin_key, end_key)) {
+    ++report.degenerate;
+    return false;
+  }
   ray = RayEnd{end.x(), end.y(), end.z(), flags};
   return true;
 }
 
-void prepare_points(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range,
-                    double resolution, PreparedChunk& out) {
+void prepare_points(const octomap::point3d& origin, const octomap::OcTreeKey& origin_key,
+                    std::span<const octomap::point3d> points, double max_range, double resolution, PreparedChunk& out) {
   RayEnd ray;
   octomap::OcTreeKey key;
   for (const octomap::point3d& p : points) {
-    if (!prepare_point(origin, p, max_range, resolution, out.report, ray, key)) continue;
+    if (!prepare_point(origin, origin_key, p, max_range, resolution, out.report, ray, key)) continue;
     out.keys.include(key);
     out.ends.push_back(ray);
   }
 }
 
 #if defined(__x86_64__)
-// The common case four points at a time (AVX2): no max range, all four finite and inside the
-// key range. Keys by coordToKeyChecked's expression (floor(1 / resolution * coord) in double),
+// The common case four points at a time (AVX2): no max range, all four finite, inside the
+// key range and more than 1e-18 m from the origin along some axis (so that no ray of theirs is
+// degenerate: a squared length of at least 1e-36 is a normal float). Keys by coordToKeyChecked's expression (floor(1 / resolution * coord) in double),
 // the box kept in lanes; any other group of four goes to prepare_points, so the rays, their
 // order and the counts are the scalar loop's.
 __attribute__((target("avx2"))) void prepare_points_avx2(const octomap::point3d& origin,
+                                                         const octomap::OcTreeKey& origin_key,
                                                          std::span<const octomap::point3d> points, double max_range,
                                                          double resolution, PreparedChunk& out) {
   static_assert(sizeof(octomap::point3d) == 12);
@@ -73,6 +80,8 @@ __attribute__((target("avx2"))) void prepare_points_avx2(const octomap::point3d&
   const __m256d factor = _mm256_set1_pd(1.0 / resolution), low = _mm256_set1_pd(-32768.0),
                 high = _mm256_set1_pd(32768.0);
   const __m128i max_val = _mm_set1_epi32(32768);
+  const __m128 sign_bit = _mm_set1_ps(-0.0f), near = _mm_set1_ps(1e-18f);
+  const __m128 o[3] = {_mm_set1_ps(origin.x()), _mm_set1_ps(origin.y()), _mm_set1_ps(origin.z())};
   __m128i lo[3], hi[3];
   for (int i = 0; i < 3; ++i) lo[i] = _mm_set1_epi32(65536), hi[i] = _mm_set1_epi32(-1);
   size_t n = out.ends.size();
@@ -90,6 +99,10 @@ __attribute__((target("avx2"))) void prepare_points_avx2(const octomap::point3d&
     const __m128 v[3] = {x, y, z};
     __m128i key[3];
     __m256d ok = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+    __m128 away = _mm_setzero_ps();  // lanes more than 1e-18 from the origin along some axis
+    for (int i = 0; i < 3; ++i)
+      away = _mm_or_ps(away, _mm_cmpgt_ps(_mm_andnot_ps(sign_bit, _mm_sub_ps(v[i], o[i])), near));
+    ok = _mm256_and_pd(ok, _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_castps_si128(away))));
     for (int i = 0; i < 3; ++i) {
       const __m256d scaled = _mm256_mul_pd(factor, _mm256_cvtps_pd(v[i]));
       // scaled >= -32768 and < 32768 (false for NaN and inf: the finiteness test too).
@@ -101,7 +114,7 @@ __attribute__((target("avx2"))) void prepare_points_avx2(const octomap::point3d&
     if (_mm256_movemask_pd(ok) != 15) {
       octomap::OcTreeKey k;
       for (size_t j = 4 * g; j < 4 * g + 4; ++j)
-        if (prepare_point(origin, points[j], max_range, resolution, out.report, out.ends[n], k))
+        if (prepare_point(origin, origin_key, points[j], max_range, resolution, out.report, out.ends[n], k))
           out.keys.include(k), ++n;
       continue;
     }
@@ -120,17 +133,19 @@ __attribute__((target("avx2"))) void prepare_points_avx2(const octomap::point3d&
       out.keys.include(octomap::OcTreeKey(l[0][j], l[1][j], l[2][j]));
       out.keys.include(octomap::OcTreeKey(h[0][j], h[1][j], h[2][j]));
     }
-  prepare_points(origin, points.subspan(4 * groups), max_range, resolution, out);
+  prepare_points(origin, origin_key, points.subspan(4 * groups), max_range, resolution, out);
 }
 #endif
 
-void prepare_chunk(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range,
-                   double resolution, bool simd, PreparedChunk& out) {
+void prepare_chunk(const octomap::point3d& origin, const octomap::OcTreeKey& origin_key,
+                   std::span<const octomap::point3d> points, double max_range, double resolution, bool simd,
+                   PreparedChunk& out) {
   out.ends.reserve(points.size());
 #if defined(__x86_64__)
-  if (simd && __builtin_cpu_supports("avx2")) return prepare_points_avx2(origin, points, max_range, resolution, out);
+  if (simd && __builtin_cpu_supports("avx2"))
+    return prepare_points_avx2(origin, origin_key, points, max_range, resolution, out);
 #endif
-  prepare_points(origin, points, max_range, resolution, out);
+  prepare_points(origin, origin_key, points, max_range, resolution, out);
 }
 
 }  // namespace
@@ -160,7 +175,7 @@ RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::p
   std::vector<PreparedChunk> chunks(threads);
   auto run = [&](unsigned t) {
     const size_t begin = points.size() * t / threads, end = points.size() * (t + 1) / threads;
-    prepare_chunk(origin, points.subspan(begin, end - begin), max_range, resolution, simd, chunks[t]);
+    prepare_chunk(origin, batch.origin_key, points.subspan(begin, end - begin), max_range, resolution, simd, chunks[t]);
   };
   {
     std::vector<std::jthread> pool;
@@ -183,6 +198,7 @@ RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::p
     report.nonfinite += c.report.nonfinite;
     report.out_of_range += c.report.out_of_range;
     report.cut_at_max_range += c.report.cut_at_max_range;
+    report.degenerate += c.report.degenerate;
   }
   report.rays += batch.ends.size();
   batch.keys_hold_ends = true;

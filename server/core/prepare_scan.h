@@ -19,10 +19,28 @@ struct PrepareReport {
   uint64_t nonfinite = 0;         // NaN or inf coordinates: skipped
   uint64_t out_of_range = 0;      // ray end outside the map's key range: skipped (OctoMap does too)
   uint64_t cut_at_max_range = 0;  // longer than max range: cut, free space only
+  uint64_t degenerate = 0;        // end in another voxel than the origin at a float distance of 0: skipped
   bool origin_ok = true;          // false: origin not finite or outside the key range; no rays
   std::string error;              // set when origin_ok is false
   bool device_declined = false;   // shoot_posed: over PosedPoints' bounds, the device shot nothing (CPU-prepared)
 };
+
+// A ray OctoMap's walk cannot take: its end key differs from the origin's, yet its length as
+// computeRayKeys computes it ((float)(end - origin).norm()) is 0 (the squares underflow: an end
+// within ~1e-19 m of an origin on a voxel border, e.g. a max range of 1e-30 or a point at
+// -1e-30 beside an origin at 0). The walk would divide by that 0 and never stop (OctoMap's
+// KeyRay is then written past its end, the cpu-grid walk leaves its window), so such rays are
+// skipped and counted (PrepareReport::degenerate) on every back end.
+inline bool degenerate_ray(const octomap::point3d& origin, const octomap::point3d& end,
+                           const octomap::OcTreeKey& origin_key, const octomap::OcTreeKey& end_key) {
+  return end_key != origin_key && !((float)(end - origin).norm() > 0.0f);
+}
+
+// The smallest positive max range accepted from a scan message or a flag [m]. Below it a
+// sensor sees nothing beyond its own voxel at any resolution the flags accept, and such values
+// only come from a unit or encoding mistake; a positive max range whose square underflows
+// would make every cut ray degenerate (degenerate_ray above).
+inline constexpr double kMinMaxRange = 1e-3;
 
 // Builds the rays of one scan. Points are in the map frame, as OctoMap's insertPointCloud
 // takes them. max_range < 0 means no limit. Large scans are prepared on `threads` threads

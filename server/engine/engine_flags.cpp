@@ -42,6 +42,9 @@ EngineOptions to_engine_options(const EngineFlags& f) {
     throw CLI::ValidationError("--resolution", "must lie within [0.0001, 1000] m, not " + std::to_string(f.resolution));
   if (!std::isfinite(f.max_range))
     throw CLI::ValidationError("--max-range", "must be a finite number of metres (< 0: no limit)");
+  if (f.max_range >= 0 && f.max_range < kMinMaxRange)
+    throw CLI::ValidationError("--max-range", "must be at least " + std::to_string(kMinMaxRange) +
+                                                  " m (or < 0: no limit), not " + std::to_string(f.max_range));
   o.resolution = f.resolution;
   o.max_range = f.max_range;
   if (!parse_backend(f.backend, o.backend.kind))

@@ -128,6 +128,7 @@ DevicePrepared GpuPrepare::run(const ScanFrame& frame, VkBuffer rays) {
   out.nonfinite = c.nonfinite;
   out.out_of_range = c.out_of_range;
   out.cut_at_max_range = c.cut_at_max_range;
+  out.degenerate = c.degenerate;
   return out;
 }
 

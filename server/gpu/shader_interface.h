@@ -60,7 +60,7 @@ struct PrepareCounts {
   uint32_t nonfinite;
   uint32_t out_of_range;
   uint32_t cut_at_max_range;
-  uint32_t pad;
+  uint32_t degenerate;  // rays whose walk would have no length (prepare_scan.h's degenerate_ray)
 };
 static_assert(sizeof(PrepareCounts) == 40);
 

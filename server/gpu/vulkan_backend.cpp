@@ -99,7 +99,8 @@ class VulkanBackend final : public RayBackend {
     report.nonfinite += p.nonfinite;
     report.out_of_range += p.out_of_range;
     report.cut_at_max_range += p.cut_at_max_range;
-    const uint64_t kept = points - p.nonfinite - p.out_of_range;
+    report.degenerate += p.degenerate;
+    const uint64_t kept = points - p.nonfinite - p.out_of_range - p.degenerate;
     report.rays += kept;
     if (kept == 0) return;  // as prepare_scan: no rays, nothing shot
     header.keys.include(octomap::OcTreeKey(p.end_keys.lo[0], p.end_keys.lo[1], p.end_keys.lo[2]));

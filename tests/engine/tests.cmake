@@ -17,3 +17,6 @@ octomap_rt_add_test(engine_far_flung_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/far_
 # Issue 12: the two-stage pipeline of `octomap-rt bench` / `build` gives the sequential map.
 octomap_rt_add_test(engine_pipeline_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/pipeline_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/warm_up_test.cpp TIMEOUT 600)
+
+# Issue 21: rays OctoMap's walk cannot take (degenerate but finite fields) on every back end.
+octomap_rt_add_test(engine_degenerate_rays_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/degenerate_rays_test.cpp)

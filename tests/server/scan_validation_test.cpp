@@ -128,6 +128,51 @@ TEST(ScanValidation, RobotIds) {
   EXPECT_EQ(check(far), Reject::kOriginOutsideMap);
 }
 
+// Issue 21: degenerate but finite values of every numeric field, each refused with its own
+// reason or passed on to code that handles it (the crash was a max range of 1e-30).
+TEST(ScanValidation, DegenerateButFiniteFieldsAreRefusedOrHarmless) {
+  auto with = [](auto change) {
+    auto m = small_scan("alpha", 0);
+    change(m);
+    return check(m);
+  };
+  using M = octomap_rt::scan_t;
+  // max range: <= 0 is "no limit of its own"; a positive one below 1 mm is refused.
+  for (float r : {1e-30f, 1.4e-45f, 1e-4f, 0.00099f})
+    EXPECT_EQ(with([r](M& m) { m.max_range = r; }), Reject::kMaxRangeTooSmall) << r;
+  for (float r : {0.0f, -0.0f, -1.4e-45f, -1e30f, 0.001f, 3e38f})
+    EXPECT_EQ(with([r](M& m) { m.max_range = r; }), Reject::kNone) << r;
+  EXPECT_EQ(with([](M& m) { m.max_range = std::numeric_limits<float>::infinity(); }), Reject::kBadMaxRange);
+  EXPECT_EQ(with([](M& m) { m.max_range = -std::numeric_limits<float>::infinity(); }), Reject::kBadMaxRange);
+  // Position: beyond what a float holds, or the key range, before it is rounded to float.
+  for (double v : {1e300, -1e300, 1e39, 3276.9, -3276.9, std::numeric_limits<double>::max()})
+    EXPECT_EQ(with([v](M& m) { m.sensor_position[2] = v; }), Reject::kOriginOutsideMap) << v;
+  for (double v : {1e-300, -1e-300, 0.0, 3276.7, -3276.7})
+    EXPECT_EQ(with([v](M& m) { m.sensor_position[0] = v; }), Reject::kNone) << v;
+  EXPECT_EQ(with([](M& m) { m.sensor_position[1] = std::numeric_limits<double>::infinity(); }), Reject::kNonFinitePose);
+  // Orientation: tiny (its squared norm underflows), huge (overflows), denormal, negated.
+  EXPECT_EQ(with([](M& m) {
+              m.sensor_orientation[0] = 1e-300,
+              m.sensor_orientation[1] = m.sensor_orientation[2] = m.sensor_orientation[3] = 0;
+            }),
+            Reject::kZeroQuaternion);
+  EXPECT_EQ(with([](M& m) { m.sensor_orientation[0] = 1e300; }), Reject::kNonUnitQuaternion);
+  EXPECT_EQ(with([](M& m) { m.sensor_orientation[3] = std::numeric_limits<double>::max(); }),
+            Reject::kNonUnitQuaternion);
+  EXPECT_EQ(with([](M& m) {
+              for (double& q : m.sensor_orientation) q = -q;
+            }),
+            Reject::kNone);  // -q is the same rotation
+  // seq and utime: any value (seq steps are judged with an overflow check by the registry).
+  for (int64_t v : {std::numeric_limits<int64_t>::min(), int64_t(-1), std::numeric_limits<int64_t>::max()}) {
+    EXPECT_EQ(with([v](M& m) { m.seq = v; }), Reject::kNone) << v;
+    EXPECT_EQ(with([v](M& m) { m.utime = v; }), Reject::kNone) << v;
+  }
+  // points_frame: only the two values.
+  for (int8_t f : {int8_t(-1), int8_t(2), std::numeric_limits<int8_t>::min()})
+    EXPECT_EQ(with([f](M& m) { m.points_frame = f; }), Reject::kUnknownPointsFrame) << int(f);
+}
+
 TEST(ScanValidation, TooLarge) {
   std::vector<uint8_t> big(89 + 12 * 1000 + 400, 0);
   EXPECT_EQ(check(big), Reject::kTooLarge);

@@ -41,3 +41,6 @@ octomap_rt_add_test(server_delta_changes_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/
 # The long-lived map's upkeep in the daemon: decay steps and clearing passes between scans.
 octomap_rt_add_test(map_upkeep_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_upkeep_test.cpp ${SERVER_TEST_FIXTURES}
                     LIBS octomap_rt_daemon TIMEOUT 120)
+# Issue 21: every numeric field of scan_t at its degenerate values, on every back end.
+octomap_rt_add_test(server_scan_fields_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/scan_fields_test.cpp
+                    ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)

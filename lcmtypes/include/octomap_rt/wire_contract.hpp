@@ -52,6 +52,9 @@ inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
 inline constexpr uint64_t kDefaultMaxScanPoints = 4'000'000;
 // scan_t.robot_id: 1-32 of [A-Za-z0-9_-].
 inline constexpr size_t kMaxRobotIdLength = 32;
+// Smallest positive scan_t.max_range [m] (<= 0 means "no limit of its own"): below it every
+// ray ends in the sensor's voxel; the server refuses such a scan ("max range too small").
+inline constexpr double kMinScanMaxRange = 1e-3;
 // scan_t.map_frame.
 inline constexpr size_t kMaxMapFrameLength = 256;
 // occupancy_query_t: at most this many points (60 KB of xyz) in one query.

@@ -20,6 +20,7 @@ const char* to_string(Reject r) {
     case Reject::kZeroQuaternion: return "zero quaternion";
     case Reject::kNonUnitQuaternion: return "non-unit quaternion";
     case Reject::kBadMaxRange: return "bad max range";
+    case Reject::kMaxRangeTooSmall: return "max range too small";
     case Reject::kUnknownPointsFrame: return "unknown points frame";
     case Reject::kBadRobotId: return "bad robot id";
     case Reject::kRobotIdMismatch: return "robot id does not match channel";

@@ -27,6 +27,7 @@ enum class Reject {
   kZeroQuaternion,
   kNonUnitQuaternion,  // | |q| - 1 | > 1e-3
   kBadMaxRange,        // NaN or infinite
+  kMaxRangeTooSmall,   // positive, below kMinMaxRange (1 mm): every ray would end in the sensor's voxel
   kUnknownPointsFrame,
   kBadRobotId,        // empty, too long, or outside [A-Za-z0-9_-]
   kRobotIdMismatch,   // robot_id differs from the channel's suffix

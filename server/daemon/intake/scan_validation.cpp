@@ -76,12 +76,22 @@ Reject check_scan_content(const octomap_rt::scan_t& m, const std::string& expect
   // already be a rotation: a scaled quaternion would scale the scan.
   if (std::abs(std::sqrt(norm2) - 1.0) > 1e-3) return Reject::kNonUnitQuaternion;
   if (!std::isfinite(m.max_range)) return Reject::kBadMaxRange;
+  // <= 0 means "no limit of its own"; a positive one so small that every ray is cut to the
+  // sensor's own voxel is a unit or encoding mistake (the flags' rule: prepare_scan.h).
+  static_assert(octomap_rt::wire::kMinScanMaxRange == kMinMaxRange);
+  if (m.max_range > 0 && m.max_range < octomap_rt::wire::kMinScanMaxRange) return Reject::kMaxRangeTooSmall;
   if (m.points_frame != octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME &&
       m.points_frame != octomap_rt::scan_t::POINTS_IN_MAP_FRAME)
     return Reject::kUnknownPointsFrame;
   if (!valid_robot_id(m.robot_id)) return Reject::kBadRobotId;
   if (!same_robot_id(m.robot_id, expected_robot_id)) return Reject::kRobotIdMismatch;
-  // The ray origin is the position rounded to float, as OctoMap's pose6d holds it.
+  // The ray origin is the position rounded to float, as OctoMap's pose6d holds it. A double
+  // far outside the key range (up to 1e308) is refused before that rounding (which is only
+  // defined for values a float can hold).
+  const double key_range = 32768.0 * limits.resolution;
+  for (double v : m.sensor_position) {
+    if (!(std::abs(v) <= 2 * key_range)) return Reject::kOriginOutsideMap;
+  }
   const octomap::point3d origin(static_cast<float>(m.sensor_position[0]), static_cast<float>(m.sensor_position[1]),
                                 static_cast<float>(m.sensor_position[2]));
   octomap::OcTreeKey key;
