@@ -103,7 +103,7 @@ TEST(ServerMemq, CraftedBadMessagesAreCountedAndServingGoesOn) {
   }  // data > counts
   {
     auto m = small_scan("alpha", 1, 10);
-    m.xyz[2] = std::nanf("");
+    m.sensor_position[2] = std::nan("");
     bad(encode(m));
   }
   {
@@ -140,7 +140,7 @@ TEST(ServerMemq, CraftedBadMessagesAreCountedAndServingGoesOn) {
   EXPECT_EQ(a->applied, 3);
   EXPECT_EQ(a->rejected, 10);
   for (Reject r : {Reject::kTruncated, Reject::kWrongFingerprint, Reject::kNegativeCount, Reject::kCountTooLarge,
-                   Reject::kCountExceedsData, Reject::kTrailingBytes, Reject::kNonFinitePoint, Reject::kZeroQuaternion,
+                   Reject::kCountExceedsData, Reject::kTrailingBytes, Reject::kNonFinitePose, Reject::kZeroQuaternion,
                    Reject::kNonUnitQuaternion, Reject::kRobotIdMismatch})
     EXPECT_EQ(reason_count(*a, r), 1) << daemon::to_string(r);
   EXPECT_EQ(a->missed, 2);  // seq gaps are judged on valid scans only: 10, 11, 14
@@ -158,7 +158,7 @@ TEST(ServerMemq, CraftedBadMessagesAreCountedAndServingGoesOn) {
     EXPECT_EQ(r.scans_rejected, 10);
     EXPECT_EQ(r.num_reject_reasons, 10);
     ASSERT_EQ(r.reject_reason.size(), r.reject_count.size());
-    const auto it = std::find(r.reject_reason.begin(), r.reject_reason.end(), std::string("non-finite point"));
+    const auto it = std::find(r.reject_reason.begin(), r.reject_reason.end(), std::string("non-finite pose"));
     ASSERT_NE(it, r.reject_reason.end());
     EXPECT_EQ(r.reject_count[it - r.reject_reason.begin()], 1);
   }

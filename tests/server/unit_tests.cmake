@@ -44,3 +44,10 @@ octomap_rt_add_test(map_upkeep_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_upkeep
 # Issue 21: every numeric field of scan_t at its degenerate values, on every back end.
 octomap_rt_add_test(server_scan_fields_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/scan_fields_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
+# Issue 21: the server's numeric flags are range-checked at start.
+octomap_rt_add_test(server_flags_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_flags_test.cpp TIMEOUT 120)
+target_compile_definitions(server_flags_test PRIVATE OCTOMAP_RT_SERVER="$<TARGET_FILE:octomap-rt-server>")
+add_dependencies(server_flags_test octomap-rt-server)
+# Issue 24: an organised cloud with NaN no-returns (a range image of a real scan), every back end.
+octomap_rt_add_test(server_organised_cloud_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/organised_cloud_test.cpp
+                    ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)

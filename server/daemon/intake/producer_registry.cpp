@@ -73,6 +73,7 @@ void ProducerRegistry::release(size_t slot) {
     r.rejects[k] += p.rejects[k];
     r.drop_reasons[k] += p.drop_reasons[k];
   }
+  for (size_t k = 0; k < kPointDropReasonCount; ++k) r.point_drops[k] += p.point_drops[k];
   r.released++;
   by_channel_.erase(p.channel);
   p = ProducerStats{};
@@ -159,12 +160,14 @@ bool ProducerRegistry::admit(size_t producer, int64_t seq, int64_t utime, const 
   return true;
 }
 
-void ProducerRegistry::count_applied(size_t producer, int64_t points, double end_to_end_ms) {
+void ProducerRegistry::count_applied(size_t producer, int64_t points, double end_to_end_ms,
+                                     const PointDropCounts& dropped) {
   std::lock_guard lock(mutex_);
   ProducerStats& p = producers_[producer];
   p.in_flight--;
   p.applied++;
   p.points_applied += points;
+  for (size_t k = 0; k < kPointDropReasonCount; ++k) p.point_drops[k] += dropped[k];
   p.last_end_to_end_ms = end_to_end_ms;
 }
 

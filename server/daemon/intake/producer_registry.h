@@ -37,6 +37,7 @@ struct ProducerStats {
   double last_end_to_end_ms = 0;
   std::array<int64_t, kRejectReasonCount> rejects{};
   std::array<int64_t, kRejectReasonCount> drop_reasons{};  // why dropped (queue full, shed, ...)
+  PointDropCounts point_drops{};  // points of applied scans that gave no ray, by reason (NaN no-returns, ...)
 };
 
 struct ProducerPolicy {
@@ -73,7 +74,8 @@ class ProducerRegistry {
   // queue full). Returns whether it was queued.
   bool admit(size_t producer, int64_t seq, int64_t utime, const std::function<bool()>& enqueue);
 
-  void count_applied(size_t producer, int64_t points, double end_to_end_ms);
+  // A scan was applied: `points` of its points became rays, `dropped` gave none (by reason).
+  void count_applied(size_t producer, int64_t points, double end_to_end_ms, const PointDropCounts& dropped = {});
   void count_rejected_in_flight(size_t producer, Reject why);
   // An accepted scan left the queue without being applied (shed, or left at stop).
   void count_dropped_in_flight(size_t producer, Reject why);

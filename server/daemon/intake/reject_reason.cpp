@@ -15,7 +15,6 @@ const char* to_string(Reject r) {
     case Reject::kBadStringLength: return "bad string length";
     case Reject::kDecodeFailed: return "decode failed";
     case Reject::kCountNotMultipleOf3: return "count not a multiple of 3";
-    case Reject::kNonFinitePoint: return "non-finite point";
     case Reject::kNonFinitePose: return "non-finite pose";
     case Reject::kZeroQuaternion: return "zero quaternion";
     case Reject::kNonUnitQuaternion: return "non-unit quaternion";
@@ -34,6 +33,16 @@ const char* to_string(Reject r) {
     case Reject::kOverLatencyBound: return "over latency bound";
     case Reject::kLeftAtShutdown: return "left at shutdown";
     case Reject::kCount_: break;
+  }
+  return "unknown";
+}
+
+const char* to_string(PointDrop d) {
+  switch (d) {
+    case PointDrop::kNonFinite: return "non-finite";
+    case PointDrop::kOutsideKeyRange: return "outside key range";
+    case PointDrop::kDegenerateRay: return "degenerate ray";
+    case PointDrop::kCount_: break;
   }
   return "unknown";
 }

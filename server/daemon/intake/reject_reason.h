@@ -3,7 +3,9 @@
 // of these reasons; the names are what status messages, logs and tests show.
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
 
 namespace ort::daemon {
 
@@ -22,7 +24,6 @@ enum class Reject {
   kDecodeFailed,      // decode() threw or returned an error despite the checks
   // Content checks on the decoded message.
   kCountNotMultipleOf3,
-  kNonFinitePoint,
   kNonFinitePose,
   kZeroQuaternion,
   kNonUnitQuaternion,  // | |q| - 1 | > 1e-3
@@ -48,5 +49,21 @@ inline constexpr std::size_t kRejectReasonCount = static_cast<std::size_t>(Rejec
 
 // Stable human-readable name ("truncated", "non-finite point", ...).
 const char* to_string(Reject r);
+
+// Why single points of an applied scan gave no ray (the scan itself is applied with the rest).
+// Organised clouds (Ouster, Velodyne, depth cameras) carry NaN for every no-return, so these
+// are counted per producer, never a reason to refuse the scan.
+enum class PointDrop {
+  kNonFinite = 0,    // NaN or infinite coordinate (a no-return), or made infinite by the pose
+  kOutsideKeyRange,  // the ray's end lies outside the map's key range (OctoMap skips it too)
+  kDegenerateRay,    // within ~1e-19 m of the sensor across a voxel border: OctoMap's walk cannot take it
+  kCount_
+};
+
+inline constexpr std::size_t kPointDropReasonCount = static_cast<std::size_t>(PointDrop::kCount_);
+using PointDropCounts = std::array<int64_t, kPointDropReasonCount>;
+
+// Stable human-readable name ("non-finite", ...).
+const char* to_string(PointDrop d);
 
 }  // namespace ort::daemon

@@ -11,7 +11,6 @@ namespace {
 // Inner loops of a fixed trip count: vectorized at -O2 (GCC's cheap cost model takes only
 // loops whose vector code replaces the scalar loop whole).
 constexpr size_t kBlock = 16;
-constexpr uint32_t kExponent = 0x7f800000u;  // all ones: inf or NaN
 
 uint32_t be32(const uint8_t* p) {
   uint32_t w;
@@ -33,22 +32,6 @@ void decode_be_floats(const uint8_t* src, float* dst, size_t count) {
     const uint32_t w = be32(src + 4 * i);
     std::memcpy(dst + i, &w, 4);
   }
-}
-
-bool all_finite(std::span<const float> values) {
-  uint32_t bad = 0;
-  size_t i = 0;
-  for (; i + kBlock <= values.size(); i += kBlock) {
-    uint32_t w[kBlock];
-    std::memcpy(w, values.data() + i, sizeof w);
-    for (size_t k = 0; k < kBlock; ++k) bad |= uint32_t((w[k] & kExponent) == kExponent);
-  }
-  for (; i < values.size(); ++i) {
-    uint32_t w;
-    std::memcpy(&w, values.data() + i, 4);
-    bad |= uint32_t((w & kExponent) == kExponent);
-  }
-  return bad == 0;
 }
 
 // LCM's decode runs on the message without its point array (num_xyz patched to 0), so every

@@ -22,7 +22,4 @@ int decode_scan(const uint8_t* data, size_t size, octomap_rt::scan_t& out);
 // Big-endian 32-bit words (LCM's float encoding) into host floats.
 void decode_be_floats(const uint8_t* src, float* dst, size_t count);
 
-// True when no value is NaN or infinite.
-bool all_finite(std::span<const float> values);
-
 }  // namespace ort::daemon

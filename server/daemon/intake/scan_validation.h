@@ -1,7 +1,9 @@
 // Validation of one raw scan_t message, in the order that keeps the LCM thread safe:
 // size bounds, fingerprint, and every count/length at its fixed byte offset are checked on
 // the raw bytes first; only then does the generated decode() run (inside try/catch); then
-// the content (finite points, finite pose, unit quaternion, robot id) is checked.
+// the content (finite pose, unit quaternion, max range, robot id) is checked. Points are not:
+// a NaN point is a no-return of an organised cloud, dropped and counted by preparation
+// (core/prepare_scan.h) while the rest of the scan is applied.
 #pragma once
 
 #include <cstddef>

@@ -149,6 +149,20 @@ void ScanPipeline::apply_edit(MapEditItem& edit) {
   if (edit.done) edit.done(r);
 }
 
+namespace {
+
+// What preparation skipped of a scan's points, by the daemon's reasons (every back end
+// prepares by the same rules: core/prepare_scan.h, shaders/prepare_rays.comp).
+PointDropCounts point_drops(const PrepareReport& r) {
+  PointDropCounts d{};
+  d[static_cast<size_t>(PointDrop::kNonFinite)] = static_cast<int64_t>(r.nonfinite);
+  d[static_cast<size_t>(PointDrop::kOutsideKeyRange)] = static_cast<int64_t>(r.out_of_range);
+  d[static_cast<size_t>(PointDrop::kDegenerateRay)] = static_cast<int64_t>(r.degenerate);
+  return d;
+}
+
+}  // namespace
+
 void ScanPipeline::apply(ShotJob& job) {
   if (job.edit) return apply_edit(*job.edit);
   const double token = metrics_.overlap().begin(1);
@@ -198,7 +212,8 @@ void ScanPipeline::apply(ShotJob& job) {
   t.voxels = job.shot.free_voxels + job.shot.occupied_voxels;
   t.new_nodes = new_nodes;
   metrics_.record(t);
-  producers_.count_applied(job.producer, job.points, t.end_to_end_ms);
+  producers_.count_applied(job.producer, static_cast<int64_t>(job.shot.prepare.rays), t.end_to_end_ms,
+                           point_drops(job.shot.prepare));
 }
 
 void ScanPipeline::run_stage1() {

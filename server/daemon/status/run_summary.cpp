@@ -28,6 +28,12 @@ void print_producers(std::ostream& out, const StatusInputs& s) {
         drops += std::string(drops.empty() ? "" : ", ") + to_string(static_cast<Reject>(k)) + " " +
                  std::to_string(p.drop_reasons[k]);
     if (!drops.empty()) out << "      dropped: " << drops << "\n";
+    std::string points;
+    for (size_t k = 0; k < kPointDropReasonCount; ++k)
+      if (p.point_drops[k])
+        points += std::string(points.empty() ? "" : ", ") + to_string(static_cast<PointDrop>(k)) + " " +
+                  std::to_string(p.point_drops[k]);
+    if (!points.empty()) out << "      points without a ray: " << points << "\n";
   }
 }
 

@@ -51,6 +51,12 @@ octomap_rt::robot_stats_t robot_message(const ProducerStats& p, int64_t queue_by
   r.num_reject_reasons = add_reasons(p.rejects, r.reject_reason, r.reject_count);
   r.num_drop_reasons = add_reasons(p.drop_reasons, r.drop_reason, r.drop_count);
   r.seq_restarts = p.seq_restarts;
+  for (size_t k = 0; k < kPointDropReasonCount; ++k) {
+    if (p.point_drops[k] == 0) continue;
+    r.point_drop_reason.push_back(to_string(static_cast<PointDrop>(k)));
+    r.point_drop_count.push_back(p.point_drops[k]);
+  }
+  r.num_point_drop_reasons = static_cast<int32_t>(r.point_drop_reason.size());
   r.robot_id = p.robot_id;
   r.channel = p.channel;
   return r;

@@ -1,0 +1,63 @@
+// Issue 21: the server's own flags that feed the ray walk and the sensor model are range-checked
+// at start: each absurd value ends the server at once, before it maps anything, with an error
+// that names the flag.
+#include <cstdio>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace {
+
+struct ServerRun {
+  int exit = -1;
+  std::string output;
+};
+
+// The server with `flags` (and a memq:// bus, no map file); `timeout` ends one that started.
+ServerRun run_server(const std::string& flags) {
+  ServerRun r;
+  const std::string cmd =
+      std::string("timeout 20 ") + OCTOMAP_RT_SERVER + " --lcm-url memq:// --backend cpu " + flags + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  while (size_t n = fread(buf, 1, sizeof buf, p)) r.output.append(buf, n);
+  const int status = pclose(p);
+  r.exit = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+TEST(ServerFlags, AbsurdNumbersForTheWalkAndTheSensorModelAreRefusedAtStart) {
+  const struct {
+    const char* flags;
+    const char* names;
+  } cases[] = {
+      {"-r 0.1 --max-range 1e-30", "--max-range"},  // every cut ray degenerate (the crash)
+      {"-r 0.1 --max-range 0", "--max-range"},
+      {"-r 0.1 --max-range 0.0005", "--max-range"},
+      {"-r 0.1 --max-range nan", "--max-range"},
+      {"-r 0.1 --max-range inf", "--max-range"},
+      {"-r 0", "--resolution"},
+      {"-r 1e-300", "--resolution"},
+      {"-r 1e300", "--resolution"},
+      {"-r nan", "--resolution"},
+      {"-r -0.1", "--resolution"},
+      {"-r 0.1 --prob-hit 1", "--prob-hit"},
+      {"-r 0.1 --prob-hit 0", "--prob-hit"},
+      {"-r 0.1 --prob-hit nan", "--prob-hit"},
+      {"-r 0.1 --prob-miss 1.5", "--prob-miss"},
+      {"-r 0.1 --prob-miss -0.1", "--prob-miss"},
+      {"-r 0.1 --clamp-min 0", "--clamp-min"},
+      {"-r 0.1 --clamp-max 1", "--clamp-max"},
+      {"-r 0.1 --clamp-min 0.9 --clamp-max 0.2", "--clamp-min"},
+      {"-r 0.1 --occupancy-threshold 1", "--occupancy-threshold"},
+  };
+  for (const auto& c : cases) {
+    const ServerRun r = run_server(c.flags);
+    EXPECT_NE(r.exit, 0) << c.flags << ":\n" << r.output;
+    EXPECT_NE(r.exit, 124) << c.flags << " started the server:\n" << r.output;
+    EXPECT_NE(r.output.find(c.names), std::string::npos) << c.flags << ":\n" << r.output;
+  }
+}
+
+}  // namespace
