@@ -2,7 +2,7 @@
 # C++ types, and a CMake package config so that a planner's project does
 #   find_package(octomap_rt REQUIRED)
 #   target_link_libraries(planner PRIVATE octomap_rt::map_client)
-# (The Java jar and the Python package install themselves: lcmtypes/, client/python/.)
+# (The Java jar and the Python package install themselves: lcmtypes/, client/bindings/python/.)
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 set(ORT_INCLUDE_DEST ${CMAKE_INSTALL_INCLUDEDIR}/octomap_rt)

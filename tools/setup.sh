@@ -9,7 +9,7 @@ packages=(cmake ninja-build g++ pkg-config
   liboctomap-dev libeigen3-dev libvulkan-dev mesa-vulkan-drivers glslang-tools
   libdynamicedt3d-dev  # OctoMap's DynamicEDTOctomap: the distance tests compare with it (tests/distance)
   libjemalloc-dev libzstd-dev libgtest-dev libcli11-dev libpng-dev iproute2 bzip2 gnuplot-nox
-  python3 python3-numpy python3-zstandard  # the Python client and its tests (client/python, tests/python)
+  python3 python3-numpy python3-zstandard  # the Python client and its tests (client/bindings/python, tests/python)
   default-jre xvfb xdotool   # lcm-spy needs a JRE with AWT (not headless); Xvfb+xdotool: docs/lcm-spy.png
   clang-14 libclang-rt-14-dev)  # libFuzzer targets (tests/fuzz/, run by tools/run-tests)
 missing=()

@@ -13,10 +13,10 @@
 
 #include <CLI/CLI.hpp>
 
-#include "lcm_url.h"
+#include "cli/lcm_url.h"
 #include "octomap_rt/box_query_t.hpp"
-#include "query/query_args.h"
-#include "query/query_client.h"
+#include "query_client/query_args.h"
+#include "query_client/query_client.h"
 
 namespace {
 

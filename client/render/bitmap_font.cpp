@@ -1,4 +1,4 @@
-#include "bitmap_font.h"
+#include "render/bitmap_font.h"
 
 #include <array>
 #include <cstdint>

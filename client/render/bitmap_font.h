@@ -4,7 +4,7 @@
 
 #include <string_view>
 
-#include "canvas.h"
+#include "render/canvas.h"
 
 namespace ort::render {
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "view_camera.h"
+#include "render/view_camera.h"
 
 namespace ort::render {
 

@@ -1,4 +1,4 @@
-#include "height_colours.h"
+#include "render/height_colours.h"
 
 #include <algorithm>
 #include <array>

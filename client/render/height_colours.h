@@ -2,7 +2,7 @@
 // the convention of octovis' height colouring, with a perceptually smoother path.
 #pragma once
 
-#include "canvas.h"
+#include "render/canvas.h"
 
 namespace ort::render {
 

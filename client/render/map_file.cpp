@@ -1,4 +1,4 @@
-#include "map_file.h"
+#include "render/map_file.h"
 
 #include <filesystem>
 #include <fstream>

@@ -1,9 +1,9 @@
-#include "map_legend.h"
+#include "render/map_legend.h"
 
 #include <cmath>
 #include <cstdio>
 
-#include "bitmap_font.h"
+#include "render/bitmap_font.h"
 
 namespace ort::render {
 namespace {

@@ -3,10 +3,10 @@
 
 #include <string>
 
-#include "canvas.h"
-#include "height_colours.h"
-#include "view_camera.h"
-#include "voxel_boxes.h"
+#include "render/canvas.h"
+#include "render/height_colours.h"
+#include "render/view_camera.h"
+#include "render/voxel_boxes.h"
 
 namespace ort::render {
 

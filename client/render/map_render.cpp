@@ -1,11 +1,11 @@
-#include "map_render.h"
+#include "render/map_render.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
-#include "height_colours.h"
-#include "map_legend.h"
+#include "render/height_colours.h"
+#include "render/map_legend.h"
 
 namespace ort::render {
 namespace {

@@ -2,9 +2,9 @@
 // footprint on the floor (or hidden), a legend underneath. Software rasterizer, one thread.
 #pragma once
 
-#include "canvas.h"
-#include "view_camera.h"
-#include "voxel_boxes.h"
+#include "render/canvas.h"
+#include "render/view_camera.h"
+#include "render/voxel_boxes.h"
 
 namespace ort::render {
 

@@ -1,4 +1,4 @@
-#include "png_file.h"
+#include "render/png_file.h"
 
 #include <csetjmp>
 #include <cstdio>

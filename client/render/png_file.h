@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "canvas.h"
+#include "render/canvas.h"
 
 namespace ort::render {
 

@@ -1,4 +1,4 @@
-#include "view_camera.h"
+#include "render/view_camera.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "voxel_boxes.h"
+#include "render/voxel_boxes.h"
 
 #include <algorithm>
 #include <limits>

@@ -6,9 +6,9 @@
 
 #include <octomap/ScanGraph.h>
 
+#include "core/file_checks/scan_graph_check.h"
 #include "core/map_frame.h"
 #include "core/memory_stream.h"
-#include "core/scan_graph_check.h"
 
 namespace ort {
 
@@ -20,7 +20,7 @@ size_t ScanSet::total_points() const {
 
 ScanSet parse_scan_graph(std::string_view bytes, const std::string& name) {
   // OctoMap's reader asserts on a short cloud and trusts the scan count (see
-  // core/scan_graph_check.h): the layout is checked first, then OctoMap reads each scan.
+  // core/file_checks/scan_graph_check.h): the layout is checked first, then OctoMap reads each scan.
   const ScanGraphCheck check = check_scan_graph(bytes);
   if (!check.ok) throw std::runtime_error("'" + name + "' is not a valid OctoMap ScanGraph: " + check.error);
   if (check.scans == 0) throw std::runtime_error("'" + name + "' holds no scans");

@@ -14,7 +14,7 @@ namespace ort {
 enum class BackendKind {
   kAuto,
   kCpu,      // OctoMap's computeRayKeys + KeySets: the reference
-  kCpuGrid,  // native threads into the 2-bit shared ray space (core/cpu_grid_backend.h)
+  kCpuGrid,  // native threads into the 2-bit shared ray space (cpu/cpu_grid_backend.h)
   kVulkan,   // compute shaders (gpu/vulkan_backend.h)
   kRt,       // ray-tracing pipeline (gpu/rt_backend.h)
 };

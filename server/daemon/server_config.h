@@ -8,18 +8,11 @@
 
 #include "daemon/map/map_upkeep.h"
 #include "daemon/queries/query_config.h"
+#include "daemon/serving/octomap_raw_publisher.h"
 #include "engine/map_engine.h"
 #include "octomap_rt/wire_contract.hpp"
 
 namespace ort::daemon {
-
-// The map for LCM's OctoMap viewers (octomap.raw_t; daemon/octomap_raw_publisher.h).
-struct OctomapRawConfig {
-  double rate_hz = 0;  // 0: off
-  std::string channel = "OCTOMAP";
-  size_t max_bytes = 0;     // whole message; 0: octomap_raw_default_cap()
-  unsigned min_depth = 10;  // coarsest depth-limited map sent before giving up
-};
 
 struct ServerConfig {
   EngineOptions engine;                                             // resolution, sensor model, max range, back end

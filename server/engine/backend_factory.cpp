@@ -15,9 +15,9 @@
 
 #include <string>
 
-#include "core/cpu_backend.h"
-#include "core/cpu_grid_backend.h"
 #include "core/errors.h"
+#include "cpu/cpu_backend.h"
+#include "cpu/cpu_grid_backend.h"
 #include "gpu/rt_backend.h"
 #include "gpu/vk/vk_context.h"
 #include "gpu/vulkan_backend.h"

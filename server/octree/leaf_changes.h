@@ -24,7 +24,7 @@
 
 #include <octomap/OcTreeKey.h>
 
-#include "octree/morton_order.h"
+#include "octree/batched/morton_order.h"
 
 namespace ort {
 

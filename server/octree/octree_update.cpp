@@ -1,6 +1,6 @@
 #include "octree/octree_update.h"
 
-#include "octree/batched_update.h"
+#include "octree/batched/batched_update.h"
 
 namespace ort {
 

@@ -15,7 +15,7 @@ namespace ort {
 
 enum class OctreeUpdateMode {
   kSequential,  // one OcTree::updateNode per voxel: OctoMap's own loop, the reference
-  kBatched,     // key-ordered batched descent, multi-threaded (octree/batched_update.h)
+  kBatched,     // key-ordered batched descent, multi-threaded (octree/batched/batched_update.h)
 };
 
 struct OctreeUpdateOptions {

@@ -1,6 +1,6 @@
 #include "octree/region_sweep.h"
 
-#include "octree/node_access.h"
+#include "octree/batched/node_access.h"
 
 namespace ort {
 namespace {

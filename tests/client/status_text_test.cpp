@@ -1,8 +1,8 @@
 // `octomap-rt status` layout and JSON of a known status message.
 #include <gtest/gtest.h>
 
-#include "status/status_json.h"
-#include "status/status_text.h"
+#include "cli/status/status_json.h"
+#include "cli/status/status_text.h"
 
 namespace ort::status {
 namespace {

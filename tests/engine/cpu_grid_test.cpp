@@ -1,4 +1,4 @@
-// The cpu-grid back end's bricked layout (core/brick_layout.h) and its window walk (the voxel
+// The cpu-grid back end's bricked layout (cpu/brick_layout.h) and its window walk (the voxel
 // index kept per axis, the window's bounds tested only on the stepping axis) against the cpu
 // back end (OctoMap's computeRayKeys + a hash set), on whole scans: rays along each axis, in
 // the axis planes, across brick and window borders, at the key range's edges, one thread
@@ -10,13 +10,13 @@
 
 #include <gtest/gtest.h>
 
-#include "core/brick_layout.h"
-#include "core/cpu_backend.h"
-#include "core/cpu_grid_backend.h"
-#include "core/grid_marker.h"
 #include "core/octomap_ray_walk.h"
 #include "core/prepare_scan.h"
-#include "core/window_walk_avx2.h"
+#include "cpu/brick_layout.h"
+#include "cpu/cpu_backend.h"
+#include "cpu/cpu_grid_backend.h"
+#include "cpu/grid_marker.h"
+#include "cpu/window_walk_avx2.h"
 
 namespace ort {
 namespace {

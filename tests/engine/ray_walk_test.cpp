@@ -8,10 +8,10 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
-#include "core/cpu_backend.h"
-#include "core/cpu_grid_backend.h"
 #include "core/octomap_ray_walk.h"
 #include "core/prepare_scan.h"
+#include "cpu/cpu_backend.h"
+#include "cpu/cpu_grid_backend.h"
 
 namespace ort {
 namespace {

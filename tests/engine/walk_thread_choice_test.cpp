@@ -1,9 +1,9 @@
 // The cpu-grid walk's choice between the caller's thread alone and all its threads when it
-// shares the cores with the octree stage (core/walk_thread_choice.h): helpers that get at
+// shares the cores with the octree stage (cpu/walk_thread_choice.h): helpers that get at
 // least half a core keep walking, starved ones are let go, and measured again now and then.
 #include <gtest/gtest.h>
 
-#include "core/walk_thread_choice.h"
+#include "cpu/walk_thread_choice.h"
 
 namespace ort {
 namespace {

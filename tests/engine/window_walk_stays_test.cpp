@@ -1,4 +1,4 @@
-// The AVX2 walk without the per-step window test (core/window_walk_avx2.h, rays_stay_inside):
+// The AVX2 walk without the per-step window test (cpu/window_walk_avx2.h, rays_stay_inside):
 // taken only where no ray can leave its row-by-row window, and there the same voxels as
 // OctoMap's walk, ray by ray; refused for a window of a split ray space, a tile's window
 // (rays running on beyond it) and an origin or end near a face.
@@ -9,14 +9,14 @@
 
 #include <gtest/gtest.h>
 
-#include "core/brick_layout.h"
-#include "core/cpu_backend.h"
-#include "core/cpu_grid_backend.h"
-#include "core/grid_marker.h"
 #include "core/octomap_ray_walk.h"
 #include "core/prepare_scan.h"
 #include "core/ray_space.h"
-#include "core/window_walk_avx2.h"
+#include "cpu/brick_layout.h"
+#include "cpu/cpu_backend.h"
+#include "cpu/cpu_grid_backend.h"
+#include "cpu/grid_marker.h"
+#include "cpu/window_walk_avx2.h"
 
 namespace ort {
 namespace {

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "core/octree_file_check.h"
+#include "core/file_checks/octree_file_check.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);

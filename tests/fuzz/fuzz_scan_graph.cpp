@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "core/scan_graph_check.h"
+#include "core/file_checks/scan_graph_check.h"
 #include "scene/scan_set.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -35,9 +35,9 @@ octomap_rt_add_fuzz_target(fuzz_scan_message
           ${CMAKE_SOURCE_DIR}/server/core/prepare_scan.cpp
   LIBS octomap_rt_lcmtypes octomap_rt_lcm)
 octomap_rt_add_fuzz_target(fuzz_scan_graph
-  SOURCES ${CMAKE_SOURCE_DIR}/server/core/scan_graph_check.cpp ${CMAKE_SOURCE_DIR}/client/scene/scan_set.cpp
+  SOURCES ${CMAKE_SOURCE_DIR}/server/core/file_checks/scan_graph_check.cpp ${CMAKE_SOURCE_DIR}/client/scene/scan_set.cpp
           ${CMAKE_SOURCE_DIR}/server/core/map_frame.cpp)
-octomap_rt_add_fuzz_target(fuzz_octree_file SOURCES ${CMAKE_SOURCE_DIR}/server/core/octree_file_check.cpp)
+octomap_rt_add_fuzz_target(fuzz_octree_file SOURCES ${CMAKE_SOURCE_DIR}/server/core/file_checks/octree_file_check.cpp)
 file(GLOB FUZZ_QUERY_CORE ${CMAKE_SOURCE_DIR}/server/query/*.cpp)
 octomap_rt_add_fuzz_target(fuzz_query_message
   SOURCES ${CMAKE_SOURCE_DIR}/server/daemon/queries/query_wire.cpp ${CMAKE_SOURCE_DIR}/server/daemon/queries/query_answers.cpp

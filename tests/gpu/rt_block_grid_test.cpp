@@ -13,8 +13,8 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
-#include "core/cpu_backend.h"
 #include "core/exact_traversal.h"
+#include "cpu/cpu_backend.h"
 #include "gpu/rt/block_grid.h"
 
 namespace ort::rt {

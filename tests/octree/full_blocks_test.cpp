@@ -16,7 +16,7 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
-#include "octree/batched_update.h"
+#include "octree/batched/batched_update.h"
 #include "octree/octree_update.h"
 #include "support/leaf_change_truth.h"
 #include "tree_checks.h"

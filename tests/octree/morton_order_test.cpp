@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTreeKey.h>
 
-#include "octree/morton_order.h"
+#include "octree/batched/morton_order.h"
 
 namespace ort {
 namespace {

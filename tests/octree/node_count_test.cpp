@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
-#include "octree/node_count.h"
+#include "octree/batched/node_count.h"
 #include "support/tree_compare.h"
 
 namespace ort {

@@ -10,7 +10,7 @@
 #include <octomap/OcTree.h>
 
 #include "core/voxel_update.h"
-#include "octree/morton_order.h"
+#include "octree/batched/morton_order.h"
 
 namespace ort::test {
 

@@ -14,7 +14,7 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
-#include "octree/batched_update.h"
+#include "octree/batched/batched_update.h"
 #include "octree/octree_update.h"
 #include "random_batches.h"
 #include "tree_checks.h"

@@ -11,7 +11,7 @@
 #include <octomap/OcTree.h>
 
 #include "engine/map_engine.h"
-#include "octree/batched_update.h"
+#include "octree/batched/batched_update.h"
 #include "scene/scan_set.h"
 #include "support/test_data.h"
 #include "tree_checks.h"

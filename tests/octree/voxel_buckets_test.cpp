@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTreeKey.h>
 
-#include "octree/voxel_buckets.h"
+#include "octree/batched/voxel_buckets.h"
 
 namespace ort {
 namespace {

@@ -16,7 +16,7 @@ import octomap_rt
 
 SERVER = os.environ.get("OCTOMAP_RT_SERVER", "")
 CLI = os.environ.get("OCTOMAP_RT_CLI", "")
-EXAMPLE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "client", "python", "examples",
+EXAMPLE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "client", "bindings", "python", "examples",
                        "planner.py")
 
 

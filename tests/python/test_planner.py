@@ -1,4 +1,4 @@
-"""The planner example (client/python/examples/planner.py) against a real octomap-rt-server
+"""The planner example (client/bindings/python/examples/planner.py) against a real octomap-rt-server
 with the demo's scene streamed to it (`octomap-rt replay synthetic`, as tools/run-demo does):
 it prints a path from the corridor into a room through the door, and every waypoint of it is
 free when the C++ client (`octomap-rt query points`) asks the server."""

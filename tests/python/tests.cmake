@@ -1,4 +1,4 @@
-# Python client (client/python/) with Debian's python3, inside a network namespace per run.
+# Python client (client/bindings/python/) with Debian's python3, inside a network namespace per run.
 find_program(PYTHON3 python3 PATHS /usr/bin NO_DEFAULT_PATH)
 find_program(LCM_LOGGER lcm-logger)
 set(ORT_PY_TEST_ENV "PYTHONPATH=${CMAKE_BINARY_DIR}/python:${CMAKE_CURRENT_LIST_DIR}"

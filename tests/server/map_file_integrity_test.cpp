@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "core/octree_file_check.h"
+#include "core/file_checks/octree_file_check.h"
 #include "daemon/mapping_server.h"
 #include "daemon/persistence/map_store.h"
 #include "engine/map_engine.h"

@@ -16,7 +16,7 @@
 #include <set>
 #include <sstream>
 
-#include "daemon/persistence/applied_order.h"
+#include "daemon/map/applied_order.h"
 #include "daemon/transport/kernel_udp_stats.h"
 #include "integration_harness.h"
 #include "map_client/map_mirror.h"

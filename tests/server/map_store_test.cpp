@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/persistence/applied_order.h"
+#include "daemon/map/applied_order.h"
 #include "daemon/persistence/map_store.h"
 #include "daemon/transport/kernel_udp_stats.h"
 #include "daemon/transport/server_lcm_url.h"

@@ -10,11 +10,11 @@
 
 #include <chrono>
 
+#include "cli/replay/scan_message.h"
 #include "integration_harness.h"
 #include "octomap_rt/occupancy_reply_t.hpp"
 #include "query/point_query.h"
-#include "query/query_client.h"
-#include "scan_message.h"
+#include "query_client/query_client.h"
 #include "scene/scan_set.h"
 #include "support/test_data.h"
 

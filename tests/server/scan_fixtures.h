@@ -12,8 +12,8 @@
 
 #include <octomap/OcTree.h>
 
+#include "daemon/map/applied_order.h"
 #include "daemon/mapping_server.h"
-#include "daemon/persistence/applied_order.h"
 #include "daemon/server_config.h"
 #include "octomap_rt/scan_t.hpp"
 #include "scene/scan_set.h"

@@ -8,12 +8,12 @@
 
 #include <filesystem>
 
-#include "daemon/persistence/applied_order.h"
+#include "cli/replay/lcm_log_scans.h"
+#include "cli/replay/scan_selection.h"
+#include "daemon/map/applied_order.h"
 #include "integration_harness.h"
-#include "lcm_log_scans.h"
 #include "octomap_rt/scan_t.hpp"
 #include "octomap_rt/wire_contract.hpp"
-#include "scan_selection.h"
 #include "scene/scan_set.h"
 #include "support/octomap_reference.h"
 #include "support/test_data.h"

@@ -13,7 +13,7 @@
 #include <random>
 #include <thread>
 
-#include "daemon/persistence/applied_order.h"
+#include "daemon/map/applied_order.h"
 #include "integration_harness.h"
 #include "scene/scan_set.h"
 #include "support/octomap_reference.h"

@@ -9,9 +9,9 @@
 #include <filesystem>
 #include <map>
 
-#include "daemon/persistence/applied_order.h"
+#include "cli/replay/scan_selection.h"
+#include "daemon/map/applied_order.h"
 #include "integration_harness.h"
-#include "scan_selection.h"
 #include "scene/scan_set.h"
 #include "support/octomap_reference.h"
 #include "support/test_data.h"

@@ -9,8 +9,8 @@
 #include <octomap/OcTree.h>
 
 #include "core/voxel_update.h"
+#include "octree/batched/morton_order.h"
 #include "octree/leaf_changes.h"
-#include "octree/morton_order.h"
 
 namespace ort::test {
 

@@ -23,9 +23,9 @@
 #include "core/backend_kind.h"
 #include "core/clock.h"
 #include "engine/map_engine.h"
-#include "octree/batched_update.h"
-#include "octree/morton_order.h"
-#include "octree/voxel_buckets.h"
+#include "octree/batched/batched_update.h"
+#include "octree/batched/morton_order.h"
+#include "octree/batched/voxel_buckets.h"
 #include "octree/worker_pool.h"
 #include "scene/scan_set.h"
 

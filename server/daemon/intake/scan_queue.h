@@ -16,12 +16,15 @@
 #include <optional>
 #include <vector>
 
-#include "daemon/map/map_edit_item.h"
 #include "octomap_rt/scan_t.hpp"
 
 namespace ort::daemon {
 
 using Clock = std::chrono::steady_clock;
+
+// A map edit rides the queue to keep its place among the scans; what it is and how it is
+// applied are the map's (daemon/map/map_edit_item.h): the queue only holds it.
+struct MapEditItem;
 
 struct QueuedScan {
   size_t producer = 0;

@@ -14,7 +14,7 @@
 #include <octomap/OcTree.h>
 
 #include "core/voxel_update.h"
-#include "daemon/persistence/applied_order.h"
+#include "daemon/map/applied_order.h"
 #include "octree/leaf_changes.h"
 
 namespace ort::daemon {

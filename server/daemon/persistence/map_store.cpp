@@ -13,7 +13,7 @@
 #include <iterator>
 #include <sstream>
 
-#include "core/octree_file_check.h"
+#include "core/file_checks/octree_file_check.h"
 
 namespace ort::daemon {
 namespace {

@@ -45,7 +45,7 @@ const char* to_string(MapStoreError::Kind kind);
 // OctoMap's full format (.ot: AbstractOcTree::write, with log-odds) in memory.
 std::string serialize_map(const octomap::OcTree& tree);
 
-// Reads a .ot file whole, checks it (core/octree_file_check.h: header, node stream to the
+// Reads a .ot file whole, checks it (core/file_checks/octree_file_check.h: header, node stream to the
 // last byte, node count against the header) and only then lets OctoMap read it. Throws
 // MapStoreError: kOpen/kRead, kCorrupt, kWrongType, kWrongResolution (naming both values).
 std::unique_ptr<octomap::OcTree> load_map(const std::string& path, double resolution);

@@ -11,6 +11,7 @@
 
 #include "daemon/intake/producer_registry.h"
 #include "daemon/intake/scan_queue.h"
+#include "daemon/map/map_edit_item.h"
 #include "daemon/map/map_state.h"
 #include "daemon/pipeline/bounded_handoff.h"
 #include "daemon/pipeline/pipeline_metrics.h"

@@ -15,7 +15,7 @@
 #include <variant>
 #include <vector>
 
-#include "daemon/intake/scan_queue.h"  // Clock
+#include "core/clock.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/grid_query_t.hpp"
 #include "octomap_rt/occupancy_query_t.hpp"
@@ -28,7 +28,7 @@ using QueryMessage = std::variant<octomap_rt::occupancy_query_t, octomap_rt::ray
 
 struct PendingQuery {
   QueryMessage msg;
-  Clock::time_point received, deadline;  // deadline: when waiting for the map state ends
+  SteadyClock::time_point received, deadline;  // deadline: when waiting for the map state ends
 };
 
 struct QueryClientStats {

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "daemon/map/map_edit_item.h"
 #include "daemon/queries/query_wire.h"
 #include "octomap_rt/map_edit_ack_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
@@ -131,7 +132,7 @@ void QueryService::on_query(const lcm::ReceiveBuffer& rb, std::string (*check)(c
     return;
   }
   clients_.received(msg.client_id, msg.reply_channel, now_us());
-  PendingQuery q{QueryMessage(std::move(msg)), Clock::now(), {}};
+  PendingQuery q{QueryMessage(std::move(msg)), SteadyClock::now(), {}};
   const QueryHeader h = header_of(q.msg);
   std::string bad = validate_query(q.msg, resolution_);
   if (bad.empty() && (h.wait_timeout_ms < 0 || h.wait_timeout_ms > cfg_.max_wait_ms))
@@ -221,7 +222,7 @@ bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& o
   }
   const bool ready = stamp.snapshot_id >= h.min_snapshot_id && (!waits_for_scan || applied >= h.wait_seq);
   if (!ready) {
-    if (Clock::now() < q.deadline) return false;
+    if (SteadyClock::now() < q.deadline) return false;
     const std::string why = "map state " + std::to_string(stamp.snapshot_id) + " (robot '" + h.wait_robot_id +
                             "' applied seq " + std::to_string(applied) + ") did not reach min_snapshot_id " +
                             std::to_string(h.min_snapshot_id) + " / wait_seq " + std::to_string(h.wait_seq) +
@@ -267,7 +268,7 @@ void QueryService::run() {
       // backlog a reader gets the lock about once per scan, so each query taking it alone
       // waited a scan per query (on dev: ~20 answered a second, the rest BUSY).
       std::shared_lock lock(map_.mutex);
-      const auto turn_end = Clock::now() + kReadTurn;
+      const auto turn_end = SteadyClock::now() + kReadTurn;
       for (size_t i = 0; i < parked.size();) {
         if (answer_locked(parked[i], out)) {
           parked[i] = std::move(parked.back());
@@ -276,7 +277,7 @@ void QueryService::run() {
           ++i;
         }
       }
-      while (Clock::now() < turn_end) {
+      while (SteadyClock::now() < turn_end) {
         auto q = clients_.pop();
         if (!q) break;
         if (answer_locked(*q, out)) continue;

@@ -24,10 +24,10 @@
 
 #include "daemon/intake/scan_queue.h"
 #include "daemon/map/map_state.h"
+#include "daemon/queries/grid_publisher.h"
 #include "daemon/queries/query_answers.h"
 #include "daemon/queries/query_clients.h"
 #include "daemon/queries/query_config.h"
-#include "daemon/serving/grid_publisher.h"
 #include "daemon/transport/lcm_loop.h"
 
 namespace ort::daemon {

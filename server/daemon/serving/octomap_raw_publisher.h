@@ -16,10 +16,17 @@
 #include <vector>
 
 #include "daemon/map/map_state.h"
-#include "daemon/server_config.h"
 #include "daemon/transport/lcm_loop.h"
 
 namespace ort::daemon {
+
+// The map for LCM's OctoMap viewers (octomap.raw_t).
+struct OctomapRawConfig {
+  double rate_hz = 0;  // 0: off
+  std::string channel = "OCTOMAP";
+  size_t max_bytes = 0;     // whole message; 0: octomap_raw_default_cap()
+  unsigned min_depth = 10;  // coarsest depth-limited map sent before giving up
+};
 
 // 90 % of net.core.rmem_default: a receiver that keeps the default UDP buffer (Java's LCM
 // cannot raise it; most C programs don't) gets a message only if all of its fragments fit

@@ -6,7 +6,6 @@
 #include <stdexcept>
 
 #include "core/clock.h"
-#include "daemon/persistence/map_store.h"
 #include "octomap_rt/map_chunk_t.hpp"
 #include "protocol/map_protocol.h"
 #include "protocol/zstd_codec.h"
@@ -17,12 +16,16 @@ namespace {
 using Chunk = octomap_rt::map_chunk_t;
 
 std::string serialize(const octomap::OcTree& tree, int8_t format) {
-  if (format == Chunk::FORMAT_OCTOMAP_FULL) return serialize_map(tree);
+  std::ostringstream out(std::ios::binary);
+  if (format == Chunk::FORMAT_OCTOMAP_FULL) {
+    // The same bytes as a saved map (AbstractOcTree::write, with log-odds).
+    if (!tree.write(out)) throw std::runtime_error("could not serialize the map");
+    return std::move(out).str();
+  }
   if (format != Chunk::FORMAT_OCTOMAP_BINARY) throw std::invalid_argument("unknown snapshot format");
   // OcTree::writeBinary (what OctoMap's .bt files are) first turns the tree to maximum
   // likelihood and prunes it: do that on a copy, the served copy stays as it is.
   octomap::OcTree ml(tree);
-  std::ostringstream out;
   ml.writeBinary(out);
   return std::move(out).str();
 }

@@ -11,7 +11,7 @@
 
 #include <octomap/OcTree.h>
 
-#include "daemon/persistence/applied_order.h"
+#include "daemon/map/applied_order.h"
 
 namespace ort::daemon {
 

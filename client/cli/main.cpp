@@ -1,0 +1,27 @@
+// octomap-rt: the command-line client of octomap-rt.
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"octomap-rt: GPU-accelerated OctoMap building, and the client of octomap-rt-server"};
+  app.require_subcommand(1);
+  ort::cli::register_build_command(app);
+  ort::cli::register_replay_command(app);
+  ort::cli::register_bench_command(app);
+  ort::cli::register_render_command(app);
+  ort::cli::register_status_command(app);
+  ort::cli::register_query_command(app);
+  ort::cli::register_map_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::cerr << "octomap-rt: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

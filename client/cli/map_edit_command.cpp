@@ -1,0 +1,63 @@
+// `octomap-rt map clear-box|reset` (next to map get/info/watch/diff): edit a running server's map (applied in order with the
+// scans; the server must run with --control-token and the request carry it).
+#include <unistd.h>
+
+#include <iostream>
+#include <memory>
+
+#include "cli/commands.h"
+#include "cli/lcm_url.h"
+#include "octomap_rt/map_edit_t.hpp"
+#include "query_client/query_args.h"
+#include "query_client/query_client.h"
+#include "query_client/query_json.h"
+
+namespace ort::cli {
+namespace {
+
+struct EditArgs {
+  std::string lcm_url, token, box, to = "free";
+  double timeout_s = 10;
+  bool json = false;
+};
+
+void run_edit(const EditArgs& a, int8_t op) {
+  client::Box b{};
+  if (op != octomap_rt::map_edit_t::OP_RESET) b = client::parse_box(a.box);
+  client::QueryClient c(client_lcm_url(a.lcm_url), "cli-" + std::to_string(::getpid()),
+                        std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)));
+  const auto ack = c.edit(op, b, a.token);
+  if (a.json) client::write_edit_json(std::cout, ack);
+  if (ack.status != 0) {
+    std::cerr << "octomap-rt map: " << client::status_name(ack.status) << ": " << ack.error << "\n";
+    std::exit(2);
+  }
+  if (!a.json) std::cout << "applied; the map holds it from map state " << ack.snapshot_id << "\n";
+}
+
+void add_common(CLI::App* cmd, EditArgs& a) {
+  cmd->add_option("--token", a.token, "the server's --control-token")->required();
+  cmd->add_option("--lcm-url", a.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else the host-local udpm URL)");
+  cmd->add_option("--timeout", a.timeout_s, "seconds to wait for the acknowledgement")->capture_default_str();
+  cmd->add_flag("--json", a.json, "one JSON document on stdout");
+}
+
+}  // namespace
+
+void add_map_edit_commands(CLI::App* cmd) {
+  auto clear = std::make_shared<EditArgs>();
+  auto* c = cmd->add_subcommand("clear-box", "set every voxel of a box free, or unknown");
+  add_common(c, *clear);
+  c->add_option("box", clear->box, "MINX,MINY,MINZ:MAXX,MAXY,MAXZ [m]")->required();
+  c->add_option("--to", clear->to, "free or unknown")->check(CLI::IsMember({"free", "unknown"}))->capture_default_str();
+  c->callback([clear] {
+    run_edit(*clear, clear->to == "free" ? octomap_rt::map_edit_t::OP_CLEAR_TO_FREE
+                                         : octomap_rt::map_edit_t::OP_CLEAR_TO_UNKNOWN);
+  });
+  auto reset = std::make_shared<EditArgs>();
+  auto* r = cmd->add_subcommand("reset", "empty the whole map");
+  add_common(r, *reset);
+  r->callback([reset] { run_edit(*reset, octomap_rt::map_edit_t::OP_RESET); });
+}
+
+}  // namespace ort::cli

@@ -1,8 +1,0 @@
-# client/query/: the client side of the query service (request/reply over LCM), the 2D
-# grid picture and JSON output: used by `octomap-rt query|map` and client/examples/.
-add_library(octomap_rt_query_client STATIC ${CMAKE_CURRENT_LIST_DIR}/query_client.cpp
-            ${CMAKE_CURRENT_LIST_DIR}/grid_picture.cpp ${CMAKE_CURRENT_LIST_DIR}/query_json.cpp
-            ${CMAKE_CURRENT_LIST_DIR}/query_args.cpp)
-target_include_directories(octomap_rt_query_client PUBLIC ${CMAKE_CURRENT_LIST_DIR}/..)
-target_link_libraries(octomap_rt_query_client PUBLIC octomap_rt_lcmtypes octomap_rt_lcm octomap_rt_render)
-octomap_rt_lcm_handler_sources(octomap_rt_query_client ${CMAKE_CURRENT_LIST_DIR}/query_client.cpp)

@@ -1,0 +1,178 @@
+#include "query_client/query_client.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+
+#include "octomap_rt/box_query_t.hpp"
+#include "octomap_rt/grid_query_t.hpp"
+#include "octomap_rt/map_edit_t.hpp"
+#include "octomap_rt/occupancy_query_t.hpp"
+#include "octomap_rt/ray_query_t.hpp"
+#include "octomap_rt/wire_contract.hpp"
+
+namespace ort::client {
+namespace {
+
+namespace wire = octomap_rt::wire;
+
+int64_t now_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+}  // namespace
+
+QueryClient::QueryClient(const std::string& url, std::string client_id, std::chrono::milliseconds timeout)
+    : lcm_(std::make_unique<lcm::LCM>(url)), client_id_(std::move(client_id)), timeout_(timeout) {
+  if (!lcm_->good()) throw std::runtime_error("LCM could not start on '" + url + "'");
+  reply_channel_ = std::string(wire::kQueryReplyPrefix) + upper(client_id_);
+  // Request ids differ between runs of the same client id (stale replies are ignored).
+  next_request_ = now_us();
+}
+
+QueryClient::~QueryClient() = default;
+
+template <class Request>
+void QueryClient::address(Request& r, const WaitFor& w) {
+  r.utime = now_us();
+  r.request_id = next_request_++;
+  r.min_snapshot_id = w.min_snapshot_id;
+  r.wait_seq = w.robot_id.empty() ? -1 : w.seq;
+  r.wait_robot_id = w.robot_id.empty() ? "" : w.robot_id;
+  r.wait_timeout_ms = w.timeout_ms;
+  r.client_id = client_id_;
+  r.reply_channel = reply_channel_;
+}
+
+template <class Reply, class Request, class Done>
+std::vector<Reply> QueryClient::exchange(const std::string& channel, Request& request, Done&& done) {
+  std::vector<Reply> replies;
+  struct Sink {
+    std::vector<Reply>* out;
+    int64_t id;
+    void on(const lcm::ReceiveBuffer* rb, const std::string&) {
+      Reply r;
+      try {
+        if (r.decode(rb->data, 0, static_cast<int>(rb->data_size)) < 0) return;
+      } catch (const std::exception&) {
+        return;  // not ours or corrupt: ignored
+      }
+      if (r.request_id == id) out->push_back(std::move(r));
+    }
+  } sink{&replies, request.request_id};
+  lcm::Subscription* sub = lcm_->subscribe(reply_channel_, &Sink::on, &sink);
+  sub->setQueueCapacity(4096);
+  lcm_->publish(channel, &request);
+  const auto deadline = std::chrono::steady_clock::now() + timeout_;
+  while (!done(replies)) {
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) {
+      lcm_->unsubscribe(sub);
+      throw QueryTimeout("no complete reply on " + reply_channel_ + " within " + std::to_string(timeout_.count()) +
+                         " ms (is octomap-rt-server running on this LCM URL?)");
+    }
+    lcm_->handleTimeout(static_cast<int>(std::min<int64_t>(left.count(), 100)));
+  }
+  lcm_->unsubscribe(sub);
+  return replies;
+}
+
+namespace {
+template <class Reply>
+bool one(const std::vector<Reply>& r) {
+  return !r.empty();
+}
+}  // namespace
+
+octomap_rt::occupancy_reply_t QueryClient::points(const std::vector<float>& xyz, int depth, const WaitFor& w) {
+  octomap_rt::occupancy_query_t q{};
+  address(q, w);
+  q.depth = depth;
+  q.xyz = xyz;
+  q.num_xyz = static_cast<int32_t>(xyz.size());
+  return exchange<octomap_rt::occupancy_reply_t>(wire::kQueryChannel, q, one<octomap_rt::occupancy_reply_t>).front();
+}
+
+octomap_rt::ray_reply_t QueryClient::rays(const std::vector<float>& origins, const std::vector<float>& directions,
+                                          float max_range, bool ignore_unknown, const WaitFor& w) {
+  octomap_rt::ray_query_t q{};
+  address(q, w);
+  q.ignore_unknown = ignore_unknown;
+  q.max_range = max_range;
+  q.origin_xyz = origins;
+  q.direction_xyz = directions;
+  q.num_xyz = static_cast<int32_t>(origins.size());
+  return exchange<octomap_rt::ray_reply_t>(wire::kQueryRaysChannel, q, one<octomap_rt::ray_reply_t>).front();
+}
+
+octomap_rt::box_reply_t QueryClient::boxes(const std::vector<Box>& boxes, int8_t mode, const WaitFor& w) {
+  octomap_rt::box_query_t q{};
+  address(q, w);
+  q.mode = mode;
+  for (const Box& b : boxes)
+    q.boxes.insert(q.boxes.end(), {b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]});
+  q.num_values = static_cast<int32_t>(q.boxes.size());
+  return exchange<octomap_rt::box_reply_t>(wire::kQueryBoxesChannel, q, one<octomap_rt::box_reply_t>).front();
+}
+
+std::vector<octomap_rt::region_chunk_t> QueryClient::region(const Box& b, int depth, bool include_free,
+                                                            const WaitFor& w) {
+  octomap_rt::box_query_t q{};
+  address(q, w);
+  q.mode = octomap_rt::box_query_t::MODE_REGION;
+  q.depth = depth;
+  q.include_free = include_free;
+  q.boxes = {b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]};
+  q.num_values = 6;
+  auto chunks = exchange<octomap_rt::region_chunk_t>(wire::kQueryBoxesChannel, q, [](const auto& r) {
+    return !r.empty() && (r[0].status != 0 || static_cast<int>(r.size()) >= r[0].num_chunks);
+  });
+  std::sort(chunks.begin(), chunks.end(), [](const auto& a, const auto& b) { return a.chunk_index < b.chunk_index; });
+  return chunks;
+}
+
+Grid QueryClient::grid(double z_min, double z_max, double cell_size, const Box* window, const WaitFor& w) {
+  octomap_rt::grid_query_t q{};
+  address(q, w);
+  q.z_min = z_min, q.z_max = z_max, q.cell_size = cell_size;
+  q.use_window = window != nullptr;
+  if (window) {
+    q.window_min[0] = window->min[0], q.window_min[1] = window->min[1];
+    q.window_max[0] = window->max[0], q.window_max[1] = window->max[1];
+  }
+  auto rows = exchange<octomap_rt::grid_t>(wire::kQueryGridChannel, q, [](const auto& r) {
+    return !r.empty() && (r[0].status != 0 || static_cast<int>(r.size()) >= r[0].num_chunks);
+  });
+  Grid g;
+  g.header = rows.front();
+  g.header.cells.clear();
+  g.header.num_cells = 0;
+  if (g.header.status != 0) return g;
+  g.cells.assign(size_t(g.header.width) * g.header.height, 0);
+  for (const auto& r : rows)
+    std::copy(r.cells.begin(), r.cells.end(), g.cells.begin() + size_t(r.row_start) * g.header.width);
+  return g;
+}
+
+octomap_rt::map_edit_ack_t QueryClient::edit(int8_t op, const Box& b, const std::string& token) {
+  octomap_rt::map_edit_t e{};
+  e.utime = now_us();
+  e.request_id = next_request_++;
+  e.op = op;
+  std::copy(b.min, b.min + 3, e.box_min);
+  std::copy(b.max, b.max + 3, e.box_max);
+  e.client_id = client_id_;
+  e.reply_channel = reply_channel_;
+  e.token = token;
+  return exchange<octomap_rt::map_edit_ack_t>(wire::kMapEditChannel, e, one<octomap_rt::map_edit_ack_t>).front();
+}
+
+}  // namespace ort::client
