@@ -17,3 +17,6 @@ if(dynamicEDT3D_FOUND)
 else()
   message(WARNING "octomap-rt: libdynamicedt3d-dev not found: distance_test runs without its DynamicEDTOctomap check")
 endif()
+
+set_property(TEST distance_test APPEND PROPERTY LABELS data)
+set_property(TEST distance_test APPEND PROPERTY LABELS slow)

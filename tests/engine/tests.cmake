@@ -20,3 +20,6 @@ octomap_rt_add_test(engine_pipeline_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/pipel
 
 # Issue 21: rays OctoMap's walk cannot take (degenerate but finite fields) on every back end.
 octomap_rt_add_test(engine_degenerate_rays_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/degenerate_rays_test.cpp)
+
+set_property(TEST engine_cli_parity_test engine_pipeline_test APPEND PROPERTY LABELS data)
+set_property(TEST engine_far_flung_test engine_pipeline_test APPEND PROPERTY LABELS slow)

@@ -32,3 +32,7 @@ octomap_rt_add_test(gpu_prepare_test SOURCES ${GPU_TEST_DIR}/gpu_prepare_test.cp
 octomap_rt_add_test(gpu_distance_test SOURCES ${GPU_TEST_DIR}/gpu_distance_test.cpp
                     ${CMAKE_CURRENT_SOURCE_DIR}/query/query_test_maps.cpp
                     LIBS octomap_rt_gpu octomap_rt_distance TIMEOUT 600)
+
+set_property(TEST gpu_prepare_test gpu_rt_parity_test gpu_distance_test APPEND PROPERTY LABELS data)
+set_property(TEST gpu_traversal_test gpu_rt_parity_test gpu_ray_space_test gpu_prepare_test gpu_distance_test
+             APPEND PROPERTY LABELS slow)

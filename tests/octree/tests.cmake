@@ -25,3 +25,6 @@ octomap_rt_add_test(forgetting_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/decay_test.cpp ${CMAKE_CURRENT_LIST_DIR}/distance_clearing_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp
   TIMEOUT 300)
+
+set_property(TEST octree_test region_test forgetting_test APPEND PROPERTY LABELS data)
+set_property(TEST octree_test APPEND PROPERTY LABELS slow)

@@ -10,3 +10,6 @@ octomap_rt_add_test(query_test
           ${CMAKE_CURRENT_LIST_DIR}/map_edit_test.cpp
   LIBS octomap_rt_query
   TIMEOUT 600)
+
+set_property(TEST query_test APPEND PROPERTY LABELS data)
+set_property(TEST query_test APPEND PROPERTY LABELS slow)
