@@ -1,20 +1,19 @@
 // jemalloc's start-up options for the programs that build maps in batches (octomap-rt build
 // and bench, the octree bench), compiled into each through the octomap_rt_huge_pages CMake
-// target. Not into the daemon: with these options its end-to-end p99 rose on the H200
-// (skt-corridor, 3 producers x 100 Hz: 11.8 -> 15.7 ms while mapping new space, and in steady
-// state the LCM thread fell behind: 469 datagrams dropped), as its 3 MB scan messages,
-// allocated and freed hundreds of times a second, were refaulted as 2 MiB pages.
+// target. Not into the daemon: with these options its end-to-end p99 rose on the H200 and in
+// steady state its LCM thread fell behind (datagrams dropped), as its 3 MB scan messages,
+// allocated and freed hundreds of times a second, were refaulted as 2 MiB pages
+// (docs/history/benchmarks-log.md, "main on the GPU machine, and jemalloc's huge pages").
 // jemalloc reads this string before main (jemalloc(3), "malloc_conf"); /etc/malloc.conf and
 // the MALLOC_CONF environment variable are read after it and override it, e.g.
 // MALLOC_CONF=thp:default,metadata_thp:disabled turns huge pages off again.
 //
 // Why huge pages: OcTree's nodes and child arrays (OctoMap allocates each with `new`) are
 // scattered over the heap and the octree stage hops from node to node, so far fewer TLB
-// entries cover the tree on 2 MiB pages (our reading; not profiled). Measured: with them the
-// H200's octree stage went from 798 to 459-493 ms on campus (149 to 133-159 ms on fr079, within
-// its noise) and campus's voxel-list copy from 320 to 131-149 ms
-// (docs/BENCHMARKS.md, "Performance (issue 12)"), while OctoMap's own time in the same
-// process did not change. With the kernel's THP mode `madvise` (the Debian and Ubuntu
+// entries cover the tree on 2 MiB pages (our reading; not profiled). Measured on the H200: the
+// octree stage and the voxel-list copy on campus took markedly less time with them, fr079's
+// octree stage changed within its noise, and OctoMap's own time in the same process did not
+// change (the same section of the log). With the kernel's THP mode `madvise` (the Debian and Ubuntu
 // default) jemalloc asks for them with madvise; with `never` this is a no-op. The cost is
 // memory: a 2 MiB page is backed whole once touched, a few MiB a process.
 

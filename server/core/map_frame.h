@@ -1,7 +1,6 @@
 // Sensor-frame points into the map frame, exactly as OctoMap's Pointcloud::transform does it
 // (Pose6D::transform per point, OctoMap's own float quaternion arithmetic), but on several
-// threads. OctoMap's version rotates one point at a time on one thread (~50 ns a point);
-// on a 16-core machine with a GPU doing the rays, that single-threaded transform is a large
+// threads. OctoMap's version rotates one point at a time on one thread; on a 16-core machine with a GPU doing the rays, that single-threaded transform is a large
 // share of a scan's time. Each point is independent, so splitting the array changes nothing
 // in the result: tests compare both bit for bit.
 #pragma once
@@ -19,7 +18,7 @@ namespace ort {
 // Pose6D::transform inlined: rot.rotate(v) + trans, rotate = (q * (0, v)) * q.inv(), with
 // OctoMap 1.9.7's Quaternion::operator* term for term (float, left to right) and inv() =
 // (u, -x, -y, -z). The same IEEE operations in the same order, so bit for bit OctoMap's
-// result (the build contracts nothing into FMAs: no -march); ~10x cheaper than the library's
+// result (the build contracts nothing into FMAs: no -march), without the library's
 // out-of-line calls and temporaries.
 class MapFrameTransform {
  public:

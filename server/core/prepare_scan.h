@@ -57,7 +57,7 @@ bool prepare_origin(const octomap::point3d& origin, double resolution, RayBatch&
 // OctoMap's coordToKeyChecked for a tree of the given resolution (depth 16): the same
 // expression, floor(resolution_factor * coord) in double with resolution_factor = 1.0 /
 // resolution, and the same range. Inline, with the floor done by truncation (std::floor is a
-// libm call without SSE4.1, ~10 ns a coordinate, and this runs for every point and ray end):
+// libm call without SSE4.1, and this runs for every point and ray end):
 // for v in [-32768, 32768), floor(v) = trunc(v) - (trunc(v) > v), exactly.
 inline bool coord_to_key_checked(const octomap::point3d& p, double resolution, octomap::OcTreeKey& key) {
   constexpr int kTreeMaxVal = 32768;  // OctoMap depth 16

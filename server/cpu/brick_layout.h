@@ -9,7 +9,7 @@
 // A window small enough for one core's L2 (kRowsUpTo voxels) is laid out row by row instead (x
 // fastest, each row whole words, words of 16 x 1 x 1): there the bricks' locality buys nothing,
 // and the AVX2 walk keeps a row-by-row index with one add a step instead of the bricks' 16
-// operations (skt-corridor 0.1's windows, 5 K-250 K voxels: -10 to -19 % of the walk's CPU).
+// operations (docs/history/benchmarks-log.md, the cpu-grid walk's sections).
 #pragma once
 
 #include <cstdint>

@@ -241,10 +241,10 @@ class CpuGridBackend final : public RayBackend {
   }
 
   // The walk's touched words into `out`. On the caller's thread unless the window touched
-  // more than CpuGridOptions::compact_alone_up_to_words: measured on 2 cores, compacting
-  // fr079-real's ~30 K words a window on two threads took 85-115 ms over 66 windows against
-  // 31-42 ms on one (a thread started per window, half of the words last written on the other
-  // core, a helper at the lowest priority waited for).
+  // more than CpuGridOptions::compact_alone_up_to_words: measured on 2 cores, compacting a
+  // window of a few ten thousand words took longer on two threads than on one (a thread
+  // started per window, half of the words last written on the other core, a helper at the
+  // lowest priority waited for).
   void compact_window(const BrickLayout& layout, unsigned n_threads, const std::vector<std::vector<uint32_t>>& touched,
                       VoxelList& out, ShootStats& stats) {
     size_t words = 0;

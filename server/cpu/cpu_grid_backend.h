@@ -1,8 +1,8 @@
 // The `cpu-grid` back end: the paper's shared ray space, on the CPU. Worker threads walk the
 // rays (OctoMap's exact DDA, or the exact closed-box traversal) into a persistent grid of
 // 2-bit voxel states with atomic OR, list the words they touch first, and compact those words
-// into the voxel list, clearing them as they go. It replaces OctoMap's hash-set inserts
-// (~30 ns a voxel visit) with a bit set in a dense word, for machines without a GPU.
+// into the voxel list, clearing them as they go. It replaces OctoMap's hash-set inserts (one
+// per voxel visit) with a bit set in a dense word, for machines without a GPU.
 #pragma once
 
 #include <memory>

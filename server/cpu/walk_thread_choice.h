@@ -3,13 +3,13 @@
 // beside it): the caller's thread alone, or all the walk's threads.
 //
 // Why: the helper threads run at the lowest priority so that they take only what the other
-// stage leaves idle. Where that stage is light (skt-corridor: octree 30-40 ms against a walk of
-// ~600 ms) a helper gets most of a core and nearly halves the walk. Where it is heavy
-// (fr079-real on 2 cores: ~400 ms of octree CPU against a walk of ~650), or another program
-// takes the cores, a helper gets little CPU, the caller waits for the helper's last chunk at
-// every window's join, and two threads marking one grid pass its cache lines between the
-// cores: measured, the walk then took 25-60 % more CPU and stage 1 longer than the caller
-// walking alone (docs/BENCHMARKS.md, issue 12, fifth session). The balance moves with the data
+// stage leaves idle. Where that stage is light (skt-corridor: a short octree stage beside a
+// long walk) a helper gets most of a core and nearly halves the walk. Where it is heavy
+// (fr079-real on 2 cores), or another program takes the cores, a helper gets little CPU, the
+// caller waits for the helper's last chunk at every window's join, and two threads marking
+// one grid pass its cache lines between the cores: measured, the walk then took more CPU and
+// stage 1 longer than the caller walking alone (docs/history/benchmarks-log.md, "the cpu-grid
+// walk beside the octree stage on two cores"). The balance moves with the data
 // and with whatever else runs, so it is measured where it happens: after a window walked with
 // helpers, the CPU time they got per wall-clock millisecond of the walk (their share of a
 // core). Helpers that got at least kWorthFrom of a core keep walking; below it the caller

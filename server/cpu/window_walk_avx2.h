@@ -1,7 +1,7 @@
 // OctoMap's DDA on four rays at once (AVX2, 64-bit lanes), for the cpu-grid back end.
 //
 // Why: the scalar walk's axis choice is a data-dependent branch that mispredicts often, and
-// after the bricked grid the DDA itself was ~75 % of the walk. Here each lane takes the same
+// after the bricked grid the DDA itself was most of the walk. Here each lane takes the same
 // double comparisons and additions as octomap_ray_walk.h (the axis choice as masks, the same
 // three stop tests), so each ray visits the same keys; only the order of the marks differs,
 // which the 2-bit OR does not see. Used only where the CPU says it has AVX2 (checked at run

@@ -123,8 +123,8 @@ class MappingServer {
   std::chrono::steady_clock::time_point leaves_time_;
   std::atomic<int64_t> leaves_version_{-1};    // map version of cached_leaves_
   std::atomic<bool> pipeline_drained_{false};  // set by stop() once the pipeline is joined
-  // Maps up to this size have their leaves counted at every status (under ~1.5 ms of the map
-  // lock on the dev machine).
+  // Maps up to this size have their leaves counted at every status (a short hold of the map
+  // lock even on the 2-core dev machine).
   static constexpr size_t kLeafWalkEveryStatus = 65'536;
   DegradedTracker degraded_;  // used by the status thread only
   std::thread status_thread_, save_thread_;

@@ -30,8 +30,8 @@ StatusInputs MappingServer::gather_status() {
   in.resolution = cfg_.engine.resolution;
   {
     // size() is O(1); the leaf count (and memoryUsage(), which needs it) walks the whole
-    // tree under the map lock, stalling stage 2 for the whole walk (4-13 ms for 600K nodes
-    // on the dev machine: at 300 scans/s a few scans' end-to-end time each second). So it is
+    // tree under the map lock, stalling stage 2 for the whole walk (at 300 scans/s, several
+    // scans' end-to-end time each second on big maps). So it is
     // walked only when the map changed, and then on maps above kLeafWalkEveryStatus nodes at
     // most every 10 s while scans are applied, and once more when the pipeline has drained
     // (the summary's figures are exact); memory comes from the cached leaf count with

@@ -159,10 +159,9 @@ ServerConfig to_server_config(const ServerFlags& f) {
   // scan, small here, comes straight into host memory (one fence wait less a scan).
   c.engine.shoots_beside_apply = c.pipeline;
   // ... and, in a daemon, more: its LCM thread receives and decodes the scans (300 RGB-D
-  // scans/s = 930 MB/s) beside the kernel's network work. On the H200 (16 hardware threads)
-  // 12 octree workers instead of 15 took the p99 of stage 2 over runs mapping new space from
-  // 2.4-6.4 ms to 1.9-2.8 ms, end to end from 5.7-10.0 ms to 5.2-6.9 ms (docs/BENCHMARKS.md,
-  // issue 12, fourth session).
+  // scans/s = 930 MB/s) beside the kernel's network work: on the H200, 12 octree workers
+  // instead of 15 shortened stage 2's p99 and the end-to-end p99 (docs/history/benchmarks-log.md,
+  // the fourth session's daemon).
   c.engine.spare_threads = 4;
   c.engine.backend.compact_into_host_memory = true;
   c.engine.max_scan_walk_keys = f.max_scan_work;

@@ -7,8 +7,8 @@
 // VK_PHYSICAL_DEVICE_TYPE_CPU): both then run the same walk into the same 2-bit grid on the
 // same cores, lavapipe through a JIT-compiled shader and a driver (staging copies,
 // submissions, atomics on a storage buffer), the native one with no driver in between.
-// Measured on the 2-core dev machine (docs/BENCHMARKS.md, "Performance (issue 12)"), the
-// native walk needs less CPU time for the same scans. A timing probe at start-up was not
+// Measured on the 2-core dev machine (docs/history/benchmarks-log.md, "Performance (issue
+// 12)"), the native walk needs less CPU time for the same scans. A timing probe at start-up was not
 // taken: on a shared machine it measures the neighbours' load as much as the back ends, and
 // the device type decides the same question deterministically.
 #include "engine/backend_factory.h"

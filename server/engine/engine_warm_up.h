@@ -4,7 +4,7 @@
 // first submissions, the octree stage's threads and buffers made on first use (octree/
 // octree_update.h: OctreeStage), the first touch of their pages. In a daemon the scans that
 // arrive meanwhile queue behind it, so a p99 over a run that starts on a fresh daemon carries
-// those costs several times (docs/BENCHMARKS.md, issue 12). The map is untouched: the scan
+// those costs several times (docs/history/benchmarks-log.md, "warm-up at start"). The map is untouched: the scan
 // goes to a tree of its own, and the GPU grid is clear again after every shot.
 #pragma once
 

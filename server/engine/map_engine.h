@@ -37,7 +37,7 @@ struct EngineOptions {
   // (engine/engine_pipeline.h). With a device back end (vulkan, rt), octree.threads = 0 and
   // at least kSpareCoreAbove hardware threads, the octree stage then keeps one hardware
   // thread free for that stage-1 thread: with a worker on every core, stage 1 preempts one
-  // and the others wait for it at each of the stage's joins (docs/BENCHMARKS.md, issue 12).
+  // and the others wait for it at each of the stage's joins (docs/history/benchmarks-log.md).
   bool shoots_beside_apply = false;
   // The hardware threads the octree stage then leaves to others (at most half of them): 1,
   // stage 1's, in bench and build. The daemon leaves more (its LCM thread receives and
@@ -46,9 +46,9 @@ struct EngineOptions {
   // Set by the batch programs (bench, build) beside shoots_beside_apply. With the cpu-grid
   // back end and both thread counts at 0, the octree stage takes half the hardware threads
   // (at least one) and the walk all of them, its helper threads at the lowest priority: the
-  // walk then has a core of its own and the octree stage's idle ones. On 2 cores this took
-  // fr079-real from 1.06-1.25 s to 0.73 s and fr079 0.1 from 197-243 to 166-210 ms, where one
-  // thread a stage lost 27-60 % on the sets stage 1 dominates (docs/BENCHMARKS.md, issue 12).
+  // walk then has a core of its own and the octree stage's idle ones: on 2 cores the sets that
+  // stage 1 dominates ran faster than with one thread a stage (docs/history/benchmarks-log.md,
+  // "the cpu-grid walk").
   // Not for the daemon: a helper starved by other processes would hold up a scan.
   bool stage1_helpers_yield = false;
 };

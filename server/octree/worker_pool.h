@@ -3,7 +3,7 @@
 // because starting 16 threads per scan costs about as much as a small scan's update.
 //
 // One scan's update is five jobs back to back (four bucketing passes, then the subtrees)
-// with short serial steps between them, each job ~0.1-1 ms on 16 threads. So a thread that
+// with short serial steps between them, each job short on 16 threads. So a thread that
 // finished a job first spins on the job counter for a short while (the next job of the same
 // scan usually comes within it) and only then sleeps on a futex (std::atomic::wait); run()
 // wakes every sleeper with one notify and waits for the last one the same way. Spinning

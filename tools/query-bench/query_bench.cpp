@@ -256,7 +256,7 @@ int64_t send_all(lcm::LCM& lc, Queries& make, Ledger& ledger, const Options& o) 
 int main(int argc, char** argv) {
   CLI::App app{
       "octomap-rt-query-bench: latency of point, ray and box queries against a running octomap-rt-server, "
-      "sent open loop at a fixed rate (docs/BENCHMARKS.md \"Queries (issue 11)\")"};
+      "sent open loop at a fixed rate (docs/BENCHMARKS.md \"Queries\")"};
   Options o;
   app.add_option("--graph", o.graph, "scan graph the queries are drawn from (the producers' scans)")->required();
   app.add_option("--lcm-url", o.lcm_url, "LCM URL")->capture_default_str();

@@ -1,7 +1,7 @@
 // Decoding a scan_t on the LCM thread without LCM's per-float loop. LCM's generated decode
 // assembles each float of the point array from four bytes (and the content check then tests
-// each for finiteness one by one): ~2.5 ms of the LCM thread for a 257K-point RGB-D scan on
-// the dev machine, inside every scan's end-to-end time. Here the fixed fields and the strings
+// each for finiteness one by one), on the LCM thread, inside every scan's end-to-end time
+// (the log's "the daemon's host work on a scan"). Here the fixed fields and the strings
 // are still decoded by LCM's own code, and only the point array is byte-swapped in blocks the
 // compiler vectorizes; the values are the same bit for bit (NaN payloads included).
 #pragma once

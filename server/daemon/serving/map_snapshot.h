@@ -22,8 +22,8 @@ struct MapCopy {
   double lock_ms = 0;           // how long the copy held the map lock
 };
 
-// Copies the map under its lock. OcTree's copy constructor holds the lock about half as
-// long as serializing would (measured on a 400k-node map: 52-85 ms vs 89-98 ms).
+// Copies the map under its lock. OcTree's copy constructor holds the lock for less time than
+// serializing would (docs/BENCHMARKS.md, "Serving the map").
 MapCopy copy_map(MapState& map);
 // The same, unless the map's version is still `unchanged_since` (then nothing is copied).
 std::optional<MapCopy> copy_map_if_changed(MapState& map, uint64_t unchanged_since);

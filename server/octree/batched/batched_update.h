@@ -24,9 +24,9 @@
 // subtree the list updates one way (8^k keys, one state: free space near a LiDAR, mostly) is
 // made a leaf of value + update at once: OctoMap's loop creates or expands its 8^k leaves,
 // each value + update (none if v is at the bound), and prunes them back level by level into
-// that same leaf (subtree_update.cpp). On campus-like scans (~7.7 M voxels a scan, most in new
-// space) about 31 % of the voxels lie in such blocks of 8 or more; on fr079 (66 scans) 6.8 %
-// in new space and 9.1 % inside pruned leaves not at the bound.
+// that same leaf (subtree_update.cpp). Scans that map much new space (campus-like LiDAR) have a
+// large share of their voxels in such blocks (docs/history/benchmarks-log.md, "full blocks made
+// at once").
 //
 // Trees with change detection on (enableChangeDetection) go through the plain updateNode
 // loop, which also records the changed keys.
