@@ -26,5 +26,10 @@ octomap_rt_add_test(forgetting_test
           ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp
   TIMEOUT 300)
 
-set_property(TEST octree_test region_test forgetting_test APPEND PROPERTY LABELS data)
+# The memory bound's spill and restore on real scans: a map built with regions spilled and
+# brought back is, once everything is back, the map built without the bound.
+octomap_rt_add_test(eviction_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/eviction_test.cpp ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp
+  TIMEOUT 300)
+
+set_property(TEST octree_test region_test forgetting_test eviction_test APPEND PROPERTY LABELS data)
 set_property(TEST octree_test APPEND PROPERTY LABELS slow)

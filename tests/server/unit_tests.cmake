@@ -51,3 +51,6 @@ add_dependencies(server_flags_test octomap-rt-server)
 # Issue 24: an organised cloud with NaN no-returns (a range image of a real scan), every back end.
 octomap_rt_add_test(server_organised_cloud_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/organised_cloud_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
+# The memory bound's region store: crash-safe puts (kill -9), lock, bound, full disk.
+octomap_rt_add_test(region_store_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/region_store_test.cpp ${SERVER_TEST_FIXTURES}
+                    LIBS octomap_rt_daemon TIMEOUT 120)

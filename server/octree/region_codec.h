@@ -1,0 +1,54 @@
+// A region's subtree as bytes, for the memory bound's spill to disk (issue 25): eviction
+// keeps the region's root node in the tree as a childless stand-in holding its value (the max
+// of its subtree, which is what it held before), so every node above stays as it was, and
+// moves the nodes below it into bytes; restoring puts them back node for node.
+//
+// Format (little-endian): "ORTR" magic, u32 version (1), u64 region id, u32 region depth,
+// u64 node count, u64 FNV-1a-64 of the body, then the body: the subtree in pre-order, each
+// node a float log-odds and a byte of child bits (bit i: child i follows).
+//
+// A region in stand-in form must be restored before anything reads or changes its voxels:
+// the stand-in looks like one coarse leaf to OctoMap's code.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <stdexcept>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "octree/region.h"
+
+namespace ort {
+
+class RegionCodecError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// The bytes of region `id`'s subtree (its root at the region depth, which must exist and
+// have children; throws RegionCodecError otherwise).
+std::vector<uint8_t> encode_region(const octomap::OcTree& tree, const RegionGrid& grid, RegionId id);
+
+// Deletes every node below region `id`'s root (the root stays, as a childless stand-in with
+// its value). Returns the nodes freed.
+uint64_t strip_region(octomap::OcTree& tree, const RegionGrid& grid, RegionId id);
+
+// Puts the subtree of `bytes` back below region `id`'s stand-in (a childless node at the
+// region depth). Throws RegionCodecError when the bytes are not a whole region of this id
+// and depth (checksum, sizes, shape) or the stand-in is not there; the tree is then unchanged.
+void restore_region(octomap::OcTree& tree, const RegionGrid& grid, RegionId id, std::span<const uint8_t> bytes);
+
+// The region id and node count in a region's header (RegionCodecError if it is not one).
+struct RegionHeader {
+  RegionId id = 0;
+  unsigned depth = 0;
+  uint64_t nodes = 0;
+};
+RegionHeader read_region_header(std::span<const uint8_t> bytes);
+
+// Checks the header and checksum only.
+bool region_bytes_intact(std::span<const uint8_t> bytes);
+
+}  // namespace ort
