@@ -133,7 +133,7 @@ void MappingServer::start() {
   open_map_serving();  // the delta observer is in place before the first scan is applied
   warm_up_engine();    // before the pipeline's threads use the engine and before the intake opens
   pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, log_, cfg_.pipeline,
-                                             std::chrono::duration<double>(cfg_.latency_bound_s));
+                                             std::chrono::duration<double>(cfg_.latency_bound_s), cfg_.point_filters);
   pipeline_->start();
   upkeep_ = std::make_unique<MapUpkeep>(map_, cfg_.upkeep, log_to(log_));
   upkeep_->start();

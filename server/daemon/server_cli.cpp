@@ -38,6 +38,11 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
   app.add_option("--octomap-raw-channel", s.octomap_raw.channel, "channel of octomap.raw_t")->capture_default_str();
+  app.add_option("--occupancy-min-z,--occupancy_min_z", s.octomap_raw.occupancy_min_z,
+                 "the OCTOMAP map shows occupied cells only above this z [m] (octomap_server's occupancy_min_z; the "
+                 "map of record keeps them; the 2D grid's band is --grid-z)");
+  app.add_option("--occupancy-max-z,--occupancy_max_z", s.octomap_raw.occupancy_max_z,
+                 "... and only below this z [m] (octomap_server's occupancy_max_z)");
   app.add_option("--octomap-raw-max-kib", f.octomap_raw_max_kib,
                  "size cap of one octomap.raw_t [KiB]; a larger map is sent depth-limited, or not at all (said in "
                  "the status); default: 90 % of net.core.rmem_default");
@@ -59,6 +64,7 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
   app.add_option("--query-queue", s.queries.per_client_queue, "queued queries per client; more get BUSY replies")
       ->capture_default_str();
   add_grid_flags(app, s.queries.grid);
+  add_point_filter_flags(app, s.point_filters);
   app.add_option("--latency-bound", s.latency_bound_s,
                  "overload bound [s]: a scan queued longer is dropped ('over latency bound') and the status is "
                  "DEGRADED while the end-to-end p99 exceeds it; 0: never drop for age")
@@ -121,6 +127,28 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                  "Not authentication: LCM has none (see docs/RELIABILITY.md)");
 }
 
+void add_point_filter_flags(CLI::App& app, PointFilters& f) {
+  // Each flag also answers to octomap_server's parameter name, so that a --config file may use
+  // its keys (pointcloud_min_z = 0.1); README, "Connect your robot", has the table.
+  const char* axes[] = {"x", "y", "z"};
+  for (int i = 0; i < 3; ++i) {
+    const std::string a = axes[i];
+    app.add_option(
+        "--pointcloud-min-" + a + ",--pointcloud_min_" + a, f.map_frame.min[i],
+        "drop points whose map-frame " + a + " is below this [m] (octomap_server's pointcloud_min_" + a + ")");
+    app.add_option(
+        "--pointcloud-max-" + a + ",--pointcloud_max_" + a, f.map_frame.max[i],
+        "drop points whose map-frame " + a + " is above this [m] (octomap_server's pointcloud_max_" + a + ")");
+    app.add_option("--sensor-min-" + a, f.sensor_frame.min[i],
+                   "drop points whose " + a + " in the sensor frame is below this [m]");
+    app.add_option("--sensor-max-" + a, f.sensor_frame.max[i],
+                   "drop points whose " + a + " in the sensor frame is above this [m]");
+  }
+  app.add_option("--min-range,--min_range", f.min_range,
+                 "drop points nearer the sensor than this [m] (no ray at all); 0: none")
+      ->capture_default_str();
+}
+
 void add_grid_flags(CLI::App& app, GridPublishConfig& g) {
   auto* z = app.add_option_function<std::string>(
       "--grid-z",
@@ -168,6 +196,9 @@ ServerConfig to_server_config(const ServerFlags& f) {
   if (!(f.queue_mib >= 0 && f.queue_mib <= 1e9)) throw CLI::ValidationError("--queue-mib", "must be a number >= 0");
   c.queue_budget_bytes = static_cast<uint64_t>(f.queue_mib * 1048576.0);
   if (f.octomap_raw_max_kib < 0) throw CLI::ValidationError("--octomap-raw-max-kib", "must be >= 0");
+  if (std::isnan(c.octomap_raw.occupancy_min_z) || std::isnan(c.octomap_raw.occupancy_max_z) ||
+      !(c.octomap_raw.occupancy_min_z < c.octomap_raw.occupancy_max_z))
+    throw CLI::ValidationError("--occupancy-min-z/--occupancy-max-z", "must be numbers with min < max");
   c.octomap_raw.max_bytes = static_cast<size_t>(f.octomap_raw_max_kib * 1024.0);
   if (!(c.status_period_s > 0 && c.status_period_s < 1e6))
     throw CLI::ValidationError("--status-period", "must be a number of seconds > 0");
@@ -179,6 +210,8 @@ ServerConfig to_server_config(const ServerFlags& f) {
     throw CLI::ValidationError("--snapshot-zstd-level", "must be within 0..19");
   if (c.snapshots_kept == 0) throw CLI::ValidationError("--snapshots-kept", "must be > 0");
   if (!(c.chunk_interval_ms >= 0)) throw CLI::ValidationError("--chunk-interval-ms", "must be >= 0");
+  if (const std::string bad = check_point_filters(c.point_filters); !bad.empty())
+    throw CLI::ValidationError("--pointcloud-*/--sensor-*/--min-range", bad);
   if (c.queries.grid.rate_hz > 0) {  // the rule of grid queries (daemon/query_answers)
     octomap_rt::grid_query_t q{};
     q.z_min = c.queries.grid.z_min, q.z_max = c.queries.grid.z_max, q.cell_size = c.queries.grid.cell_size;

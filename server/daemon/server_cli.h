@@ -19,6 +19,8 @@ struct ServerFlags {
 };
 
 void add_server_flags(CLI::App& app, ServerFlags& f);
+// --pointcloud-min/max-x/y/z (map frame), --sensor-min/max-x/y/z, --min-range.
+void add_point_filter_flags(CLI::App& app, PointFilters& f);
 // --grid-rate, --grid-z MIN:MAX, --grid-cell (the grid published on OCTOMAP_RT_GRID).
 void add_grid_flags(CLI::App& app, GridPublishConfig& g);
 // Validates and converts (after parsing); throws CLI::ValidationError with a clear message.

@@ -3,10 +3,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "daemon/map/map_upkeep.h"
+#include "daemon/pipeline/point_filters.h"
 #include "daemon/queries/query_config.h"
 #include "daemon/serving/octomap_raw_publisher.h"
 #include "engine/map_engine.h"
@@ -15,9 +17,10 @@
 namespace ort::daemon {
 
 struct ServerConfig {
-  EngineOptions engine;                                             // resolution, sensor model, max range, back end
-  std::string lcm_url;                                              // "": $LCM_DEFAULT_URL, else host-local udpm
-  uint64_t recv_buf_size = 16u << 20;                               // udpm receive buffer wanted (capped by rmem_max)
+  PointFilters point_filters;          // octomap_server's pass-through and a min range, before preparation
+  EngineOptions engine;                // resolution, sensor model, max range, back end
+  std::string lcm_url;                 // "": $LCM_DEFAULT_URL, else host-local udpm
+  uint64_t recv_buf_size = 16u << 20;  // udpm receive buffer wanted (capped by rmem_max)
   std::string scan_channels = octomap_rt::wire::kScanChannelRegex;  // regex; its literal prefix + robot id
   std::string status_channel = octomap_rt::wire::kStatusChannel;
   std::string map_path;                 // .ot; "": no persistence

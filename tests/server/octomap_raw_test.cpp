@@ -97,5 +97,37 @@ TEST(OctomapRaw, FarTooLargeIsSkippedWithANote) {
   EXPECT_NE(r.note.find("depth 10"), std::string::npos) << r.note;
 }
 
+// Issue 24: octomap_server's occupancy_min_z/max_z on the viewer's copy. Checked leaf by leaf
+// against the tree it came from: occupied leaves stay exactly where their centre is strictly
+// inside the band, every free leaf stays.
+TEST(OctomapRaw, TheOccupancyBandLeavesOutOccupiedCellsOutsideItOnly) {
+  octomap::OcTree tree(0.1);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-3.0f, 3.0f);
+  octomap::Pointcloud cloud;
+  for (int i = 0; i < 3000; ++i) cloud.push_back(u(rng), u(rng), u(rng));
+  tree.insertPointCloud(cloud, octomap::point3d(0, 0, 0));
+  octomap::OcTree band(tree);
+  const double lo = -0.5, hi = 1.2;
+  const size_t dropped = drop_occupied_outside_band(band, lo, hi);
+  size_t expect_dropped = 0;
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    const octomap::OcTreeNode* kept = band.search(it.getKey(), it.getDepth());
+    const bool occupied_outside = tree.isNodeOccupied(*it) && !(it.getZ() > lo && it.getZ() < hi);
+    expect_dropped += occupied_outside;
+    if (!occupied_outside) {
+      ASSERT_NE(kept, nullptr);
+      EXPECT_EQ(kept->getLogOdds(), it->getLogOdds());
+    }
+  }
+  EXPECT_EQ(dropped, expect_dropped);
+  EXPECT_GT(dropped, 100u);
+  for (auto it = band.begin_leafs(), end = band.end_leafs(); it != end; ++it) {
+    if (band.isNodeOccupied(*it)) {
+      EXPECT_TRUE(it.getZ() > lo && it.getZ() < hi) << it.getZ();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ort::daemon

@@ -51,6 +51,11 @@ TEST(ServerFlags, AbsurdNumbersForTheWalkAndTheSensorModelAreRefusedAtStart) {
       {"-r 0.1 --clamp-max 1", "--clamp-max"},
       {"-r 0.1 --clamp-min 0.9 --clamp-max 0.2", "--clamp-min"},
       {"-r 0.1 --occupancy-threshold 1", "--occupancy-threshold"},
+      // Issue 24's filters: inverted or NaN limits, a negative min range, an inverted band.
+      {"-r 0.1 --pointcloud-min-z 2 --pointcloud-max-z 1", "--pointcloud"},
+      {"-r 0.1 --sensor-max-x nan", "--sensor"},
+      {"-r 0.1 --min-range -1", "--min-range"},
+      {"-r 0.1 --occupancy-min-z 3 --occupancy-max-z 1", "--occupancy-min-z"},
   };
   for (const auto& c : cases) {
     const ServerRun r = run_server(c.flags);

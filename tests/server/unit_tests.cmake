@@ -54,3 +54,6 @@ octomap_rt_add_test(server_organised_cloud_test SOURCES ${CMAKE_CURRENT_LIST_DIR
 # The memory bound's region store: crash-safe puts (kill -9), lock, bound, full disk.
 octomap_rt_add_test(region_store_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/region_store_test.cpp ${SERVER_TEST_FIXTURES}
                     LIBS octomap_rt_daemon TIMEOUT 120)
+# Issue 24: octomap_server's filters (map-frame and sensor-frame pass-through, min range) against OctoMap.
+octomap_rt_add_test(server_point_filters_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/point_filters_test.cpp
+                    ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)

@@ -79,9 +79,17 @@ void robots(std::ostringstream& o, const Status& s, int64_t now) {
              with_commas(r.scans_missed).c_str(), r.queue_depth, (long long)r.last_seq, r.last_end_to_end_ms,
              age_text(r.last_scan_utime, now).c_str());
     const size_t n = std::min(r.reject_reason.size(), r.reject_count.size());
-    if (n == 0) continue;
-    o << "    rejected:";
-    for (size_t i = 0; i < n; ++i) o << (i ? ", " : " ") << r.reject_reason[i] << " " << with_commas(r.reject_count[i]);
+    if (n) {
+      o << "    rejected:";
+      for (size_t i = 0; i < n; ++i)
+        o << (i ? ", " : " ") << r.reject_reason[i] << " " << with_commas(r.reject_count[i]);
+      o << "\n";
+    }
+    const size_t d = std::min(r.point_drop_reason.size(), r.point_drop_count.size());
+    if (d == 0) continue;
+    o << "    points without a ray:";
+    for (size_t i = 0; i < d; ++i)
+      o << (i ? ", " : " ") << r.point_drop_reason[i] << " " << with_commas(r.point_drop_count[i]);
     o << "\n";
   }
 }

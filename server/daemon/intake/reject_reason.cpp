@@ -42,6 +42,9 @@ const char* to_string(PointDrop d) {
     case PointDrop::kNonFinite: return "non-finite";
     case PointDrop::kOutsideKeyRange: return "outside key range";
     case PointDrop::kDegenerateRay: return "degenerate ray";
+    case PointDrop::kOutsideSensorBox: return "outside sensor-frame box";
+    case PointDrop::kOutsideMapBox: return "outside map-frame box";
+    case PointDrop::kBelowMinRange: return "below min range";
     case PointDrop::kCount_: break;
   }
   return "unknown";

@@ -26,7 +26,7 @@ void note_robot_seen(MapState& map, const std::string& robot, const octomap::poi
 
 ScanPipeline::ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, ProducerRegistry& producers,
                            PipelineMetrics& metrics, std::ostream& log, bool pipelined,
-                           std::chrono::duration<double> max_queue_age)
+                           std::chrono::duration<double> max_queue_age, const PointFilters& filters)
     : engine_(engine),
       map_(map),
       queue_(queue),
@@ -34,7 +34,8 @@ ScanPipeline::ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, P
       metrics_(metrics),
       log_(log),
       pipelined_(pipelined),
-      max_queue_age_(max_queue_age) {}
+      max_queue_age_(max_queue_age),
+      filters_(filters) {}
 
 void ScanPipeline::set_busy(int stage, bool busy) {
   busy_since_ns_[stage] = busy ? std::max<int64_t>(1, Clock::now().time_since_epoch().count()) : 0;
@@ -94,7 +95,9 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
   bool ok = true;
   try {
     const double max_range = effective_max_range(item.msg.max_range, engine_.options().max_range);
-    if (item.msg.points_frame == octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME) {
+    if (filters_.active()) {
+      job.filtered = shoot_filtered(engine_, item.msg, filters_, max_range, filter_scratch_, job.shot);
+    } else if (item.msg.points_frame == octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME) {
       // The message's floats as they are: a back end preparing on its device copies them
       // straight into its upload buffer (transformed on the GPU where it can).
       const octomap::pose6d pose = scan_pose(item.msg);
@@ -153,11 +156,14 @@ namespace {
 
 // What preparation skipped of a scan's points, by the daemon's reasons (every back end
 // prepares by the same rules: core/prepare_scan.h, shaders/prepare_rays.comp).
-PointDropCounts point_drops(const PrepareReport& r) {
+PointDropCounts point_drops(const PrepareReport& r, const FilterCounts& f) {
   PointDropCounts d{};
   d[static_cast<size_t>(PointDrop::kNonFinite)] = static_cast<int64_t>(r.nonfinite);
   d[static_cast<size_t>(PointDrop::kOutsideKeyRange)] = static_cast<int64_t>(r.out_of_range);
   d[static_cast<size_t>(PointDrop::kDegenerateRay)] = static_cast<int64_t>(r.degenerate);
+  d[static_cast<size_t>(PointDrop::kOutsideSensorBox)] = static_cast<int64_t>(f.outside_sensor_box);
+  d[static_cast<size_t>(PointDrop::kOutsideMapBox)] = static_cast<int64_t>(f.outside_map_box);
+  d[static_cast<size_t>(PointDrop::kBelowMinRange)] = static_cast<int64_t>(f.below_min_range);
   return d;
 }
 
@@ -213,7 +219,7 @@ void ScanPipeline::apply(ShotJob& job) {
   t.new_nodes = new_nodes;
   metrics_.record(t);
   producers_.count_applied(job.producer, static_cast<int64_t>(job.shot.prepare.rays), t.end_to_end_ms,
-                           point_drops(job.shot.prepare));
+                           point_drops(job.shot.prepare, job.filtered));
 }
 
 void ScanPipeline::run_stage1() {

@@ -14,6 +14,7 @@
 #include "daemon/map/map_edit_item.h"
 #include "daemon/map/map_state.h"
 #include "daemon/pipeline/bounded_handoff.h"
+#include "daemon/pipeline/filtered_shoot.h"
 #include "daemon/pipeline/pipeline_metrics.h"
 #include "engine/map_engine.h"
 
@@ -29,6 +30,7 @@ struct ShotJob {
   double shoot_ms = 0;
   octomap::point3d origin;  // the sensor's, in the map frame
   ShotScan shot;
+  FilterCounts filtered;              // points the server's filters removed before preparation
   std::shared_ptr<MapEditItem> edit;  // set: apply this edit instead of a scan
 };
 
@@ -40,7 +42,8 @@ class ScanPipeline {
   // `log` is the daemon's log stream (engine errors, step-guard warnings).
   ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, ProducerRegistry& producers,
                PipelineMetrics& metrics, std::ostream& log, bool pipelined,
-               std::chrono::duration<double> max_queue_age = std::chrono::duration<double>::zero());
+               std::chrono::duration<double> max_queue_age = std::chrono::duration<double>::zero(),
+               const PointFilters& filters = {});
   ~ScanPipeline();
   void start();
   // Call after queue.close(): returns once every queued scan was applied or rejected.
@@ -78,6 +81,8 @@ class ScanPipeline {
   std::atomic<int64_t> engine_errors_{0}, shed_{0};
   int64_t overrun_warnings_ = 0;  // stage 1 only
   std::chrono::duration<double> max_queue_age_;
+  PointFilters filters_;
+  FilterScratch filter_scratch_;                    // stage 1 only
   std::atomic<int64_t> busy_since_ns_[2] = {0, 0};  // steady clock; 0: idle
 };
 

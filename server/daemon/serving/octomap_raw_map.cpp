@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "octree/region_sweep.h"
+
 namespace ort::daemon {
 namespace {
 
@@ -80,6 +82,46 @@ RawMap make_raw_map(const octomap::OcTree& tree, int64_t utime, const RawMapOpti
   r.note = "OCTOMAP map not published: " + kib(raw_message_bytes(bytes.size())) + " even at depth " +
            std::to_string(options.min_depth) + " > cap " + kib(options.max_bytes);
   return r;
+}
+
+namespace {
+
+// Deletes the occupied leaves below `node` (at `depth`, min-corner key `min_key`) whose centre
+// z is outside (lo, hi), keeping inner values the max of their children; true when `node`
+// is left without children (its parent then deletes it, as OctoMap's deleteNode would).
+bool drop_below(octomap::OcTree& tree, octomap::OcTreeNode* node, unsigned depth, const octomap::OcTreeKey& min_key,
+                double lo, double hi, size_t& dropped) {
+  for (unsigned i = 0; i < 8; ++i) {
+    if (!tree.nodeChildExists(node, i)) continue;
+    octomap::OcTreeNode* child = tree.getNodeChild(node, i);
+    const octomap::OcTreeKey key = child_min_key(min_key, depth, i);
+    if (!tree.nodeHasChildren(child)) {
+      const double z = tree.keyToCoord(key[2], depth + 1);
+      if (tree.isNodeOccupied(child) && !(z > lo && z < hi)) delete_subtree(tree, node, i), ++dropped;
+    } else if (drop_below(tree, child, depth + 1, key, lo, hi, dropped)) {
+      delete_subtree(tree, node, i);
+    }
+  }
+  if (!tree.nodeHasChildren(node)) {
+    free_empty_child_array(node);
+    return true;
+  }
+  node->updateOccupancyChildren();
+  return false;
+}
+
+}  // namespace
+
+size_t drop_occupied_outside_band(octomap::OcTree& tree, double min_z, double max_z) {
+  size_t dropped = 0;
+  octomap::OcTreeNode* root = tree.getRoot();
+  if (!root) return 0;
+  if (!tree.nodeHasChildren(root)) {  // a map of one leaf: the root itself
+    if (tree.isNodeOccupied(root) && !(0.0 > min_z && 0.0 < max_z)) tree.clear(), dropped = 1;
+    return dropped;
+  }
+  if (drop_below(tree, root, 0, octomap::OcTreeKey(0, 0, 0), min_z, max_z, dropped)) tree.clear();
+  return dropped;
 }
 
 }  // namespace ort::daemon

@@ -30,6 +30,12 @@ struct RawMap {
 
 RawMap make_raw_map(const octomap::OcTree& tree, int64_t utime, const RawMapOptions& options);
 
+// octomap_server's occupancy_min_z/max_z for the map a viewer shows: deletes from `tree` (a
+// copy: the map of record is never filtered) every occupied leaf whose centre z is not
+// strictly inside (min_z, max_z), as octomap_server leaves such cells out of its occupied
+// cells and its 2D map; free leaves stay. Returns how many leaves went.
+size_t drop_occupied_outside_band(octomap::OcTree& tree, double min_z, double max_z);
+
 // Encoded size of a raw_t carrying `data_bytes` of map.
 size_t raw_message_bytes(size_t data_bytes);
 

@@ -1,5 +1,6 @@
 #include "daemon/serving/octomap_raw_publisher.h"
 
+#include <cmath>
 #include <fstream>
 
 #include "daemon/serving/map_snapshot.h"
@@ -46,6 +47,8 @@ void OctomapRawPublisher::encode_if_changed() {
   auto copy = copy_map_if_changed(map_, encoded_version_);
   if (!copy) return;
   encoded_version_ = copy->version;
+  if (std::isfinite(cfg_.occupancy_min_z) || std::isfinite(cfg_.occupancy_max_z))
+    drop_occupied_outside_band(*copy->tree, cfg_.occupancy_min_z, cfg_.occupancy_max_z);
   const RawMap raw = make_raw_map(*copy->tree, copy->last_scan_utime, RawMapOptions{cfg_.max_bytes, cfg_.min_depth});
   encoded_.clear();
   if (raw.message) {

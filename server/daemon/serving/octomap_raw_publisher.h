@@ -9,6 +9,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <limits>
 #include <mutex>
 #include <ostream>
 #include <string>
@@ -26,6 +27,9 @@ struct OctomapRawConfig {
   std::string channel = "OCTOMAP";
   size_t max_bytes = 0;     // whole message; 0: octomap_raw_default_cap()
   unsigned min_depth = 10;  // coarsest depth-limited map sent before giving up
+  // octomap_server's occupancy_min_z/max_z: occupied cells shown only strictly inside the band.
+  double occupancy_min_z = -std::numeric_limits<double>::infinity();
+  double occupancy_max_z = std::numeric_limits<double>::infinity();
 };
 
 // 90 % of net.core.rmem_default: a receiver that keeps the default UDP buffer (Java's LCM
