@@ -231,6 +231,9 @@ void check_numbers(const ReplayArgs& a) {
   if (!(std::isfinite(a.speed) && a.speed > 0 && a.speed <= 1e6))
     throw CLI::ValidationError("--speed", "must be a factor in (0, 1e6]");
   if (!std::isfinite(a.max_range)) throw CLI::ValidationError("--max-range", "must be a finite number of metres");
+  if (a.max_range > 0 && a.max_range < octomap_rt::wire::kMinScanMaxRange)
+    throw CLI::ValidationError("--max-range", "must be at least " + std::to_string(octomap_rt::wire::kMinScanMaxRange) +
+                                                  " m (or <= 0: the server's applies)");
   if (!(std::isfinite(a.wait_for_server_s) && a.wait_for_server_s >= 0))
     throw CLI::ValidationError("--wait-for-server", "must be a number of seconds >= 0");
 }

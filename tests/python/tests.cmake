@@ -3,7 +3,8 @@ find_program(PYTHON3 python3 PATHS /usr/bin NO_DEFAULT_PATH)
 find_program(LCM_LOGGER lcm-logger)
 set(ORT_PY_TEST_ENV "PYTHONPATH=${CMAKE_BINARY_DIR}/python:${CMAKE_CURRENT_LIST_DIR}"
     "OCTOMAP_RT_CLI=$<TARGET_FILE:octomap-rt>" "OCTOMAP_RT_SERVER=$<TARGET_FILE:octomap-rt-server>"
-    "PYTHONDONTWRITEBYTECODE=1")
+    "PYTHONDONTWRITEBYTECODE=1" "OCTOMAP_RT_DATA=${OCTOMAP_RT_DATA_DIR}"
+    "OCTOMAP_RT_PUBLISH_EXAMPLE=$<TARGET_FILE:octomap-rt-publish-example>")
 
 # octomap_rt_add_python_test(<name> <module> <timeout>): `python3 -m unittest <module>` in its namespace.
 function(octomap_rt_add_python_test name module timeout)
@@ -18,6 +19,8 @@ if(PYTHON3 AND LCM_LOGGER)
   octomap_rt_add_python_test(python_map_service_test test_map_service 300)
   octomap_rt_add_python_test(python_queries_test test_queries 300)
   octomap_rt_add_python_test(python_planner_test test_planner 300)
+  # README's "Connect your robot": the C++ and the Python producer examples against a real server.
+  octomap_rt_add_python_test(python_producers_test test_producers 300)
 else()
   message(WARNING "octomap-rt: python3 or lcm-logger missing: the Python client tests are not registered")
 endif()

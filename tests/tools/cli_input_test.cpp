@@ -122,10 +122,14 @@ TEST(CliInput, NonFiniteOrAbsurdNumbersAreRefused) {
   expect_refused(run(build + "-r 1e-300"), "--resolution", "-r 1e-300");
   expect_refused(run(build + "-r 1e300"), "--resolution", "-r 1e300");
   expect_refused(run(build + "-r 0.2 --max-range nan"), "--max-range", "build --max-range nan");
+  // Issue 21: a positive max range far below the resolution made every cut ray degenerate.
+  for (const char* r : {"1e-30", "0", "0.0009"})
+    expect_refused(run(build + "-r 0.2 --max-range " + r), "--max-range", std::string("build --max-range ") + r);
   const std::string replay = "replay synthetic --robot r1 --lcm-url memq:// -q ";
   for (const char* rate : {"0", "-1", "nan", "inf"})
     expect_refused(run(replay + "--rate " + rate), "--rate", std::string("replay --rate ") + rate);
   expect_refused(run(replay + "--max-range nan"), "--max-range", "replay --max-range nan");
+  expect_refused(run(replay + "--max-range 1e-30"), "--max-range", "replay --max-range 1e-30");
   expect_refused(run(replay + "--speed nan"), "--speed", "replay --speed nan");
   const CliRun ok = run(replay + "--unpaced --count 2");
   EXPECT_EQ(ok.exit, 0) << ok.output;
