@@ -37,9 +37,12 @@ octomap_rt::server_status_t example_status() {
   r.scans_rejected = 5;
   r.last_seq = 1234;
   r.last_scan_utime = s.utime - 500'000;
-  r.reject_reason = {"non-finite point", "truncated \"x\""};
+  r.reject_reason = {"non-finite pose", "truncated \"x\""};
   r.reject_count = {3, 2};
   r.num_reject_reasons = 2;
+  r.point_drop_reason = {"non-finite", "below min range"};
+  r.point_drop_count = {12000, 7};
+  r.num_point_drop_reasons = 2;
   s.robots = {r};
   s.num_robots = 1;
   return s;
@@ -60,7 +63,8 @@ TEST(StatusText, LaysOutStateRatesLatenciesAndRobotsWithReasons) {
   EXPECT_NE(text.find("receive-buffer errors unknown"), std::string::npos) << text;
   EXPECT_NE(text.find("message   1 scan rejected"), std::string::npos) << text;
   EXPECT_NE(text.find("alpha            1,235     1,230"), std::string::npos) << text;
-  EXPECT_NE(text.find("rejected: non-finite point 3, truncated \"x\" 2"), std::string::npos) << text;
+  EXPECT_NE(text.find("rejected: non-finite pose 3, truncated \"x\" 2"), std::string::npos) << text;
+  EXPECT_NE(text.find("points without a ray: non-finite 12,000, below min range 7"), std::string::npos) << text;
 }
 
 octomap_rt::server_status_t with_queries() {
@@ -164,8 +168,9 @@ TEST(StatusJson, EveryFieldAndEscapedStrings) {
   EXPECT_NE(json.find("\"state_name\":\"DEGRADED\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"pid\":4242"), std::string::npos) << json;
   EXPECT_NE(json.find("\"pipelined\":true"), std::string::npos) << json;
-  EXPECT_NE(json.find("\"reject_reasons\":{\"non-finite point\":3,\"truncated \\\"x\\\"\":2}"), std::string::npos)
+  EXPECT_NE(json.find("\"reject_reasons\":{\"non-finite pose\":3,\"truncated \\\"x\\\"\":2}"), std::string::npos)
       << json;
+  EXPECT_NE(json.find("\"point_drops\":{\"non-finite\":12000,\"below min range\":7}"), std::string::npos) << json;
   EXPECT_EQ(json_string("a\nb\\"), "\"a\\u000ab\\\\\"");
 }
 

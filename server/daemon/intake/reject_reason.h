@@ -47,7 +47,7 @@ enum class Reject {
 
 inline constexpr std::size_t kRejectReasonCount = static_cast<std::size_t>(Reject::kCount_);
 
-// Stable human-readable name ("truncated", "non-finite point", ...).
+// Stable human-readable name ("truncated", "non-finite pose", ...).
 const char* to_string(Reject r);
 
 // Why single points of an applied scan gave no ray (the scan itself is applied with the rest).
