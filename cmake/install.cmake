@@ -21,7 +21,6 @@ install(DIRECTORY ${CMAKE_SOURCE_DIR}/client/map_client/ DESTINATION ${ORT_INCLU
         FILES_MATCHING PATTERN "*.h")
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/protocol/ DESTINATION ${ORT_INCLUDE_DEST}/protocol FILES_MATCHING PATTERN "*.h")
 install(DIRECTORY ${CMAKE_BINARY_DIR}/lcmtypes/cpp/ DESTINATION ${ORT_INCLUDE_DEST} FILES_MATCHING PATTERN "*.hpp")
-install(DIRECTORY ${CMAKE_SOURCE_DIR}/lcmtypes/include/ DESTINATION ${ORT_INCLUDE_DEST} FILES_MATCHING PATTERN "*.hpp")
 install(EXPORT octomap_rtTargets NAMESPACE octomap_rt:: DESTINATION ${ORT_CMAKE_DEST})
 configure_package_config_file(${CMAKE_SOURCE_DIR}/cmake/octomap_rtConfig.cmake.in
                               ${CMAKE_BINARY_DIR}/octomap_rtConfig.cmake INSTALL_DESTINATION ${ORT_CMAKE_DEST})

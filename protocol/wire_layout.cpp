@@ -35,6 +35,8 @@ const char* wire_fault_name(WireFault f) {
     case WireFault::kBadStringLength: return "bad string length";
     case WireFault::kStringNotTerminated: return "string not terminated";
     case WireFault::kTrailingBytes: return "trailing bytes";
+    case WireFault::kTooLarge: return "too large";
+    case WireFault::kUndecodable: return "undecodable";
   }
   return "unknown wire fault";
 }
@@ -42,6 +44,7 @@ const char* wire_fault_name(WireFault f) {
 std::string describe(const WireCheck& check) {
   std::string text = wire_fault_name(check.fault);
   if (check.fault == WireFault::kCountTooLarge) text += " (at most " + std::to_string(check.limit) + ")";
+  if (check.fault == WireFault::kTooLarge) text += " (at most " + std::to_string(check.limit) + " bytes)";
   return text;
 }
 

@@ -46,20 +46,23 @@ enum class WireFault {
   kBadStringLength,      // a string length below 1 (the NUL counts) or above its bound
   kStringNotTerminated,  // a string's last byte is not NUL
   kTrailingBytes,        // bytes after the message's end
+  kTooLarge,             // the whole message is above its size bound (WireCheck::limit)
+  kUndecodable,          // LCM's decode() refused bytes the walk accepted
 };
 
 struct WireCheck {
   WireFault fault = WireFault::kNone;
-  int64_t limit = 0;  // for kCountTooLarge: the bound the count broke
+  int64_t limit = 0;  // for kCountTooLarge, kTooLarge: the bound broken
   bool ok() const { return fault == WireFault::kNone; }
 };
 
 // The fault's short name: "truncated", "wrong fingerprint", "negative count", "count too
 // large", "count exceeds data", "bad string length", "string not terminated", "trailing
-// bytes"; "" for kNone.
+// bytes", "too large", "undecodable"; "" for kNone.
 const char* wire_fault_name(WireFault fault);
 
-// The short name with the bound where there is one: "count too large (at most N)".
+// The short name with the bound where there is one: "count too large (at most N)", "too
+// large (at most N bytes)".
 std::string describe(const WireCheck& check);
 
 // Whether the bytes are exactly one message of this layout with the 8-byte fingerprint

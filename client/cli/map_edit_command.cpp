@@ -6,8 +6,8 @@
 #include <memory>
 
 #include "cli/commands.h"
-#include "cli/lcm_url.h"
 #include "octomap_rt/map_edit_t.hpp"
+#include "protocol/lcm_url.h"
 #include "query_client/query_args.h"
 #include "query_client/query_client.h"
 #include "query_client/query_json.h"
@@ -24,7 +24,7 @@ struct EditArgs {
 void run_edit(const EditArgs& a, int8_t op) {
   client::Box b{};
   if (op != octomap_rt::map_edit_t::OP_RESET) b = client::parse_box(a.box);
-  client::QueryClient c(client_lcm_url(a.lcm_url), "cli-" + std::to_string(::getpid()),
+  client::QueryClient c(ort::protocol::lcm_url_or_default(a.lcm_url), "cli-" + std::to_string(::getpid()),
                         std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)));
   const auto ack = c.edit(op, b, a.token);
   if (a.json) client::write_edit_json(std::cout, ack);

@@ -6,9 +6,9 @@
 #include <ctime>
 #include <stdexcept>
 
-#include "cli/lcm_url.h"
 #include "cli/map_commands.h"
 #include "map_client/map_mirror.h"
+#include "protocol/lcm_url.h"
 
 namespace ort::cli {
 namespace {
@@ -40,7 +40,7 @@ void run_map_watch(const MapArgs& a) {
   sigaddset(&sigs, SIGINT);
   sigaddset(&sigs, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &sigs, nullptr);
-  client::MapClient c(client_lcm_url(a.lcm_url));
+  client::MapClient c(ort::protocol::lcm_url_or_default(a.lcm_url));
   client::MirrorOptions o;
   o.fetch_timeout_s = a.timeout_s;
   client::MapMirror m(c, o);

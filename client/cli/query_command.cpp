@@ -7,8 +7,8 @@
 
 #include "cli/commands.h"
 #include "cli/grid_picture.h"
-#include "cli/lcm_url.h"
 #include "octomap_rt/box_query_t.hpp"
+#include "protocol/lcm_url.h"
 #include "query_client/query_args.h"
 #include "query_client/query_client.h"
 #include "query_client/query_json.h"
@@ -39,7 +39,7 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
 
 std::unique_ptr<QueryClient> connect(const CommonArgs& a) {
   const std::string id = a.client_id.empty() ? "cli-" + std::to_string(::getpid()) : a.client_id;
-  return std::make_unique<QueryClient>(client_lcm_url(a.lcm_url), id,
+  return std::make_unique<QueryClient>(ort::protocol::lcm_url_or_default(a.lcm_url), id,
                                        std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)));
 }
 

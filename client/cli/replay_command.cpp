@@ -14,14 +14,15 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "cli/commands.h"
-#include "cli/lcm_url.h"
 #include "cli/progress_bar.h"
 #include "cli/replay/lcm_log_scans.h"
 #include "cli/replay/lcm_server_wait.h"
 #include "cli/replay/scan_message.h"
 #include "cli/replay/scan_selection.h"
 #include "core/clock.h"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
+#include "protocol/lcm_url.h"
+#include "protocol/limits.h"
 #include "scene/scan_set.h"
 #include "scene/synthetic_scene.h"
 
@@ -38,8 +39,8 @@ struct ReplayArgs {
   bool rate_given = false;  // logs: --rate replaces the recorded timing
   double speed = 1.0;       // logs: playback speed factor on the recorded timing
   std::string lcm_url;
-  std::string channel_prefix = octomap_rt::wire::kScanChannelPrefix;
-  std::string status_channel = octomap_rt::wire::kStatusChannel;
+  std::string channel_prefix = ort::protocol::kScanChannelPrefix;
+  std::string status_channel = ort::protocol::kStatusChannel;
   double max_range = -1.0;
   std::string points_frame = "sensor";
   std::string part;
@@ -231,8 +232,8 @@ void check_numbers(const ReplayArgs& a) {
   if (!(std::isfinite(a.speed) && a.speed > 0 && a.speed <= 1e6))
     throw CLI::ValidationError("--speed", "must be a factor in (0, 1e6]");
   if (!std::isfinite(a.max_range)) throw CLI::ValidationError("--max-range", "must be a finite number of metres");
-  if (a.max_range > 0 && a.max_range < octomap_rt::wire::kMinScanMaxRange)
-    throw CLI::ValidationError("--max-range", "must be at least " + std::to_string(octomap_rt::wire::kMinScanMaxRange) +
+  if (a.max_range > 0 && a.max_range < ort::protocol::kMinScanMaxRange)
+    throw CLI::ValidationError("--max-range", "must be at least " + std::to_string(ort::protocol::kMinScanMaxRange) +
                                                   " m (or <= 0: the server's applies)");
   if (!(std::isfinite(a.wait_for_server_s) && a.wait_for_server_s >= 0))
     throw CLI::ValidationError("--wait-for-server", "must be a number of seconds >= 0");
@@ -249,7 +250,7 @@ int run_replay(ReplayArgs a) {
     if (std::string why = check_robot_id(a.robot); !why.empty()) throw CLI::ValidationError("--robot", why);
   }
 
-  const std::string url = client_lcm_url(a.lcm_url);
+  const std::string url = ort::protocol::lcm_url_or_default(a.lcm_url);
   lcm::LCM lc(url);
   if (!lc.good())
     throw std::runtime_error("cannot open LCM at " + url +
@@ -286,7 +287,7 @@ void register_replay_command(CLI::App& app) {
   cmd->add_flag("--unpaced", args->unpaced, "publish as fast as possible (no pacing)");
   cmd->add_option("--speed", args->speed, "logs: speed factor on the recorded timing")->capture_default_str();
   cmd->add_option("--lcm-url", args->lcm_url,
-                  std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + octomap_rt::wire::kDefaultLcmUrl + ")");
+                  std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + ort::protocol::kDefaultLcmUrl + ")");
   cmd->add_option("--channel-prefix", args->channel_prefix, "scan channel prefix")->capture_default_str();
   cmd->add_option("--status-channel", args->status_channel, "the server's status channel (for --wait-for-server)")
       ->capture_default_str();

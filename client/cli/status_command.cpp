@@ -10,17 +10,18 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "cli/commands.h"
-#include "cli/lcm_url.h"
 #include "cli/status/status_json.h"
 #include "cli/status/status_text.h"
 #include "core/clock.h"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
+#include "protocol/lcm_url.h"
+#include "protocol/version.h"
 
 namespace ort::cli {
 namespace {
 
 struct StatusArgs {
-  std::string lcm_url, channel = octomap_rt::wire::kStatusChannel;
+  std::string lcm_url, channel = ort::protocol::kStatusChannel;
   bool watch = false, json = false;
   double timeout_s = 5;
   int64_t count = 0;  // --watch: stop after this many statuses (0: never)
@@ -31,19 +32,21 @@ struct Inbox {
   std::optional<octomap_rt::server_status_t> latest;
   bool fresh = false;
   int64_t received_utime = 0, undecodable = 0;
+  std::string foreign_version;  // the last undecodable status came from this protocol version
 };
 
 // Untyped, so a message that does not decode as server_status_t is counted, never thrown
 // through LCM's C dispatch.
 void on_status(const lcm::ReceiveBuffer* rbuf, const std::string&, Inbox* inbox) {
   octomap_rt::server_status_t s;
+  bool ok = false;
   try {
-    if (s.decode(rbuf->data, 0, rbuf->data_size) < 0) {
-      ++inbox->undecodable;
-      return;
-    }
-  } catch (const std::exception&) {
+    ok = s.decode(rbuf->data, 0, rbuf->data_size) >= 0;
+  } catch (const std::exception&) {}
+  if (!ok) {
     ++inbox->undecodable;
+    inbox->foreign_version = ort::protocol::describe_foreign_version(static_cast<const uint8_t*>(rbuf->data),
+                                                                     static_cast<size_t>(rbuf->data_size), s.getHash());
     return;
   }
   inbox->latest = std::move(s);
@@ -86,10 +89,11 @@ int run_once(const StatusArgs& a, lcm::LCM& lc, const std::string& url, Inbox& i
   while (!in.fresh && std::chrono::steady_clock::now() < deadline)
     if (lc.handleTimeout(100) < 0) throw std::runtime_error("LCM receive failed on " + url);
   if (!in.fresh)
-    throw std::runtime_error(
-        "no status on " + a.channel + " within " + std::to_string(int(a.timeout_s)) + " s at " + url +
-        ": is octomap-rt-server running with this LCM URL?" +
-        (in.undecodable ? " (" + std::to_string(in.undecodable) + " messages did not decode)" : ""));
+    throw std::runtime_error("no status on " + a.channel + " within " + std::to_string(int(a.timeout_s)) + " s at " +
+                             url + ": is octomap-rt-server running with this LCM URL?" +
+                             (in.undecodable ? " (" + std::to_string(in.undecodable) + " messages did not decode" +
+                                                   (in.foreign_version.empty() ? "" : ": " + in.foreign_version) + ")"
+                                             : ""));
   std::cout << (a.json ? status::status_json(*in.latest) + "\n" : status::format_status(*in.latest, now_utime()));
   return 0;
 }
@@ -115,7 +119,7 @@ int run_watch(const StatusArgs& a, lcm::LCM& lc, const std::string& url, Inbox& 
 }
 
 int run_status(const StatusArgs& a) {
-  const std::string url = client_lcm_url(a.lcm_url);
+  const std::string url = ort::protocol::lcm_url_or_default(a.lcm_url);
   std::optional<lcm::LCM> slot;
   lcm::LCM& lc = open_lcm(slot, url);
   Inbox inbox;

@@ -8,4 +8,4 @@ install(TARGETS octomap-rt-plan RUNTIME DESTINATION bin)
 # The C++ producer of README's "Connect your robot" (publish_scan.cpp): built by default, run by
 # tests/python/test_producers.py against a real server.
 add_executable(octomap-rt-publish-example ${CMAKE_CURRENT_LIST_DIR}/publish_scan.cpp)
-target_link_libraries(octomap-rt-publish-example PRIVATE octomap_rt_lcmtypes octomap_rt_lcm octomap_rt_octomap)
+target_link_libraries(octomap-rt-publish-example PRIVATE octomap_rt_protocol octomap_rt_lcmtypes octomap_rt_lcm octomap_rt_octomap)

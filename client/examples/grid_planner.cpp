@@ -13,8 +13,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "cli/lcm_url.h"
 #include "octomap_rt/box_query_t.hpp"
+#include "protocol/lcm_url.h"
 #include "query_client/query_args.h"
 #include "query_client/query_client.h"
 
@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
     const auto from = ort::client::parse_numbers(from_s, 2), to = ort::client::parse_numbers(to_s, 2);
     double z0, z1;
     ort::client::parse_range(z_s, z0, z1);
-    ort::client::QueryClient client(ort::cli::client_lcm_url(lcm_url), "planner-" + std::to_string(::getpid()),
+    ort::client::QueryClient client(ort::protocol::lcm_url_or_default(lcm_url), "planner-" + std::to_string(::getpid()),
                                     std::chrono::milliseconds(static_cast<int64_t>(timeout_s * 1000)));
     const Grid g = client.grid(z0, z1, cell, nullptr);
     if (g.header.status != 0) throw std::runtime_error("grid refused: " + g.header.error);

@@ -13,6 +13,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "octomap_rt/scan_t.hpp"
+#include "protocol/channels.h"
 
 int main(int argc, char** argv) {
   if (argc < 2) return std::cerr << "usage: " << argv[0] << " SCAN.graph [LCM_URL] [ROBOT_ID]\n", 2;
@@ -38,7 +39,7 @@ int main(int argc, char** argv) {
   m.num_xyz = static_cast<int32_t>(m.xyz.size());
   m.robot_id = robot;  // = the channel's suffix
   m.map_frame = "map";
-  std::string channel = "OCTOMAP_RT_SCAN_" + robot;
+  std::string channel = ort::protocol::kScanChannelPrefix + robot;
   for (char& c : channel) c = char(std::toupper(static_cast<unsigned char>(c)));
   lcm::LCM lc(argc > 2 ? argv[2] : "");
   if (!lc.good() || lc.publish(channel, &m) != 0) return std::cerr << "publish failed\n", 1;

@@ -10,8 +10,10 @@
 
 #include "map_client/snapshot_assembly.h"
 #include "octomap_rt/map_request_t.hpp"
-#include "protocol/map_protocol.h"
-#include "protocol/wire_checks.h"
+#include "protocol/ids.h"
+#include "protocol/inbound_checks.h"
+#include "protocol/limits.h"
+#include "protocol/version.h"
 #include "protocol/zstd_codec.h"
 
 namespace ort::client {
@@ -51,9 +53,11 @@ std::unique_ptr<octomap::OcTree> FetchedSnapshot::tree() const {
 MapClient::MapClient(const std::string& url, ClientOptions opts) : opts_(std::move(opts)), lcm_(url) {
   if (!lcm_.good()) throw std::runtime_error("LCM could not start on '" + url + "'");
   if (opts_.client_id.empty()) opts_.client_id = default_client_id();
-  if (!protocol::valid_name(opts_.client_id))
-    throw std::invalid_argument("client id '" + opts_.client_id + "': 1..63 of [A-Za-z0-9_-]");
-  reply_channel_ = protocol::reply_channel_for(opts_.client_id);
+  if (std::string why = protocol::check_client_id(opts_.client_id); !why.empty())
+    throw std::invalid_argument("client id '" + opts_.client_id + "': " + why);
+  reply_channel_ = protocol::reply_channel_for(opts_.client_id, opts_.reply_prefix);
+  if (std::string why = protocol::check_channel_length(reply_channel_); !why.empty())
+    throw std::invalid_argument("client id '" + opts_.client_id + "': " + why);
   // Subscribed before any handle runs (this object's thread is the only one handling).
   lcm_.subscribe(reply_channel_, &MapClient::on_chunk_bytes, this)->setQueueCapacity(0);
   lcm_.subscribe(opts_.info_channel, &MapClient::on_info_bytes, this);
@@ -63,9 +67,8 @@ MapClient::~MapClient() = default;
 
 void MapClient::on_chunk_bytes(const lcm::ReceiveBuffer* rb, const std::string&) {
   Chunk c{};
-  const std::string why = protocol::check_chunk(rb->data, rb->data_size, c);
-  if (!why.empty()) {
-    inbound_.refused["chunk: " + why]++;
+  if (const protocol::WireCheck check = protocol::check_chunk(rb->data, rb->data_size, c); !check.ok()) {
+    inbound_.refused["chunk: " + protocol::describe(check)]++;
     return;
   }
   if (c.client_id != opts_.client_id) return;  // another client sharing our id's channel
@@ -75,9 +78,11 @@ void MapClient::on_chunk_bytes(const lcm::ReceiveBuffer* rb, const std::string&)
 
 void MapClient::on_info_bytes(const lcm::ReceiveBuffer* rb, const std::string&) {
   octomap_rt::map_info_t m{};
-  const std::string why = protocol::check_info(rb->data, rb->data_size, m);
-  if (!why.empty()) {
-    inbound_.refused["info: " + why]++;
+  if (const protocol::WireCheck check = protocol::check_info(rb->data, rb->data_size, m); !check.ok()) {
+    inbound_.refused["info: " + protocol::describe(check)]++;
+    if (check.fault == protocol::WireFault::kWrongFingerprint)
+      inbound_.foreign_version = protocol::describe_foreign_version(static_cast<const uint8_t*>(rb->data),
+                                                                    rb->data_size, octomap_rt::map_info_t::getHash());
     return;
   }
   inbound_.infos++;
@@ -87,9 +92,8 @@ void MapClient::on_info_bytes(const lcm::ReceiveBuffer* rb, const std::string&) 
 
 void MapClient::on_delta_bytes(const lcm::ReceiveBuffer* rb, const std::string&) {
   octomap_rt::map_delta_t d{};
-  const std::string why = protocol::check_delta(rb->data, rb->data_size, d);
-  if (!why.empty()) {
-    inbound_.refused["delta: " + why]++;
+  if (const protocol::WireCheck check = protocol::check_delta(rb->data, rb->data_size, d); !check.ok()) {
+    inbound_.refused["delta: " + protocol::describe(check)]++;
     return;
   }
   inbound_.deltas++;
@@ -162,6 +166,7 @@ FetchedSnapshot MapClient::fetch_snapshot(int8_t format, double timeout_s, const
         why << as.received() << " of " << as.num_chunks() << " chunks after " << out.requests << " requests";
       else
         why << "no answer to " << out.requests << " requests (is octomap-rt-server running on this LCM URL?)";
+      if (!inbound_.foreign_version.empty()) why << "; " << inbound_.foreign_version;
       throw FetchError(FetchError::kTimeout, why.str());
     }
     handle_for(std::min(0.02, timeout_s - seconds_since(t0)));

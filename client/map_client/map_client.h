@@ -4,7 +4,7 @@
 // Single-threaded by design: every call runs LCM's handle on the caller's thread (LCM
 // allows one handling thread), so a MapClient and the MapMirror on it are used from one
 // thread. Every inbound message is checked on its raw bytes before decode
-// (protocol/wire_checks.h); refusals are counted by reason.
+// (protocol/inbound_checks.h); refusals are counted by reason.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +21,7 @@
 #include "octomap_rt/map_chunk_t.hpp"
 #include "octomap_rt/map_delta_t.hpp"
 #include "octomap_rt/map_info_t.hpp"
+#include "protocol/channels.h"
 
 namespace ort::client {
 
@@ -36,9 +37,10 @@ struct ClientOptions {
   std::string client_id;            // "": client_<pid>_<random>
   double rerequest_after_s = 0.25;  // silence before missing chunks are asked for again
   double first_answer_after_s = 3;  // silence before a request with no answer at all is repeated
-  std::string request_channel = "OCTOMAP_RT_MAP_REQUEST";
-  std::string info_channel = "OCTOMAP_RT_MAP_INFO";
-  std::string delta_channel = "OCTOMAP_RT_MAP_DELTA";
+  std::string request_channel = ort::protocol::kMapRequestChannel;
+  std::string info_channel = ort::protocol::kMapInfoChannel;
+  std::string delta_channel = ort::protocol::kMapDeltaChannel;
+  std::string reply_prefix = ort::protocol::kMapReplyPrefix;  // + the client id: the reply channel
   // Test hooks in the receive path, after validation: return true to treat the message as
   // lost on the way (loss tests without netem).
   std::function<bool(const octomap_rt::map_chunk_t&)> drop_chunk;
@@ -61,6 +63,9 @@ using FetchProgress = std::function<void(int64_t, int64_t)>;
 
 struct InboundCounts {
   std::map<std::string, int64_t> refused;  // reason -> messages
+  // Non-empty when a map_info_t came from a server of another protocol version: which
+  // (protocol/version.h), said in every timeout's message.
+  std::string foreign_version;
   int64_t chunks = 0, infos = 0, deltas = 0;
 };
 

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "protocol/limits.h"
 #include "protocol/map_protocol.h"
 
 namespace ort::client {

@@ -46,7 +46,7 @@ struct Grid {
 
 class QueryClient {
  public:
-  // `url`: as client_lcm_url(); `client_id`: 1..64 of [A-Za-z0-9_.-].
+  // `url`: as ort::protocol::lcm_url_or_default(); `client_id`: 1..64 of [A-Za-z0-9_.-].
   QueryClient(const std::string& url, std::string client_id, std::chrono::milliseconds timeout);
   ~QueryClient();
 

@@ -5,8 +5,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "daemon/intake/scan_validation.h"
 #include "daemon/queries/query_answers.h"
+#include "protocol/ids.h"
+#include "protocol/lcm_url.h"
 
 namespace ort::daemon {
 
@@ -25,7 +26,7 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
   app.add_option("--applied-log", s.applied_log,
                  "also append each applied scan's (robot, seq) to this file as it happens");
   app.add_option("--lcm-url", s.lcm_url,
-                 std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + octomap_rt::wire::kDefaultLcmUrl +
+                 std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + ort::protocol::kDefaultLcmUrl +
                      "); udpm URLs get recv_buf_size=min(--recv-buf-size, net.core.rmem_max) unless they set it");
   app.add_option("--recv-buf-size", s.recv_buf_size, "UDP receive buffer wanted [bytes]")->capture_default_str();
   app.add_option("--scan-channels", s.scan_channels,
@@ -168,7 +169,7 @@ void add_grid_flags(CLI::App& app, GridPublishConfig& g) {
       "z band of the published grid, MIN:MAX [m]");
   app.add_option("--grid-rate", g.rate_hz,
                  std::string("publish the 2D grid of the --grid-z band (projected_map rule, grid_t rows) on ") +
-                     octomap_rt::wire::kGridChannel + " at this rate [Hz]; 0: off")
+                     ort::protocol::kGridChannel + " at this rate [Hz]; 0: off")
       ->check(CLI::Range(0.0, 50.0))
       ->needs(z)
       ->capture_default_str();
@@ -230,7 +231,7 @@ ServerConfig to_server_config(const ServerFlags& f) {
   if (!std::isfinite(c.producer_idle_release_s))
     throw CLI::ValidationError("--producer-idle-release", "must be a finite number of seconds");
   for (const std::string& id : c.allowed_robots)
-    if (!valid_robot_id(id))
+    if (!protocol::valid_robot_id(id))
       throw CLI::ValidationError("--allow-robot", "'" + id + "' is not a robot id (1-32 of [A-Za-z0-9_-])");
   try {
     std::regex check(c.scan_channels);

@@ -12,7 +12,8 @@
 #include "daemon/queries/query_config.h"
 #include "daemon/serving/octomap_raw_publisher.h"
 #include "engine/map_engine.h"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
+#include "protocol/limits.h"
 
 namespace ort::daemon {
 
@@ -21,8 +22,9 @@ struct ServerConfig {
   EngineOptions engine;                // resolution, sensor model, max range, back end
   std::string lcm_url;                 // "": $LCM_DEFAULT_URL, else host-local udpm
   uint64_t recv_buf_size = 16u << 20;  // udpm receive buffer wanted (capped by rmem_max)
-  std::string scan_channels = octomap_rt::wire::kScanChannelRegex;  // regex; its literal prefix + robot id
-  std::string status_channel = octomap_rt::wire::kStatusChannel;
+  std::string scan_channels =
+      (std::string(ort::protocol::kScanChannelPrefix) + ".*");  // regex; its literal prefix + robot id
+  std::string status_channel = ort::protocol::kStatusChannel;
   std::string map_path;                 // .ot; "": no persistence
   bool move_corrupt_map_aside = false;  // corrupt map: keep it as FILE.corrupt-<time>, start anew
   std::string applied_log;              // live applied-order log; "": none
@@ -33,18 +35,18 @@ struct ServerConfig {
   // intake opens (engine/engine_warm_up.h), so the first scans pay no one-time costs; 0: none.
   // Default: one VGA depth image (640 x 480).
   size_t warm_up_points = 640 * 480;
-  std::string server_id;                                          // "": octomap-rt-server@<host>
-  uint64_t queue_budget_bytes = 0;                                // per producer; 0: automatic_queue_budget()
-  uint64_t max_points = octomap_rt::wire::kDefaultMaxScanPoints;  // per scan
+  std::string server_id;                                       // "": octomap-rt-server@<host>
+  uint64_t queue_budget_bytes = 0;                             // per producer; 0: automatic_queue_budget()
+  uint64_t max_points = ort::protocol::kDefaultMaxScanPoints;  // per scan
   size_t max_producers = 64;
   double producer_idle_release_s = 600;     // an idle producer's slot goes to a new robot; <= 0: never
   std::vector<std::string> allowed_robots;  // --allow-robot; empty: any valid robot id
   int lcm_queue_capacity = 64;              // LCM's own per-subscription queue (messages)
   OctomapRawConfig octomap_raw;
   // Serving the map (docs/PROTOCOL.md).
-  std::string map_request_channel = "OCTOMAP_RT_MAP_REQUEST";
-  std::string map_info_channel = "OCTOMAP_RT_MAP_INFO";
-  std::string map_delta_channel = "OCTOMAP_RT_MAP_DELTA";
+  std::string map_request_channel = ort::protocol::kMapRequestChannel;
+  std::string map_info_channel = ort::protocol::kMapInfoChannel;
+  std::string map_delta_channel = ort::protocol::kMapDeltaChannel;
   int snapshot_zstd_level = 3;           // 0: snapshots uncompressed
   size_t snapshots_kept = 4;             // for re-sends of chunks
   double snapshot_min_interval_s = 0.5;  // a new snapshot at most this often

@@ -19,6 +19,7 @@
 
 #include "daemon/mapping_server.h"
 #include "daemon/server_cli.h"
+#include "protocol/channels.h"
 
 namespace {
 
@@ -60,9 +61,9 @@ void watch_signals(ort::daemon::MappingServer& server, sigset_t sigs, Clock::tim
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{
-      "octomap-rt-server: LCM mapping daemon. Robots publish octomap_rt::scan_t on "
-      "OCTOMAP_RT_SCAN_<ROBOT>; status goes to OCTOMAP_RT_STATUS (watch it with tools/octomap-rt-spy)."};
+  CLI::App app{std::string("octomap-rt-server: LCM mapping daemon. Robots publish octomap_rt::scan_t on ") +
+               ort::protocol::kScanChannelPrefix + "<ROBOT>; status goes to " + ort::protocol::kStatusChannel +
+               " (watch it with tools/octomap-rt-spy)."};
   ort::daemon::ServerFlags flags;
   ort::daemon::add_server_flags(app, flags);
   ort::daemon::ServerConfig cfg;

@@ -13,12 +13,12 @@
 #include <octomap/OcTree.h>
 
 #include "daemon/queries/query_answers.h"
-#include "daemon/queries/query_wire.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/grid_query_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/occupancy_query_t.hpp"
 #include "octomap_rt/ray_query_t.hpp"
+#include "protocol/inbound_checks.h"
 #include "query/query_types.h"
 
 namespace {
@@ -41,8 +41,9 @@ const octomap::OcTree& small_map() {
 
 // The raw-byte check, then decode(): false when the check refused the bytes.
 template <class Message>
-bool decoded(const uint8_t* data, size_t size, std::string (*check)(const uint8_t*, size_t), Message& msg) {
-  if (!check(data, size).empty()) return false;
+bool decoded(const uint8_t* data, size_t size, ort::protocol::WireCheck (*check)(const uint8_t*, size_t),
+             Message& msg) {
+  if (!check(data, size).ok()) return false;
   try {
     if (msg.decode(data, 0, static_cast<int>(size)) != static_cast<int>(size)) std::abort();
   } catch (const std::exception&) {
@@ -52,7 +53,7 @@ bool decoded(const uint8_t* data, size_t size, std::string (*check)(const uint8_
 }
 
 template <class Message>
-void exercise(const uint8_t* data, size_t size, std::string (*check)(const uint8_t*, size_t)) {
+void exercise(const uint8_t* data, size_t size, ort::protocol::WireCheck (*check)(const uint8_t*, size_t)) {
   Message msg;
   if (!decoded(data, size, check, msg)) return;
   const QueryMessage q(msg);
@@ -72,13 +73,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const uint8_t kind = data[0] % 5;
   ++data, --size;
   switch (kind) {
-    case 0: exercise<octomap_rt::occupancy_query_t>(data, size, check_occupancy_query); break;
-    case 1: exercise<octomap_rt::ray_query_t>(data, size, check_ray_query); break;
-    case 2: exercise<octomap_rt::box_query_t>(data, size, check_box_query); break;
-    case 3: exercise<octomap_rt::grid_query_t>(data, size, check_grid_query); break;
+    case 0: exercise<octomap_rt::occupancy_query_t>(data, size, ort::protocol::check_occupancy_query_bytes); break;
+    case 1: exercise<octomap_rt::ray_query_t>(data, size, ort::protocol::check_ray_query_bytes); break;
+    case 2: exercise<octomap_rt::box_query_t>(data, size, ort::protocol::check_box_query_bytes); break;
+    case 3: exercise<octomap_rt::grid_query_t>(data, size, ort::protocol::check_grid_query_bytes); break;
     default: {
       octomap_rt::map_edit_t edit;
-      (void)decoded(data, size, check_map_edit, edit);
+      (void)decoded(data, size, ort::protocol::check_map_edit_bytes, edit);
       break;
     }
   }

@@ -9,8 +9,8 @@
 #include <cstring>
 #include <exception>
 
-#include "daemon/intake/scan_decode.h"
 #include "daemon/intake/scan_validation.h"
+#include "protocol/scan_decode.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ort::daemon;
@@ -27,7 +27,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       std::abort();  // the wire checks let through what decode() cannot read
     }
     octomap_rt::scan_t ours;
-    if (decode_scan(data, size, ours) != static_cast<int>(size)) std::abort();
+    if (ort::protocol::decode_scan(data, size, ours) != static_cast<int>(size)) std::abort();
     if (ours.xyz.size() != again.xyz.size() || ours.num_xyz != again.num_xyz || ours.robot_id != again.robot_id ||
         ours.map_frame != again.map_frame || ours.seq != again.seq || ours.utime != again.utime ||
         (!ours.xyz.empty() && std::memcmp(ours.xyz.data(), again.xyz.data(), ours.xyz.size() * sizeof(float)) != 0))

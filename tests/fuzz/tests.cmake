@@ -22,16 +22,16 @@ function(octomap_rt_add_fuzz_target name)
   add_executable(${name} ${FUZZ_DIR}/${name}.cpp ${ARG_SOURCES})
   target_compile_options(${name} PRIVATE ${FUZZ_FLAGS})
   target_link_options(${name} PRIVATE ${FUZZ_FLAGS})
-  target_include_directories(${name} PRIVATE ${CMAKE_SOURCE_DIR} ${CMAKE_SOURCE_DIR}/server ${CMAKE_SOURCE_DIR}/client
-                             ${CMAKE_SOURCE_DIR}/lcmtypes/include)
+  target_include_directories(${name} PRIVATE ${CMAKE_SOURCE_DIR} ${CMAKE_SOURCE_DIR}/server ${CMAKE_SOURCE_DIR}/client)
   target_link_libraries(${name} PRIVATE octomap_rt_octomap Threads::Threads ${ARG_LIBS})
   set(OCTOMAP_RT_FUZZ_TARGETS ${OCTOMAP_RT_FUZZ_TARGETS} ${name} PARENT_SCOPE)
 endfunction()
 
 octomap_rt_add_fuzz_target(fuzz_scan_message
-  SOURCES ${CMAKE_SOURCE_DIR}/server/daemon/intake/scan_validation.cpp ${CMAKE_SOURCE_DIR}/server/daemon/intake/scan_decode.cpp
+  SOURCES ${CMAKE_SOURCE_DIR}/server/daemon/intake/scan_validation.cpp ${CMAKE_SOURCE_DIR}/protocol/scan_decode.cpp
           ${CMAKE_SOURCE_DIR}/server/daemon/intake/reject_reason.cpp
-          ${CMAKE_SOURCE_DIR}/protocol/wire_layout.cpp
+          ${CMAKE_SOURCE_DIR}/protocol/wire_layout.cpp ${CMAKE_SOURCE_DIR}/protocol/inbound_checks.cpp
+          ${CMAKE_SOURCE_DIR}/protocol/ids.cpp
           ${CMAKE_SOURCE_DIR}/server/core/prepare_scan.cpp
   LIBS octomap_rt_lcmtypes octomap_rt_lcm)
 octomap_rt_add_fuzz_target(fuzz_scan_graph
@@ -40,12 +40,12 @@ octomap_rt_add_fuzz_target(fuzz_scan_graph
 octomap_rt_add_fuzz_target(fuzz_octree_file SOURCES ${CMAKE_SOURCE_DIR}/server/core/file_checks/octree_file_check.cpp)
 file(GLOB FUZZ_QUERY_CORE ${CMAKE_SOURCE_DIR}/server/query/*.cpp)
 octomap_rt_add_fuzz_target(fuzz_query_message
-  SOURCES ${CMAKE_SOURCE_DIR}/server/daemon/queries/query_wire.cpp ${CMAKE_SOURCE_DIR}/server/daemon/queries/query_answers.cpp
+  SOURCES ${CMAKE_SOURCE_DIR}/protocol/inbound_checks.cpp ${CMAKE_SOURCE_DIR}/server/daemon/queries/query_answers.cpp
           ${CMAKE_SOURCE_DIR}/protocol/wire_layout.cpp ${FUZZ_QUERY_CORE}
   LIBS octomap_rt_lcmtypes octomap_rt_lcm)
 octomap_rt_add_fuzz_target(fuzz_map_request
-  SOURCES ${CMAKE_SOURCE_DIR}/protocol/wire_checks.cpp ${CMAKE_SOURCE_DIR}/protocol/wire_layout.cpp
-          ${CMAKE_SOURCE_DIR}/protocol/map_protocol.cpp
-          ${CMAKE_SOURCE_DIR}/server/daemon/serving/map_request_rules.cpp
+  SOURCES ${CMAKE_SOURCE_DIR}/protocol/inbound_checks.cpp ${CMAKE_SOURCE_DIR}/protocol/wire_layout.cpp
+          ${CMAKE_SOURCE_DIR}/protocol/ids.cpp ${CMAKE_SOURCE_DIR}/protocol/channels.cpp
+          ${CMAKE_SOURCE_DIR}/protocol/map_request_rules.cpp
   LIBS octomap_rt_lcmtypes octomap_rt_lcm)
 add_custom_target(octomap_rt_fuzz_targets DEPENDS ${OCTOMAP_RT_FUZZ_TARGETS})

@@ -9,8 +9,9 @@
 
 #include "map_client/snapshot_assembly.h"
 #include "protocol/delta_codec.h"
+#include "protocol/inbound_checks.h"
+#include "protocol/limits.h"
 #include "protocol/map_protocol.h"
-#include "protocol/wire_checks.h"
 #include "protocol/wire_layout.h"
 #include "protocol/zstd_codec.h"
 
@@ -33,6 +34,9 @@ int32_t be32(const std::vector<uint8_t>& b, size_t off) {
 void put_be32(std::vector<uint8_t>& b, size_t off, int32_t v) {
   for (int i = 0; i < 4; ++i) b[off + i] = static_cast<uint8_t>(static_cast<uint32_t>(v) >> (24 - 8 * i));
 }
+
+// The refusal's short name ("" when the message was taken).
+std::string fault_name(const WireCheck& c) { return wire_fault_name(c.fault); }
 
 octomap_rt::map_request_t request(int n) {
   octomap_rt::map_request_t r{};
@@ -90,36 +94,36 @@ TEST(Protocol, TheWireWalkNamesEachFaultWithItsBound) {
 TEST(Protocol, CraftedRequestsAreRefusedWithAReason) {
   octomap_rt::map_request_t out{};
   const auto good = encode(request(3));
-  EXPECT_EQ(check_request(good.data(), good.size(), out), "");
+  EXPECT_EQ(fault_name(check_request(good.data(), good.size(), out)), "");
   EXPECT_EQ(out.chunk_indices.size(), 3u);
   auto b = good;
   b[0] ^= 1;
-  EXPECT_EQ(check_request(b.data(), b.size(), out), "wrong fingerprint");
+  EXPECT_EQ(fault_name(check_request(b.data(), b.size(), out)), "wrong fingerprint");
   b = good;
   put_be32(b, kRequestNumIndicesOffset, -1);
-  EXPECT_EQ(check_request(b.data(), b.size(), out), "negative count");
+  EXPECT_EQ(fault_name(check_request(b.data(), b.size(), out)), "negative count");
   put_be32(b, kRequestNumIndicesOffset, 0x7fffffff);
-  EXPECT_EQ(check_request(b.data(), b.size(), out), "count too large");
+  EXPECT_EQ(fault_name(check_request(b.data(), b.size(), out)), "count too large");
   put_be32(b, kRequestNumIndicesOffset, 1000);
-  EXPECT_EQ(check_request(b.data(), b.size(), out), "count exceeds data");
-  EXPECT_EQ(check_request(good.data(), 20, out), "truncated");
+  EXPECT_EQ(fault_name(check_request(b.data(), b.size(), out)), "count exceeds data");
+  EXPECT_EQ(fault_name(check_request(good.data(), 20, out)), "truncated");
   b = good;
   b.push_back(0);
-  EXPECT_EQ(check_request(b.data(), b.size(), out), "trailing bytes");
+  EXPECT_EQ(fault_name(check_request(b.data(), b.size(), out)), "trailing bytes");
   b = good;
   b[b.size() - 28] = 0xff;  // the reply channel's string length
-  EXPECT_NE(check_request(b.data(), b.size(), out), "");
+  EXPECT_NE(fault_name(check_request(b.data(), b.size(), out)), "");
   // Found by fuzz_map_request: a string length of INT32_MIN made LCM's generated decode()
   // compute len - 1 (signed overflow) and copy from past the buffer. Lengths are walked first.
   const size_t client_len = kRequestNumIndicesOffset + 4 + 4 * 3;
   b = good;
   put_be32(b, client_len, INT32_MIN);
-  EXPECT_EQ(check_request(b.data(), b.size(), out), "bad string length");
+  EXPECT_EQ(fault_name(check_request(b.data(), b.size(), out)), "bad string length");
   put_be32(b, client_len, 0);
-  EXPECT_EQ(check_request(b.data(), b.size(), out), "bad string length");
+  EXPECT_EQ(fault_name(check_request(b.data(), b.size(), out)), "bad string length");
   b = good;
   b[client_len + 4 + size_t(be32(good, client_len)) - 1] = 'x';
-  EXPECT_EQ(check_request(b.data(), b.size(), out), "string not terminated");
+  EXPECT_EQ(fault_name(check_request(b.data(), b.size(), out)), "string not terminated");
 }
 
 // map_info_t carries one string per producer after the array of their seqs: each is walked.
@@ -132,24 +136,24 @@ TEST(Protocol, CraftedInfosAreRefusedWithAReason) {
   m.map_frame = "map";
   const auto good = encode(m);
   octomap_rt::map_info_t out{};
-  EXPECT_EQ(check_info(good.data(), good.size(), out), "");
+  EXPECT_EQ(fault_name(check_info(good.data(), good.size(), out)), "");
   EXPECT_EQ(out.producer_id.size(), 2u);
   EXPECT_EQ(out.producer_id[1], "robot_b");
   const size_t first_id = kInfoNumProducersOffset + 4 + 8 * 2;  // after the seqs
   const size_t second_id = first_id + 4 + size_t(be32(good, first_id));
   auto b = good;
   put_be32(b, second_id, INT32_MIN);
-  EXPECT_EQ(check_info(b.data(), b.size(), out), "bad string length");
+  EXPECT_EQ(fault_name(check_info(b.data(), b.size(), out)), "bad string length");
   put_be32(b, second_id, 1000);  // within the bound, beyond the bytes
-  EXPECT_EQ(check_info(b.data(), b.size(), out), "truncated");
+  EXPECT_EQ(fault_name(check_info(b.data(), b.size(), out)), "truncated");
   b = good;
   b[second_id + 4 + size_t(be32(good, second_id)) - 1] = 'x';
-  EXPECT_EQ(check_info(b.data(), b.size(), out), "string not terminated");
+  EXPECT_EQ(fault_name(check_info(b.data(), b.size(), out)), "string not terminated");
   b = good;
   put_be32(b, kInfoNumProducersOffset, 3);  // a third id the bytes do not hold
-  EXPECT_NE(check_info(b.data(), b.size(), out), "");
+  EXPECT_NE(fault_name(check_info(b.data(), b.size(), out)), "");
   put_be32(b, kInfoNumProducersOffset, 5000);
-  EXPECT_EQ(check_info(b.data(), b.size(), out), "count too large");
+  EXPECT_EQ(fault_name(check_info(b.data(), b.size(), out)), "count too large");
 }
 
 std::vector<VoxelChange> random_changes(size_t n, int8_t mode, unsigned seed) {

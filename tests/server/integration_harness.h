@@ -25,7 +25,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "octomap_rt/server_status_t.hpp"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
 
 namespace ort::test {
 
@@ -80,7 +80,7 @@ class ChildProcess {
 // Decodes every OCTOMAP_RT_STATUS on its own LCM instance and thread.
 class StatusWatcher {
  public:
-  StatusWatcher(const std::string& url, const std::string& channel = octomap_rt::wire::kStatusChannel);
+  StatusWatcher(const std::string& url, const std::string& channel = ort::protocol::kStatusChannel);
   ~StatusWatcher();
   bool good() const { return good_; }
   // Waits until a status satisfying `pred` arrives (or already has); returns it.

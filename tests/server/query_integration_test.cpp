@@ -62,7 +62,7 @@ TEST(QueryIntegration, ARobotSeesItsOwnScanRightAfterSendingIt) {
     cli::ScanMessageFields fields;
     fields.robot_id = "rover", fields.seq = k, fields.utime = now_us();
     const octomap_rt::scan_t msg = cli::make_scan_message(scan, fields);
-    robot.publish(cli::scan_channel(octomap_rt::wire::kScanChannelPrefix, "rover"), &msg);
+    robot.publish(cli::scan_channel(ort::protocol::kScanChannelPrefix, "rover"), &msg);
     const std::vector<float> xyz = end_points(scan, 5000);
     client::WaitFor wait;
     wait.robot_id = "rover", wait.seq = k, wait.timeout_ms = 30000;

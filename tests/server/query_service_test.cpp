@@ -9,7 +9,6 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/queries/query_wire.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/box_reply_t.hpp"
 #include "octomap_rt/grid_query_t.hpp"
@@ -21,7 +20,8 @@
 #include "octomap_rt/ray_query_t.hpp"
 #include "octomap_rt/ray_reply_t.hpp"
 #include "octomap_rt/region_chunk_t.hpp"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
+#include "protocol/limits.h"
 #include "query/box_count.h"
 #include "query/point_query.h"
 #include "query/projected_grid.h"
@@ -30,8 +30,6 @@
 
 namespace ort::test {
 namespace {
-
-namespace wire = octomap_rt::wire;
 
 TEST(QueryService, ReadYourWritesSeesTheScanJustSent) {
   lcm::LCM lc("memq://");
@@ -44,7 +42,7 @@ TEST(QueryService, ReadYourWritesSeesTheScanJustSent) {
     // Right after the scan: ask about its own end points, waiting for its seq.
     auto q = point_query(100 + k, scan.xyz);
     q.wait_seq = k, q.wait_robot_id = "alpha", q.wait_timeout_ms = 20000;
-    lc.publish(wire::kQueryChannel, &q);
+    lc.publish(ort::protocol::kQueryChannel, &q);
     const Reply r = replies.wait_for<Reply>(100 + k);
     ASSERT_EQ(r.status, Reply::REPLY_OK) << r.error;
     EXPECT_GE(r.snapshot_id, k + 1);
@@ -54,7 +52,7 @@ TEST(QueryService, ReadYourWritesSeesTheScanJustSent) {
   // Without waiting for a seq that never comes: NOT_READY after the timeout, counted.
   auto late = point_query(200, {0, 0, 0});
   late.wait_seq = 99, late.wait_robot_id = "alpha", late.wait_timeout_ms = 200;
-  lc.publish(wire::kQueryChannel, &late);
+  lc.publish(ort::protocol::kQueryChannel, &late);
   const Reply nr = replies.wait_for<Reply>(200);
   EXPECT_EQ(nr.status, Reply::REPLY_NOT_READY);
   EXPECT_NE(nr.error.find("wait_seq 99"), std::string::npos) << nr.error;
@@ -73,19 +71,19 @@ TEST(QueryService, AnEmptyWaitRobotIdMeansNoWaitWhateverWaitSeqHolds) {
   // A default-initialised query has wait_seq 0 and no robot: answered at once, no scan needed.
   auto plain = point_query(1, {3.05f, 0.f, 0.05f});
   plain.wait_seq = 0, plain.wait_robot_id = "", plain.wait_timeout_ms = 0;
-  lc.publish(wire::kQueryChannel, &plain);
+  lc.publish(ort::protocol::kQueryChannel, &plain);
   const Reply r = replies.wait_for<Reply>(1);
   ASSERT_EQ(r.status, Reply::REPLY_OK) << r.error;
   EXPECT_EQ(r.occupancy[0], Reply::OCC_UNKNOWN);
   // With the robot named, the same wait_seq 0 waits for that robot's scan 0.
   auto waiting = plain;
   waiting.request_id = 2, waiting.wait_robot_id = "alpha", waiting.wait_timeout_ms = 300;
-  lc.publish(wire::kQueryChannel, &waiting);
+  lc.publish(ort::protocol::kQueryChannel, &waiting);
   EXPECT_EQ(replies.wait_for<Reply>(2).status, Reply::REPLY_NOT_READY);
   const auto scan = wall_scan(0);
   lc.publish("OCTOMAP_RT_SCAN_ALPHA", &scan);
   waiting.request_id = 3, waiting.wait_timeout_ms = 20000;
-  lc.publish(wire::kQueryChannel, &waiting);
+  lc.publish(ort::protocol::kQueryChannel, &waiting);
   const Reply seen = replies.wait_for<Reply>(3);
   ASSERT_EQ(seen.status, Reply::REPLY_OK) << seen.error;
   EXPECT_EQ(seen.occupancy[0], Reply::OCC_OCCUPIED);
@@ -106,7 +104,7 @@ TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
   for (int i = 0; i < 300; ++i) pts.insert(pts.end(), {-1.f + 0.023f * i, -1.2f + 0.0087f * i, 0.31f});
   auto pq = point_query(1, pts);
   pq.depth = 14;
-  lc.publish(wire::kQueryChannel, &pq);
+  lc.publish(ort::protocol::kQueryChannel, &pq);
   const Reply pr = replies.wait_for<Reply>(1);
   ASSERT_EQ(pr.status, Reply::REPLY_OK) << pr.error;
   server.with_map([&](const octomap::OcTree& t) {
@@ -126,7 +124,7 @@ TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
     rq.direction_xyz.insert(rq.direction_xyz.end(), {1.f, -0.5f + 0.02f * i, 0.f});
   }
   rq.num_xyz = static_cast<int32_t>(rq.origin_xyz.size());
-  lc.publish(wire::kQueryRaysChannel, &rq);
+  lc.publish(ort::protocol::kQueryRaysChannel, &rq);
   const auto rr = replies.wait_for<octomap_rt::ray_reply_t>(2);
   ASSERT_EQ(rr.status, Reply::REPLY_OK) << rr.error;
   server.with_map([&](const octomap::OcTree& t) {
@@ -144,7 +142,7 @@ TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
   address(bq, 3);
   bq.boxes = {2.9, -1.0, 0.0, 3.3, 1.0, 1.0, -0.5, -0.5, 0.0, 0.5, 0.5, 0.5};
   bq.num_values = 12;
-  lc.publish(wire::kQueryBoxesChannel, &bq);
+  lc.publish(ort::protocol::kQueryBoxesChannel, &bq);
   const auto br = replies.wait_for<octomap_rt::box_reply_t>(3);
   ASSERT_EQ(br.status, Reply::REPLY_OK) << br.error;
   server.with_map([&](const octomap::OcTree& t) {
@@ -161,7 +159,7 @@ TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
   octomap_rt::grid_query_t gq{};
   address(gq, 4);
   gq.z_min = 0.0, gq.z_max = 0.5, gq.cell_size = 0.2;
-  lc.publish(wire::kQueryGridChannel, &gq);
+  lc.publish(ort::protocol::kQueryGridChannel, &gq);
   const auto g = replies.wait_for<octomap_rt::grid_t>(4);
   ASSERT_EQ(g.status, Reply::REPLY_OK) << g.error;
   server.with_map([&](const octomap::OcTree& t) {
@@ -194,10 +192,10 @@ TEST(QueryService, EditsNeedTheTokenAndApplyInOrderWithTheScans) {
   e.op = octomap_rt::map_edit_t::OP_CLEAR_TO_FREE;
   double lo[3] = {2.5, -2, 0}, hi[3] = {3.5, 2, 1};
   std::copy(lo, lo + 3, e.box_min), std::copy(hi, hi + 3, e.box_max);
-  lc.publish(wire::kMapEditChannel, &e);
+  lc.publish(ort::protocol::kMapEditChannel, &e);
   EXPECT_EQ(replies.wait_for<octomap_rt::map_edit_ack_t>(1).status, Reply::REPLY_REFUSED);
   e.request_id = 2, e.token = "s3cret";
-  lc.publish(wire::kMapEditChannel, &e);  // queued behind the scan: the wall is cleared
+  lc.publish(ort::protocol::kMapEditChannel, &e);  // queued behind the scan: the wall is cleared
   const auto ack = replies.wait_for<octomap_rt::map_edit_ack_t>(2);
   ASSERT_EQ(ack.status, Reply::REPLY_OK) << ack.error;
   EXPECT_EQ(ack.snapshot_id, 2);  // one scan, then the edit
@@ -206,13 +204,13 @@ TEST(QueryService, EditsNeedTheTokenAndApplyInOrderWithTheScans) {
   bq.min_snapshot_id = ack.snapshot_id;
   bq.boxes = {lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]};
   bq.num_values = 6;
-  lc.publish(wire::kQueryBoxesChannel, &bq);
+  lc.publish(ort::protocol::kQueryBoxesChannel, &bq);
   const auto br = replies.wait_for<octomap_rt::box_reply_t>(3);
   ASSERT_EQ(br.status, Reply::REPLY_OK);
   EXPECT_EQ(br.occupied[0], 0);
   EXPECT_EQ(br.unknown[0], 0);
   e.request_id = 4, e.op = octomap_rt::map_edit_t::OP_RESET;
-  lc.publish(wire::kMapEditChannel, &e);
+  lc.publish(ort::protocol::kMapEditChannel, &e);
   EXPECT_EQ(replies.wait_for<octomap_rt::map_edit_ack_t>(4).snapshot_id, 3);
   EXPECT_EQ(server.with_map([](const octomap::OcTree& t) { return t.size(); }), 0u);
   server.stop();
@@ -226,43 +224,43 @@ TEST(QueryService, BadQueriesAreRefusedOrDroppedAndCounted) {
   Replies replies(server);
   server.start();
   auto nan = point_query(1, {0, NAN, 0});
-  lc.publish(wire::kQueryChannel, &nan);
+  lc.publish(ort::protocol::kQueryChannel, &nan);
   EXPECT_EQ(replies.wait_for<Reply>(1).status, Reply::REPLY_BAD_REQUEST);
   auto deep = point_query(2, {0, 0, 0});
   deep.depth = 17;
-  lc.publish(wire::kQueryChannel, &deep);
+  lc.publish(ort::protocol::kQueryChannel, &deep);
   EXPECT_NE(replies.wait_for<Reply>(2).error.find("depth"), std::string::npos);
   // Dropped (no trustworthy address): too many points, empty / over-long reply channel,
   // garbage, a huge count in the raw bytes.
-  auto many = point_query(3, std::vector<float>(3 * (daemon::kMaxQueryPoints + 1), 0.f));
-  lc.publish(wire::kQueryChannel, &many);
+  auto many = point_query(3, std::vector<float>(3 * (protocol::kMaxQueryPoints + 1), 0.f));
+  lc.publish(ort::protocol::kQueryChannel, &many);
   auto empty = point_query(4, {0, 0, 0});
   empty.reply_channel = "";
-  lc.publish(wire::kQueryChannel, &empty);
+  lc.publish(ort::protocol::kQueryChannel, &empty);
   auto longer = point_query(5, {0, 0, 0});
   longer.reply_channel = std::string(200, 'R');
-  lc.publish(wire::kQueryChannel, &longer);
+  lc.publish(ort::protocol::kQueryChannel, &longer);
   auto reflect = point_query(6, {0, 0, 0});
   reflect.reply_channel = "OCTOMAP_RT_SCAN_ALPHA";
-  lc.publish(wire::kQueryChannel, &reflect);
+  lc.publish(ort::protocol::kQueryChannel, &reflect);
   std::vector<uint8_t> raw(point_query(7, {0, 0, 0}).getEncodedSize());
   point_query(7, {0, 0, 0}).encode(raw.data(), 0, static_cast<int>(raw.size()));
   std::vector<uint8_t> huge = raw;
   huge[8 + 40] = 0x7f;  // num_xyz's high byte
-  lc.publish(wire::kQueryChannel, huge.data(), static_cast<unsigned>(huge.size()));
-  lc.publish(wire::kQueryChannel, raw.data(), 20);
+  lc.publish(ort::protocol::kQueryChannel, huge.data(), static_cast<unsigned>(huge.size()));
+  lc.publish(ort::protocol::kQueryChannel, raw.data(), 20);
   // Edits without a server token are refused.
   octomap_rt::map_edit_t e{};
   e.request_id = 8, e.client_id = "op", e.reply_channel = kReply, e.token = "x", e.op = 3;
-  lc.publish(wire::kMapEditChannel, &e);
+  lc.publish(ort::protocol::kMapEditChannel, &e);
   EXPECT_NE(replies.wait_for<octomap_rt::map_edit_ack_t>(8).error.find("--control-token"), std::string::npos);
   // A flood from one client: its queue holds 2, the rest are BUSY; another client is served.
   for (int i = 0; i < 200; ++i) {
     auto q = point_query(1000 + i, std::vector<float>(3 * 5000, 0.5f), "flooder");
-    lc.publish(wire::kQueryChannel, &q);
+    lc.publish(ort::protocol::kQueryChannel, &q);
   }
   auto calm = point_query(9, {0, 0, 0}, "calm");
-  lc.publish(wire::kQueryChannel, &calm);
+  lc.publish(ort::protocol::kQueryChannel, &calm);
   EXPECT_EQ(replies.wait_for<Reply>(9).status, Reply::REPLY_OK);
   // ... and mapping goes on.
   const auto s = wall_scan(0);

@@ -10,7 +10,7 @@
 #include "octomap_rt/map_edit_ack_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/server_status_t.hpp"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
 #include "query/projected_grid.h"
 #include "server/query_test_support.h"
 #include "server/scan_fixtures.h"
@@ -18,7 +18,6 @@
 namespace ort::test {
 namespace {
 
-namespace wire = octomap_rt::wire;
 using Status = octomap_rt::server_status_t;
 
 // The status as a subscriber decodes it (the message must encode and decode whole).
@@ -39,29 +38,29 @@ TEST(QueryStatus, CountsEachClientsQueriesAndWhyTheyWereRefused) {
   server.start();
   for (int i = 0; i < 3; ++i) {
     auto ok = point_query(1 + i, {0, 0, 0});
-    lc.publish(wire::kQueryChannel, &ok);
+    lc.publish(ort::protocol::kQueryChannel, &ok);
     ASSERT_EQ(replies.wait_for<Reply>(1 + i).status, Reply::REPLY_OK);
   }
   for (int depth : {17, 20}) {  // one reason, two numbers
     auto deep = point_query(10 + depth, {0, 0, 0});
     deep.depth = depth;
-    lc.publish(wire::kQueryChannel, &deep);
+    lc.publish(ort::protocol::kQueryChannel, &deep);
     ASSERT_EQ(replies.wait_for<Reply>(10 + depth).status, Reply::REPLY_BAD_REQUEST);
   }
   auto late = point_query(40, {0, 0, 0});
   late.wait_robot_id = "alpha", late.wait_seq = 5, late.wait_timeout_ms = 50;
-  lc.publish(wire::kQueryChannel, &late);
+  lc.publish(ort::protocol::kQueryChannel, &late);
   ASSERT_EQ(replies.wait_for<Reply>(40).status, Reply::REPLY_NOT_READY);
   auto nowhere = point_query(41, {0, 0, 0});
   nowhere.reply_channel = "";
-  lc.publish(wire::kQueryChannel, &nowhere);
+  lc.publish(ort::protocol::kQueryChannel, &nowhere);
   for (int i = 0; i < 100; ++i) {  // its queue holds 2: the rest are BUSY
     auto q = point_query(1000 + i, std::vector<float>(3 * 5000, 0.5f), "flooder");
-    lc.publish(wire::kQueryChannel, &q);
+    lc.publish(ort::protocol::kQueryChannel, &q);
   }
   octomap_rt::map_edit_t e{};
   e.request_id = 50, e.client_id = "op", e.reply_channel = kReply, e.token = "x", e.op = 3;
-  lc.publish(wire::kMapEditChannel, &e);
+  lc.publish(ort::protocol::kMapEditChannel, &e);
   ASSERT_EQ(replies.wait_for<octomap_rt::map_edit_ack_t>(50).status, Reply::REPLY_REFUSED);
   auto flood_done = [&] {
     for (const auto& c : server.query_stats())
@@ -70,7 +69,7 @@ TEST(QueryStatus, CountsEachClientsQueriesAndWhyTheyWereRefused) {
   };
   for (int i = 0; i < 2000 && !flood_done(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   auto last = point_query(2000, {0, 0, 0}, "flooder");  // heard from after the others
-  lc.publish(wire::kQueryChannel, &last);
+  lc.publish(ort::protocol::kQueryChannel, &last);
   ASSERT_EQ(replies.wait_for<Reply>(2000).status, Reply::REPLY_OK);
 
   const Status s = round_trip(server.status());
@@ -115,7 +114,7 @@ struct GridRows {
   std::mutex m;
   std::vector<octomap_rt::grid_t> got;
   explicit GridRows(daemon::MappingServer& s) {
-    s.lcm_loop().subscribe(wire::kGridChannel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
+    s.lcm_loop().subscribe(ort::protocol::kGridChannel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
       octomap_rt::grid_t g;
       if (g.decode(rb.data, 0, static_cast<int>(rb.data_size)) < 0) return;
       std::lock_guard lock(m);

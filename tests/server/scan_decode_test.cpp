@@ -9,8 +9,9 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/intake/scan_decode.h"
 #include "daemon/intake/scan_validation.h"
+#include "protocol/inbound_checks.h"
+#include "protocol/scan_decode.h"
 #include "server/scan_fixtures.h"
 
 namespace ort::test {
@@ -58,7 +59,7 @@ TEST(ScanDecode, EqualsLcmDecodeBitForBit) {
     octomap_rt::scan_t lcm_decoded, ours;
     ASSERT_EQ(lcm_decoded.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
     ours.xyz.assign(7, 1.0f);  // a reused message: what it held before must go
-    ASSERT_EQ(daemon::decode_scan(bytes.data(), bytes.size(), ours), static_cast<int>(bytes.size())) << points;
+    ASSERT_EQ(protocol::decode_scan(bytes.data(), bytes.size(), ours), static_cast<int>(bytes.size())) << points;
     expect_same(ours, lcm_decoded);
     expect_same(ours, m);
   }
@@ -69,9 +70,9 @@ TEST(ScanDecode, RefusesWhatLcmRefuses) {
   octomap_rt::scan_t out;
   auto wrong_hash = bytes;
   wrong_hash[0] ^= 1;
-  EXPECT_LT(daemon::decode_scan(wrong_hash.data(), wrong_hash.size(), out), 0);
-  EXPECT_LT(daemon::decode_scan(bytes.data(), 50, out), 0);                          // header cut
-  EXPECT_LT(daemon::decode_scan(bytes.data(), daemon::kScanXyzOffset + 8, out), 0);  // array cut
+  EXPECT_LT(protocol::decode_scan(wrong_hash.data(), wrong_hash.size(), out), 0);
+  EXPECT_LT(protocol::decode_scan(bytes.data(), 50, out), 0);                            // header cut
+  EXPECT_LT(protocol::decode_scan(bytes.data(), protocol::kScanXyzOffset + 8, out), 0);  // array cut
 }
 
 }  // namespace

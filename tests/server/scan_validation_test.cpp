@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "daemon/intake/scan_validation.h"
+#include "protocol/inbound_checks.h"
 #include "server/scan_fixtures.h"
 
 namespace ort::test {
@@ -62,25 +63,25 @@ TEST(ScanValidation, WrongFingerprint) {
 TEST(ScanValidation, CorruptCounts) {
   const auto good = encode(small_scan("alpha", 0, 10));
   auto neg = good;
-  put_be32(neg, daemon::kScanNumXyzOffset, -3);
+  put_be32(neg, protocol::kScanNumXyzOffset, -3);
   EXPECT_EQ(check(neg), Reject::kNegativeCount);
   auto huge = good;
-  put_be32(huge, daemon::kScanNumXyzOffset, std::numeric_limits<int32_t>::max());
+  put_be32(huge, protocol::kScanNumXyzOffset, std::numeric_limits<int32_t>::max());
   EXPECT_EQ(check(huge), Reject::kCountTooLarge);
   auto more = good;  // claims more points than the message carries
-  put_be32(more, daemon::kScanNumXyzOffset, 30 + 300);
+  put_be32(more, protocol::kScanNumXyzOffset, 30 + 300);
   EXPECT_EQ(check(more), Reject::kCountExceedsData);
   auto fewer = good;  // claims fewer: the last point's floats are then read as a string length
-  put_be32(fewer, daemon::kScanNumXyzOffset, 27);
+  put_be32(fewer, protocol::kScanNumXyzOffset, 27);
   EXPECT_EQ(check(fewer), Reject::kBadStringLength);
   auto extra = good;  // correct counts, extra bytes after the last field
   extra.insert(extra.end(), {0, 0, 0, 0});
   EXPECT_EQ(check(extra), Reject::kTrailingBytes);
   auto zero_len = encode(small_scan("alpha", 0, 0));  // robot_id length 0 (decode would throw)
-  put_be32(zero_len, daemon::kScanXyzOffset, 0);
+  put_be32(zero_len, protocol::kScanXyzOffset, 0);
   EXPECT_EQ(check(zero_len), Reject::kBadStringLength);
   auto no_nul = encode(small_scan("alpha", 0, 0));  // robot_id "alpha" whose NUL became 'x'
-  no_nul[daemon::kScanXyzOffset + 4 + 5] = 'x';
+  no_nul[protocol::kScanXyzOffset + 4 + 5] = 'x';
   EXPECT_EQ(check(no_nul), Reject::kBadStringLength);
   auto not3 = small_scan("alpha", 0, 10);
   not3.xyz.pop_back();

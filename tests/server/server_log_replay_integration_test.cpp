@@ -13,7 +13,7 @@
 #include "daemon/map/applied_order.h"
 #include "integration_harness.h"
 #include "octomap_rt/scan_t.hpp"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
 #include "scene/scan_set.h"
 #include "support/octomap_reference.h"
 #include "support/test_data.h"
@@ -101,7 +101,7 @@ TEST(ServerLogReplayIntegration, ALoggedSessionReplaysIntoTheDaemonByReplayAndBy
     ASSERT_TRUE(logger.wait(30).has_value()) << logger.log();
   }
   size_t logged_scans = 0;
-  cli::for_each_log_scan(log, octomap_rt::wire::kScanChannelPrefix, [&](const cli::LogScanEvent&) {
+  cli::for_each_log_scan(log, ort::protocol::kScanChannelPrefix, [&](const cli::LogScanEvent&) {
     ++logged_scans;
     return true;
   });
@@ -145,7 +145,7 @@ TEST(ServerLogReplayIntegration, ALoggedSessionReplaysIntoTheDaemonByReplayAndBy
   // 4. `octomap-rt replay LOG --robot solo`: every logged scan renamed to one robot and
   // renumbered, in log order; the map is OctoMap's of the scans in that order.
   ScanSet log_order;
-  cli::for_each_log_scan(log, octomap_rt::wire::kScanChannelPrefix, [&](const cli::LogScanEvent& e) {
+  cli::for_each_log_scan(log, ort::protocol::kScanChannelPrefix, [&](const cli::LogScanEvent& e) {
     octomap_rt::scan_t m;
     EXPECT_GE(m.decode(e.data, 0, static_cast<int>(e.size)), 0);
     const int p = producer_index(m.robot_id, "prod", kProducers);

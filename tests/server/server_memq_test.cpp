@@ -12,7 +12,8 @@
 #include "daemon/intake/scan_validation.h"
 #include "daemon/persistence/map_store.h"
 #include "octomap_rt/server_status_t.hpp"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
+#include "protocol/inbound_checks.h"
 #include "scene/synthetic_scene.h"
 #include "server/scan_fixtures.h"
 #include "support/octomap_reference.h"
@@ -25,7 +26,7 @@ namespace {
 using daemon::Reject;
 
 std::string channel_of(const std::string& robot) {
-  std::string c = octomap_rt::wire::kScanChannelPrefix;
+  std::string c = ort::protocol::kScanChannelPrefix;
   for (char ch : robot) c += static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
   return c;
 }
@@ -83,17 +84,17 @@ TEST(ServerMemq, CraftedBadMessagesAreCountedAndServingGoesOn) {
   }  // wrong fingerprint
   {
     auto b = good;
-    put_be32(b, daemon::kScanNumXyzOffset, -30);
+    put_be32(b, protocol::kScanNumXyzOffset, -30);
     bad(b);
   }  // negative count
   {
     auto b = good;
-    put_be32(b, daemon::kScanNumXyzOffset, 0x7fffffff);
+    put_be32(b, protocol::kScanNumXyzOffset, 0x7fffffff);
     bad(b);
   }  // huge count
   {
     auto b = good;
-    put_be32(b, daemon::kScanNumXyzOffset, 3000);
+    put_be32(b, protocol::kScanNumXyzOffset, 3000);
     bad(b);
   }  // count > data
   {

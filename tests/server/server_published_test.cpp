@@ -12,7 +12,7 @@
 #include "daemon/mapping_server.h"
 #include "octomap_rt/map_delta_t.hpp"
 #include "octomap_rt/server_status_t.hpp"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
 #include "server/scan_fixtures.h"
 
 namespace ort::test {
@@ -48,7 +48,7 @@ std::optional<octomap_rt::map_delta_t> first_delta_reaching(MessageSink<octomap_
 TEST(ServerMemq, StatusIsPublished) {
   lcm::LCM lc("memq://");
   MessageSink<octomap_rt::server_status_t> sink;  // subscribed before the server's thread handles
-  lc.subscribe(octomap_rt::wire::kStatusChannel, &MessageSink<octomap_rt::server_status_t>::on, &sink);
+  lc.subscribe(ort::protocol::kStatusChannel, &MessageSink<octomap_rt::server_status_t>::on, &sink);
   auto cfg = test_config(0.1, true);
   std::ostringstream log;
   daemon::MappingServer server(cfg, lc, log);
@@ -87,7 +87,7 @@ TEST(ServerMemq, StatusIsPublished) {
 TEST(ServerMemq, AScanThatChangesNoClassStillAdvancesTheDeltaVersion) {
   lcm::LCM lc("memq://");
   MessageSink<octomap_rt::map_delta_t> sink;
-  lc.subscribe(octomap_rt::wire::kMapDeltaChannel, &MessageSink<octomap_rt::map_delta_t>::on, &sink);
+  lc.subscribe(ort::protocol::kMapDeltaChannel, &MessageSink<octomap_rt::map_delta_t>::on, &sink);
   auto cfg = test_config(0.1, true);
   std::ostringstream log;
   daemon::MappingServer server(cfg, lc, log);

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "daemon/mapping_server.h"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
 #include "scene/scan_set.h"
 #include "server/scan_fixtures.h"
 #include "support/test_data.h"
@@ -32,7 +32,7 @@ TEST(ServerStatusCounts, BigMapIsExactOnceDrained) {
   server.start();
   for (size_t k = 0; k < set.scans.size(); ++k) {
     const auto msg = scan_message(set.scans[k], "husky1", static_cast<int64_t>(k));
-    lc.publish(std::string(octomap_rt::wire::kScanChannelPrefix) + "HUSKY1", &msg);
+    lc.publish(std::string(ort::protocol::kScanChannelPrefix) + "HUSKY1", &msg);
     ASSERT_TRUE(wait_until_done(server, static_cast<int64_t>(k + 1)));
     (void)server.status();  // a status while the map grows
   }
@@ -62,7 +62,7 @@ TEST(ServerStatusCounts, SlowestScansAreAppliedScansWithTheirParts) {
     for (size_t k = 0; k < set.scans.size(); ++k, ++sent) {
       const std::string robot = sent % 2 ? "husky2" : "husky1";  // odd seqs from husky2
       const auto msg = scan_message(set.scans[k], robot, sent);
-      lc.publish(std::string(octomap_rt::wire::kScanChannelPrefix) + (sent % 2 ? "HUSKY2" : "HUSKY1"), &msg);
+      lc.publish(std::string(ort::protocol::kScanChannelPrefix) + (sent % 2 ? "HUSKY2" : "HUSKY1"), &msg);
     }
   ASSERT_TRUE(wait_until_done(server, sent));
   server.stop();

@@ -21,6 +21,7 @@
 
 #include "cli/replay/scan_message.h"
 #include "octomap_rt/server_status_t.hpp"
+#include "protocol/channels.h"
 #include "scene/synthetic_scene.h"
 
 namespace ort::cli {
@@ -98,7 +99,7 @@ std::vector<PosedScan> load_scans(int points) {
 class StatusTracker {
  public:
   explicit StatusTracker(const std::string& url) : lcm_(url) {
-    lcm_.subscribe("OCTOMAP_RT_STATUS", &StatusTracker::on_status, this);
+    lcm_.subscribe(ort::protocol::kStatusChannel, &StatusTracker::on_status, this);
     thread_ = std::thread([this] {
       while (!stop_) lcm_.handleTimeout(100);
     });
@@ -140,7 +141,7 @@ void publish_for(const std::string& url, int index, const LoadTestConfig& cfg, c
                  std::atomic<int64_t>& published, std::atomic<int64_t>& errors) {
   lcm::LCM lc(url);
   const std::string robot = "load" + std::to_string(index);
-  const std::string channel = scan_channel("OCTOMAP_RT_SCAN_", robot);
+  const std::string channel = scan_channel(ort::protocol::kScanChannelPrefix, robot);
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / cfg.rate_hz));
   const auto end =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.duration_s));

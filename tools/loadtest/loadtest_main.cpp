@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "load_test.h"
+#include "protocol/limits.h"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -21,7 +22,9 @@ int main(int argc, char** argv) {
   app.add_option("--duration", cfg.duration_s, "seconds of publishing")
       ->check(CLI::Range(0.1, 86400.0))
       ->capture_default_str();
-  app.add_option("--points", cfg.points, "points per scan")->check(CLI::Range(1, 4'000'000))->capture_default_str();
+  app.add_option("--points", cfg.points, "points per scan")
+      ->check(CLI::Range(uint64_t{1}, ort::protocol::kDefaultMaxScanPoints))
+      ->capture_default_str();
   app.add_option("--settle", cfg.settle_s, "seconds to wait afterwards for the queue to empty")->capture_default_str();
   app.add_option("--server", cfg.server, "octomap-rt-server program")->capture_default_str();
   app.add_option("--log", cfg.log_path, "the server's log file")->capture_default_str();

@@ -16,6 +16,7 @@
 
 #include "daemon/mapping_server.h"
 #include "engine/engine_flags.h"
+#include "protocol/channels.h"
 #include "scene/scan_set.h"
 #include "scene/synthetic_scene.h"
 
@@ -70,7 +71,8 @@ RunResult run(const daemon::ServerConfig& base, bool pipelined, const ScanSet& s
   std::vector<std::thread> threads;
   for (int p = 0; p < producers; ++p)
     threads.emplace_back([&, p] {
-      for (const auto& m : msgs[p]) lc.publish("OCTOMAP_RT_SCAN_BENCH" + std::to_string(p), &m);
+      for (const auto& m : msgs[p])
+        lc.publish(std::string(ort::protocol::kScanChannelPrefix) + "BENCH" + std::to_string(p), &m);
     });
   for (auto& t : threads) t.join();
   for (;;) {

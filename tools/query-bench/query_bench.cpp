@@ -30,17 +30,17 @@
 #include "octomap_rt/occupancy_reply_t.hpp"
 #include "octomap_rt/ray_query_t.hpp"
 #include "octomap_rt/ray_reply_t.hpp"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
+#include "protocol/lcm_url.h"
+#include "protocol/limits.h"
 #include "scene/scan_set.h"
 
 namespace {
 
 using SteadyClock = std::chrono::steady_clock;
 using Reply = octomap_rt::occupancy_reply_t;
-namespace wire = octomap_rt::wire;
-
 struct Options {
-  std::string graph, lcm_url = wire::kDefaultLcmUrl, until_file, client_id = "query-bench";
+  std::string graph, lcm_url = ort::protocol::kDefaultLcmUrl, until_file, client_id = "query-bench";
   double rate = 100, duration_s = 30, box_m = 5, jitter_m = 0.3, ray_range_m = 30;
   int points = 1000, rays = 100;
   unsigned seed = 1;
@@ -98,7 +98,7 @@ class Queries {
         q.xyz.insert(q.xyz.end(), {p.x() + jitter(), p.y() + jitter(), p.z() + jitter()});
       }
       q.num_xyz = static_cast<int32_t>(q.xyz.size());
-      lc.publish(wire::kQueryChannel, &q);
+      lc.publish(ort::protocol::kQueryChannel, &q);
     } else if (kind == 1) {
       octomap_rt::ray_query_t q{};
       address(q, id, kind, o_, reply_);
@@ -111,7 +111,7 @@ class Queries {
         q.direction_xyz.insert(q.direction_xyz.end(), {d.x(), d.y(), d.z()});
       }
       q.num_xyz = static_cast<int32_t>(q.origin_xyz.size());
-      lc.publish(wire::kQueryRaysChannel, &q);
+      lc.publish(ort::protocol::kQueryRaysChannel, &q);
     } else {
       octomap_rt::box_query_t q{};
       address(q, id, kind, o_, reply_);
@@ -120,7 +120,7 @@ class Queries {
       const double h = o_.box_m / 2;
       q.boxes = {c.x() - h, c.y() - h, c.z() - h, c.x() + h, c.y() + h, c.z() + h};
       q.num_values = 6;
-      lc.publish(wire::kQueryBoxesChannel, &q);
+      lc.publish(ort::protocol::kQueryBoxesChannel, &q);
     }
   }
 
@@ -265,14 +265,18 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--duration", o.duration_s, "seconds to send for")->capture_default_str();
   app.add_option("--until-file", o.until_file, "stop sending as soon as this file exists");
-  app.add_option("--points", o.points, "points per point query")->check(CLI::Range(1, 5000))->capture_default_str();
-  app.add_option("--rays", o.rays, "rays per ray query")->check(CLI::Range(1, 2000))->capture_default_str();
+  app.add_option("--points", o.points, "points per point query")
+      ->check(CLI::Range(int64_t{1}, ort::protocol::kMaxQueryPoints))
+      ->capture_default_str();
+  app.add_option("--rays", o.rays, "rays per ray query")
+      ->check(CLI::Range(int64_t{1}, ort::protocol::kMaxQueryRays))
+      ->capture_default_str();
   app.add_option("--ray-range", o.ray_range_m, "max range of the rays [m]")->capture_default_str();
   app.add_option("--box", o.box_m, "side of the box queries [m]")->capture_default_str();
   app.add_option("--seed", o.seed, "random seed")->capture_default_str();
   app.add_option("--client-id", o.client_id,
-                 "client id prefix: the kinds are clients ID-points, ID-rays, ID-boxes (replies on "
-                 "OCTOMAP_RT_REPLY_<ID>)")
+                 "client id prefix: the kinds are clients ID-points, ID-rays, ID-boxes (replies on " +
+                     std::string(ort::protocol::kQueryReplyPrefix) + "<ID>)")
       ->capture_default_str();
   app.add_flag("--json", o.json, "one JSON document on stdout");
   CLI11_PARSE(app, argc, argv);
@@ -285,7 +289,7 @@ int main(int argc, char** argv) {
     Ledger ledger(kinds);
     lcm::LCM lc(o.lcm_url);
     if (!lc.good()) throw std::runtime_error("LCM could not start on '" + o.lcm_url + "'");
-    std::string reply_channel = std::string(wire::kQueryReplyPrefix) + o.client_id;
+    std::string reply_channel = std::string(ort::protocol::kQueryReplyPrefix) + o.client_id;
     for (char& c : reply_channel) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
     lc.subscribe(reply_channel, &Ledger::on_reply, &ledger);  // before the handling thread starts
     std::atomic<bool> stop{false};

@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-#include "daemon/intake/scan_validation.h"
+#include "protocol/ids.h"
 
 namespace ort::daemon {
 namespace {
@@ -45,7 +45,7 @@ size_t ProducerRegistry::special_entry(size_t& index, const char* channel, const
 bool ProducerRegistry::allowed(const std::string& robot_id) const {
   if (policy_.allowed_robots.empty()) return true;
   for (const std::string& id : policy_.allowed_robots)
-    if (same_robot_id(id, robot_id)) return true;
+    if (protocol::same_robot_id(id, robot_id)) return true;
   return false;
 }
 

@@ -1,12 +1,13 @@
 #include "daemon/intake/scan_validation.h"
 
-#include <cctype>
 #include <cmath>
 #include <exception>
 
 #include "core/prepare_scan.h"
-#include "daemon/intake/scan_decode.h"
-#include "protocol/wire_layout.h"
+#include "protocol/ids.h"
+#include "protocol/inbound_checks.h"
+#include "protocol/limits.h"
+#include "protocol/scan_decode.h"
 
 namespace ort::daemon {
 namespace {
@@ -25,39 +26,16 @@ Reject reject_of(protocol::WireFault fault) {
     case F::kBadStringLength:
     case F::kStringNotTerminated: return Reject::kBadStringLength;
     case F::kTrailingBytes: return Reject::kTrailingBytes;
+    case F::kTooLarge: return Reject::kTooLarge;
+    case F::kUndecodable: return Reject::kDecodeFailed;
   }
   return Reject::kTruncated;
 }
 
 }  // namespace
 
-bool valid_robot_id(const std::string& id) {
-  if (id.empty() || id.size() > kMaxRobotIdLength) return false;
-  for (char c : id) {
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) return false;
-  }
-  return true;
-}
-
-bool same_robot_id(const std::string& a, const std::string& b) {
-  if (a.size() != b.size()) return false;
-  for (size_t i = 0; i < a.size(); ++i) {
-    if (std::toupper(static_cast<unsigned char>(a[i])) != std::toupper(static_cast<unsigned char>(b[i]))) return false;
-  }
-  return true;
-}
-
 Reject check_scan_wire(const uint8_t* data, size_t size, const ScanLimits& limits) {
-  // Largest legal message: header, max points, two strings of the longest allowed length.
-  const uint64_t max_size = kScanXyzOffset + 12 * limits.max_points + 8 + kMaxRobotIdLength + kMaxMapFrameLength + 2;
-  if (size > max_size) return Reject::kTooLarge;
-  // scan_t's layout (lcmtypes/octomap_rt_scan_t.lcm): the fixed fields, num_xyz, xyz[], robot_id, map_frame.
-  namespace p = protocol;
-  return reject_of(
-      p::check_wire(data, size, octomap_rt::scan_t::getHash(),
-                    {p::wire_fixed(kScanNumXyzOffset - 8), p::wire_count(3 * static_cast<int64_t>(limits.max_points)),
-                     p::wire_array(4), p::wire_string(kMaxRobotIdLength), p::wire_string(kMaxMapFrameLength)})
-          .fault);
+  return reject_of(protocol::check_scan_bytes(data, size, limits.max_points).fault);
 }
 
 Reject check_scan_content(const octomap_rt::scan_t& m, const std::string& expected_robot_id, const ScanLimits& limits) {
@@ -77,13 +55,13 @@ Reject check_scan_content(const octomap_rt::scan_t& m, const std::string& expect
   if (!std::isfinite(m.max_range)) return Reject::kBadMaxRange;
   // <= 0 means "no limit of its own"; a positive one so small that every ray is cut to the
   // sensor's own voxel is a unit or encoding mistake (the flags' rule: prepare_scan.h).
-  static_assert(octomap_rt::wire::kMinScanMaxRange == kMinMaxRange);
-  if (m.max_range > 0 && m.max_range < octomap_rt::wire::kMinScanMaxRange) return Reject::kMaxRangeTooSmall;
+  static_assert(protocol::kMinScanMaxRange == kMinMaxRange);
+  if (m.max_range > 0 && m.max_range < protocol::kMinScanMaxRange) return Reject::kMaxRangeTooSmall;
   if (m.points_frame != octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME &&
       m.points_frame != octomap_rt::scan_t::POINTS_IN_MAP_FRAME)
     return Reject::kUnknownPointsFrame;
-  if (!valid_robot_id(m.robot_id)) return Reject::kBadRobotId;
-  if (!same_robot_id(m.robot_id, expected_robot_id)) return Reject::kRobotIdMismatch;
+  if (!protocol::valid_robot_id(m.robot_id)) return Reject::kBadRobotId;
+  if (!protocol::same_robot_id(m.robot_id, expected_robot_id)) return Reject::kRobotIdMismatch;
   // The ray origin is the position rounded to float, as OctoMap's pose6d holds it. A double
   // far outside the key range (up to 1e308) is refused before that rounding (which is only
   // defined for values a float can hold).
@@ -102,7 +80,7 @@ Reject validate_scan(const uint8_t* data, size_t size, const std::string& expect
                      octomap_rt::scan_t& out) {
   if (Reject r = check_scan_wire(data, size, limits); r != Reject::kNone) return r;
   try {
-    const int used = decode_scan(data, size, out);  // = out.decode(), the point array vectorized
+    const int used = protocol::decode_scan(data, size, out);  // = out.decode(), the point array vectorized
     if (used < 0) return Reject::kDecodeFailed;
     if (static_cast<size_t>(used) != size) return Reject::kTrailingBytes;
   } catch (const std::exception&) {

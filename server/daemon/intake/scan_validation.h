@@ -12,32 +12,23 @@
 
 #include "daemon/intake/reject_reason.h"
 #include "octomap_rt/scan_t.hpp"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/limits.h"
 
 namespace ort::daemon {
 
 struct ScanLimits {
-  uint64_t max_points = octomap_rt::wire::kDefaultMaxScanPoints;  // per scan; bounds num_xyz before any allocation
-  double resolution = 0.1;                                        // map resolution: the origin must have a key
+  uint64_t max_points = ort::protocol::kDefaultMaxScanPoints;  // per scan; bounds num_xyz before any allocation
+  double resolution = 0.1;                                     // map resolution: the origin must have a key
 };
 
-// Byte offsets in an encoded scan_t (the 8-byte fingerprint included). The .lcm file keeps
-// only fixed-size fields before num_xyz so these are constants.
-inline constexpr size_t kScanNumXyzOffset = 85;
-inline constexpr size_t kScanXyzOffset = 89;
-inline constexpr size_t kMaxRobotIdLength = octomap_rt::wire::kMaxRobotIdLength;
-inline constexpr size_t kMaxMapFrameLength = octomap_rt::wire::kMaxMapFrameLength;
-
-// Robot ids: 1-32 of [A-Za-z0-9_-].
-bool valid_robot_id(const std::string& id);
-// Case-insensitive equality: channel OCTOMAP_RT_SCAN_HUSKY3 carries robot_id "husky3".
-bool same_robot_id(const std::string& a, const std::string& b);
+// Robot ids: protocol/ids.h (valid_robot_id, same_robot_id).
 
 // Checks `data` and decodes it into `out`. `expected_robot_id` is the channel's suffix.
 Reject validate_scan(const uint8_t* data, size_t size, const std::string& expected_robot_id, const ScanLimits& limits,
                      octomap_rt::scan_t& out);
 
-// Wire checks only (no decode): kNone when decode() may run safely.
+// Wire checks only (no decode; protocol::check_scan_bytes as a reject reason): kNone when
+// decode() may run safely.
 Reject check_scan_wire(const uint8_t* data, size_t size, const ScanLimits& limits);
 // Content checks on a decoded message.
 Reject check_scan_content(const octomap_rt::scan_t& msg, const std::string& expected_robot_id,

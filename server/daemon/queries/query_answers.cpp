@@ -4,12 +4,13 @@
 #include <cmath>
 #include <span>
 
-#include "daemon/queries/query_wire.h"
 #include "octomap_rt/box_reply_t.hpp"
 #include "octomap_rt/grid_t.hpp"
 #include "octomap_rt/occupancy_reply_t.hpp"
 #include "octomap_rt/ray_reply_t.hpp"
 #include "octomap_rt/region_chunk_t.hpp"
+#include "protocol/inbound_checks.h"
+#include "protocol/limits.h"
 #include "query/box_count.h"
 #include "query/point_query.h"
 #include "query/projected_grid.h"
@@ -21,7 +22,7 @@ namespace {
 
 using Reply = octomap_rt::occupancy_reply_t;
 using Box = octomap_rt::box_query_t;
-constexpr int kRegionChunk = 4000, kGridChunkCells = 60000;
+constexpr int kRegionChunk = protocol::kRegionChunkVoxels, kGridChunkCells = protocol::kGridChunkCells;
 
 int64_t now_us() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())

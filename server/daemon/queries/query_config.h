@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <string>
 
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
 
 namespace ort::daemon {
 
@@ -14,15 +14,15 @@ struct GridPublishConfig {
   double rate_hz = 0;           // 0: not published
   double z_min = 0, z_max = 0;  // the band [m]
   double cell_size = 0;         // [m]; 0: the resolution; else a multiple of it
-  std::string channel = octomap_rt::wire::kGridChannel;
+  std::string channel = ort::protocol::kGridChannel;
 };
 
 struct QueryServiceConfig {
-  std::string points_channel = octomap_rt::wire::kQueryChannel;
-  std::string rays_channel = octomap_rt::wire::kQueryRaysChannel;
-  std::string boxes_channel = octomap_rt::wire::kQueryBoxesChannel;
-  std::string grid_channel = octomap_rt::wire::kQueryGridChannel;
-  std::string edit_channel = octomap_rt::wire::kMapEditChannel;
+  std::string points_channel = ort::protocol::kQueryChannel;
+  std::string rays_channel = ort::protocol::kQueryRaysChannel;
+  std::string boxes_channel = ort::protocol::kQueryBoxesChannel;
+  std::string grid_channel = ort::protocol::kQueryGridChannel;
+  std::string edit_channel = ort::protocol::kMapEditChannel;
   std::string control_token;     // "": every edit is refused
   size_t per_client_queue = 16;  // queued queries per client; more get BUSY
   size_t max_clients = 256;      // distinct client ids tracked; the rest share "*"

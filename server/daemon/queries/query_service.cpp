@@ -6,11 +6,12 @@
 #include <cmath>
 
 #include "daemon/map/map_edit_item.h"
-#include "daemon/queries/query_wire.h"
 #include "octomap_rt/map_edit_ack_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/occupancy_reply_t.hpp"
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/channels.h"
+#include "protocol/ids.h"
+#include "protocol/inbound_checks.h"
 #include "query/query_types.h"
 
 namespace ort::daemon {
@@ -18,13 +19,10 @@ namespace {
 
 using Reply = octomap_rt::occupancy_reply_t;
 using Count = QueryClients::Count;
-constexpr size_t kMaxMessage = 65536;
 const std::string kNoClient = "?";
 constexpr size_t kMaxParked = 256;  // queries waiting for their map state, all clients
 // Longest a batch of queries holds the map for reading (stage 2 may be waiting to write).
 constexpr auto kReadTurn = std::chrono::milliseconds(10);
-
-bool id_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.'; }
 
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -54,16 +52,16 @@ QueryService::~QueryService() { stop(); }
 void QueryService::open() {
   using namespace octomap_rt;
   subs_.push_back(loop_.subscribe(cfg_.points_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
-    on_query<occupancy_query_t>(rb, check_occupancy_query);
+    on_query<occupancy_query_t>(rb, protocol::check_occupancy_query_bytes);
   }));
   subs_.push_back(loop_.subscribe(cfg_.rays_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
-    on_query<ray_query_t>(rb, check_ray_query);
+    on_query<ray_query_t>(rb, protocol::check_ray_query_bytes);
   }));
   subs_.push_back(loop_.subscribe(cfg_.boxes_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
-    on_query<box_query_t>(rb, check_box_query);
+    on_query<box_query_t>(rb, protocol::check_box_query_bytes);
   }));
   subs_.push_back(loop_.subscribe(cfg_.grid_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
-    on_query<grid_query_t>(rb, check_grid_query);
+    on_query<grid_query_t>(rb, protocol::check_grid_query_bytes);
   }));
   subs_.push_back(
       loop_.subscribe(cfg_.edit_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) { on_edit(rb); }));
@@ -94,36 +92,23 @@ void QueryService::stop() {
 }
 
 std::string QueryService::check_addressing(const std::string& client, const std::string& channel) const {
-  if (client.empty() || client.size() > 64) return "client_id must have 1..64 characters";
-  for (char c : client)
-    if (!id_char(c)) return "client_id may hold only letters, digits, '_', '-', '.'";
-  if (channel.empty() || channel.size() > 128) return "reply_channel must have 1..128 characters";
-  for (char c : channel)
-    if (!std::isgraph(static_cast<unsigned char>(c))) return "reply_channel may hold only printable characters";
+  if (std::string why = protocol::check_client_id(client); !why.empty()) return why;
+  if (std::string why = protocol::check_reply_channel(channel); !why.empty()) return why;
   // Replies must not land on the server's own inputs.
   for (const std::string* own :
        {&cfg_.points_channel, &cfg_.rays_channel, &cfg_.boxes_channel, &cfg_.grid_channel, &cfg_.edit_channel})
     if (channel == *own) return "reply_channel is one of the server's request channels";
   if (channel == cfg_.grid.channel) return "reply_channel is the server's grid channel";
-  if (channel.rfind(octomap_rt::wire::kScanChannelPrefix, 0) == 0 || channel == octomap_rt::wire::kStatusChannel)
+  if (channel.rfind(ort::protocol::kScanChannelPrefix, 0) == 0 || channel == ort::protocol::kStatusChannel)
     return "reply_channel is one of the server's scan or status channels";
   return "";
 }
 
 template <class Message>
-void QueryService::on_query(const lcm::ReceiveBuffer& rb, std::string (*check)(const uint8_t*, size_t)) {
-  const auto* data = static_cast<const uint8_t*>(rb.data);
-  const size_t size = rb.data_size;
-  std::string why = size > kMaxMessage ? "message over 64 KiB" : check(data, size);
+void QueryService::on_query(const lcm::ReceiveBuffer& rb, protocol::WireCheck (*check)(const uint8_t*, size_t)) {
   Message msg;
-  if (why.empty()) {
-    try {
-      if (msg.decode(data, 0, static_cast<int>(size)) < 0) why = "decode failed";
-    } catch (const std::exception& e) {
-      why = std::string("decode failed: ") + e.what();
-    }
-  }
-  if (!why.empty()) {  // nobody to answer: the addressing cannot be trusted
+  if (const protocol::WireCheck c = protocol::decode_checked(rb.data, rb.data_size, check, msg); !c.ok()) {
+    const std::string why = protocol::describe(c);  // nobody to answer: the addressing cannot be trusted
     clients_.count(kNoClient, Count::kDropped, why);
     return;
   }
@@ -155,16 +140,9 @@ void QueryService::on_query(const lcm::ReceiveBuffer& rb, std::string (*check)(c
 
 void QueryService::on_edit(const lcm::ReceiveBuffer& rb) {
   using Edit = octomap_rt::map_edit_t;
-  const auto* data = static_cast<const uint8_t*>(rb.data);
-  std::string why = rb.data_size > kMaxMessage ? "message over 64 KiB" : check_map_edit(data, rb.data_size);
   Edit msg;
-  if (why.empty()) {
-    try {
-      if (msg.decode(data, 0, static_cast<int>(rb.data_size)) < 0) why = "decode failed";
-    } catch (const std::exception& e) {
-      why = std::string("decode failed: ") + e.what();
-    }
-  }
+  std::string why =
+      protocol::describe(protocol::decode_checked(rb.data, rb.data_size, protocol::check_map_edit_bytes, msg));
   if (why.empty()) why = check_addressing(msg.client_id, msg.reply_channel);
   if (!why.empty()) {
     clients_.count(kNoClient, Count::kDropped, "map edit: " + why);

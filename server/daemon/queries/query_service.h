@@ -29,6 +29,7 @@
 #include "daemon/queries/query_clients.h"
 #include "daemon/queries/query_config.h"
 #include "daemon/transport/lcm_loop.h"
+#include "protocol/wire_layout.h"
 
 namespace ort::daemon {
 
@@ -47,7 +48,7 @@ class QueryService {
 
  private:
   template <class Message>
-  void on_query(const lcm::ReceiveBuffer& rb, std::string (*check)(const uint8_t*, size_t));
+  void on_query(const lcm::ReceiveBuffer& rb, protocol::WireCheck (*check)(const uint8_t*, size_t));
   void on_edit(const lcm::ReceiveBuffer& rb);
   // "" when client_id and reply_channel are usable for a reply.
   std::string check_addressing(const std::string& client, const std::string& channel) const;

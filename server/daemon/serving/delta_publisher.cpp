@@ -9,7 +9,7 @@
 #include "octomap_rt/map_chunk_t.hpp"
 #include "octomap_rt/map_delta_t.hpp"
 #include "protocol/delta_codec.h"
-#include "protocol/map_protocol.h"
+#include "protocol/limits.h"
 #include "protocol/zstd_codec.h"
 
 namespace ort::daemon {

@@ -23,12 +23,13 @@
 #include "daemon/map/map_state.h"
 #include "daemon/transport/lcm_loop.h"
 #include "octree/leaf_changes.h"
+#include "protocol/channels.h"
 #include "protocol/delta_codec.h"
 
 namespace ort::daemon {
 
 struct DeltaConfig {
-  std::string channel = "OCTOMAP_RT_MAP_DELTA";
+  std::string channel = ort::protocol::kMapDeltaChannel;
   double max_rate_hz = 10;  // <= 0: no deltas
   bool exact = false;       // every changed leaf with its log-odds, not only class changes
   int zstd_level = 3;

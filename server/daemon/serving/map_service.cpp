@@ -5,8 +5,11 @@
 
 #include "octomap_rt/map_chunk_t.hpp"
 #include "octomap_rt/map_info_t.hpp"
+#include "protocol/ids.h"
+#include "protocol/inbound_checks.h"
+#include "protocol/limits.h"
 #include "protocol/map_protocol.h"
-#include "protocol/wire_checks.h"
+#include "protocol/version.h"
 
 namespace ort::daemon {
 namespace {
@@ -71,8 +74,8 @@ MapServiceStats MapService::stats() const {
 // On the LCM loop: check and queue, nothing slow.
 void MapService::on_request(const lcm::ReceiveBuffer& rbuf) {
   octomap_rt::map_request_t req{};
-  if (!protocol::check_request(rbuf.data, rbuf.data_size, req).empty()) {
-    refuse(nullptr, RequestRefusal::kUndecodable, "");
+  if (!protocol::check_request(rbuf.data, rbuf.data_size, req).ok()) {
+    refuse(nullptr, protocol::RequestRefusal::kUndecodable, "");
     return;
   }
   {
@@ -83,7 +86,7 @@ void MapService::on_request(const lcm::ReceiveBuffer& rbuf) {
       return;
     }
   }
-  refuse(&req, RequestRefusal::kBusy, "");
+  refuse(&req, protocol::RequestRefusal::kBusy, "");
 }
 
 void MapService::run() {
@@ -114,21 +117,21 @@ void MapService::run() {
 }
 
 void MapService::serve(const octomap_rt::map_request_t& req) {
-  RequestRefusal why = check_map_request(req);
-  if (why != RequestRefusal::kNone) return refuse(&req, why, "");
+  protocol::RequestRefusal why = protocol::check_map_request(req);
+  if (why != protocol::RequestRefusal::kNone) return refuse(&req, why, "");
   bool took_new = false;
   // snapshot_id: < 0 a fresh snapshot, 0 the latest kept (maybe older than the map), > 0 that one.
   std::shared_ptr<const SnapshotBlob> blob = req.snapshot_id <= 0
                                                  ? store_.latest(map_, req.format, req.snapshot_id < 0, took_new)
                                                  : store_.find(static_cast<uint64_t>(req.snapshot_id), req.format);
   if (!blob)
-    return refuse(&req, RequestRefusal::kUnknownSnapshot,
+    return refuse(&req, protocol::RequestRefusal::kUnknownSnapshot,
                   "snapshot " + std::to_string(req.snapshot_id) + " is not kept; the latest is " +
                       std::to_string(store_.latest_id()) + " (ask for 0 = latest)");
   const int32_t n = blob->num_chunks(protocol::kChunkDataBytes);
   for (int32_t i : req.chunk_indices)
     if (i >= n)
-      return refuse(&req, RequestRefusal::kChunkOutOfRange,
+      return refuse(&req, protocol::RequestRefusal::kChunkOutOfRange,
                     "chunk " + std::to_string(i) + " of a snapshot of " + std::to_string(n) + " chunks");
   note_blob(*blob);
   if (took_new) publish_info();
@@ -147,13 +150,13 @@ void MapService::note_blob(const SnapshotBlob& b) {
   stats_.last_size = static_cast<int64_t>(b.bytes.size());
 }
 
-void MapService::refuse(const octomap_rt::map_request_t* req, RequestRefusal why, const std::string& detail) {
+void MapService::refuse(const octomap_rt::map_request_t* req, protocol::RequestRefusal why, const std::string& detail) {
   {
     std::lock_guard lock(mutex_);
     stats_.requests_rejected++;
     stats_.refusals[static_cast<size_t>(why)]++;
   }
-  if (!req || !can_reply(*req)) return;  // nowhere safe to answer: ignored (counted)
+  if (!req || !protocol::can_reply(*req)) return;  // nowhere safe to answer: ignored (counted)
   Chunk c{};
   c.utime = utime_now();
   c.request_id = req->request_id;
@@ -204,6 +207,7 @@ void MapService::send_chunks(const octomap_rt::map_request_t& req, const Snapsho
 
 void MapService::publish_info() {
   octomap_rt::map_info_t m{};
+  m.protocol_version = protocol::kProtocolVersion;
   m.utime = utime_now();
   {
     std::lock_guard lock(map_.mutex);

@@ -20,16 +20,17 @@
 #include <thread>
 
 #include "daemon/map/map_state.h"
-#include "daemon/serving/map_request_rules.h"
 #include "daemon/serving/snapshot_store.h"
 #include "daemon/transport/lcm_loop.h"
 #include "octomap_rt/map_request_t.hpp"
+#include "protocol/channels.h"
+#include "protocol/map_request_rules.h"
 
 namespace ort::daemon {
 
 struct MapServiceConfig {
-  std::string request_channel = "OCTOMAP_RT_MAP_REQUEST";
-  std::string info_channel = "OCTOMAP_RT_MAP_INFO";
+  std::string request_channel = ort::protocol::kMapRequestChannel;
+  std::string info_channel = ort::protocol::kMapInfoChannel;
   SnapshotPolicy snapshots;
   double chunk_interval_ms = 1.5;  // between two chunks sent (pacing)
   double info_period_s = 1.0;
@@ -42,7 +43,7 @@ struct MapServiceConfig {
 struct MapServiceStats {
   int64_t requests_served = 0, requests_rejected = 0, snapshots_taken = 0, chunks_sent = 0;
   int64_t latest_snapshot_id = -1;
-  std::array<int64_t, kRequestRefusalCount> refusals{};
+  std::array<int64_t, protocol::kRequestRefusalCount> refusals{};
   double last_copy_lock_ms = 0, max_copy_lock_ms = 0, last_serialize_ms = 0, last_compress_ms = 0;
   int64_t last_raw_size = 0, last_size = 0;
 };
@@ -65,7 +66,7 @@ class MapService {
   void on_request(const lcm::ReceiveBuffer& rbuf);
   void run();
   void serve(const octomap_rt::map_request_t& req);
-  void refuse(const octomap_rt::map_request_t* req, RequestRefusal why, const std::string& detail);
+  void refuse(const octomap_rt::map_request_t* req, protocol::RequestRefusal why, const std::string& detail);
   void send_chunks(const octomap_rt::map_request_t& req, const SnapshotBlob& blob);
   void publish_info();
   void note_blob(const SnapshotBlob& b);

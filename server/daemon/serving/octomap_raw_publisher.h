@@ -18,13 +18,14 @@
 
 #include "daemon/map/map_state.h"
 #include "daemon/transport/lcm_loop.h"
+#include "protocol/channels.h"
 
 namespace ort::daemon {
 
 // The map for LCM's OctoMap viewers (octomap.raw_t).
 struct OctomapRawConfig {
   double rate_hz = 0;  // 0: off
-  std::string channel = "OCTOMAP";
+  std::string channel = ort::protocol::kOctomapRawChannel;
   size_t max_bytes = 0;     // whole message; 0: octomap_raw_default_cap()
   unsigned min_depth = 10;  // coarsest depth-limited map sent before giving up
   // octomap_server's occupancy_min_z/max_z: occupied cells shown only strictly inside the band.

@@ -114,9 +114,9 @@ void print_serving(std::ostream& out, const RunSummaryInputs& in) {
                 (long long)m.requests_rejected);
   out << line;
   std::string reasons;
-  for (size_t k = 1; k < kRequestRefusalCount; ++k)
+  for (size_t k = 1; k < protocol::kRequestRefusalCount; ++k)
     if (m.refusals[k])
-      reasons += std::string(reasons.empty() ? "" : ", ") + to_string(static_cast<RequestRefusal>(k)) + " " +
+      reasons += std::string(reasons.empty() ? "" : ", ") + to_string(static_cast<protocol::RequestRefusal>(k)) + " " +
                  std::to_string(m.refusals[k]);
   out << (reasons.empty() ? "" : " (" + reasons + ")") << "\n";
   if (m.snapshots_taken > 0) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 
+#include "protocol/version.h"
+
 namespace ort::daemon {
 namespace {
 
@@ -96,6 +98,7 @@ void add_queries(octomap_rt::server_status_t& s, const QueryServiceStats& q) {
 
 octomap_rt::server_status_t make_status(const StatusInputs& in) {
   octomap_rt::server_status_t s;
+  s.protocol_version = protocol::kProtocolVersion;
   s.utime = in.utime;
   s.seq = in.seq;
   s.start_utime = in.start_utime;

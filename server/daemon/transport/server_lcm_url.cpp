@@ -3,7 +3,7 @@
 #include <cstdlib>
 #include <fstream>
 
-#include "octomap_rt/wire_contract.hpp"
+#include "protocol/lcm_url.h"
 
 namespace ort::daemon {
 
@@ -19,7 +19,7 @@ LcmUrlChoice choose_lcm_url(const std::string& requested, uint64_t wanted, int64
   c.url = requested;
   if (c.url.empty()) {
     const char* env = std::getenv("LCM_DEFAULT_URL");
-    c.url = env && *env ? env : octomap_rt::wire::kDefaultLcmUrl;
+    c.url = env && *env ? env : ort::protocol::kDefaultLcmUrl;
   }
   if (c.url.rfind("udpm://", 0) != 0) return c;
   if (rmem_max < 0) rmem_max = read_rmem_max();

@@ -40,11 +40,11 @@ public class StatusListener implements LCMSubscriber {
   }
 
   public static void main(String[] args) throws Exception {
-    String url = args.length > 0 ? args[0] : "udpm://239.255.76.67:7667?ttl=0";
+    String url = args.length > 0 ? args[0] : ProtocolTable.DEFAULT_LCM_URL;
     int count = args.length > 1 ? Integer.parseInt(args[1]) : 0;
     LCM lcm = new LCM(url);
     StatusListener listener = new StatusListener(count);
-    lcm.subscribe("OCTOMAP_RT_STATUS", listener);
+    lcm.subscribe(ProtocolTable.STATUS_CHANNEL, listener);
     listener.awaitAll();
     lcm.close();
   }

@@ -11,6 +11,7 @@ import time
 import numpy as np
 
 from octomap_rt import open_transport, scan_t
+from octomap_rt.protocol_table import SCAN_CHANNEL_PREFIX
 
 
 def main(path, url=None, robot="pyrobot"):
@@ -27,7 +28,7 @@ def main(path, url=None, robot="pyrobot"):
     msg.num_xyz = len(msg.xyz)
     msg.robot_id = robot                           # = the channel's suffix
     msg.map_frame = "map"
-    open_transport(url).publish("OCTOMAP_RT_SCAN_" + robot.upper(), msg.encode())
+    open_transport(url).publish(SCAN_CHANNEL_PREFIX + robot.upper(), msg.encode())
     print(f"published {len(points)} points ({int(np.isnan(points[:, 0]).sum())} NaN) as {robot}")
 
 

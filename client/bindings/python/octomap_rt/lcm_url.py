@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 # octomap-rt-server's default: host-local multicast (ttl=0: packets never leave the host).
-HOST_LOCAL_URL = "udpm://239.255.76.67:7667?ttl=0"
+from .protocol_table import DEFAULT_LCM_URL as HOST_LOCAL_URL
 
 
 class LcmUrlError(ValueError):

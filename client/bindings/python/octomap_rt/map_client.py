@@ -10,9 +10,7 @@ from .bt_reader import BtMap, read_bt
 from .snapshot_fetch import Snapshot, fetch_snapshot, new_client_id
 from .transport import open_transport
 
-STATUS_CHANNEL = "OCTOMAP_RT_STATUS"
-MAP_INFO_CHANNEL = "OCTOMAP_RT_MAP_INFO"
-SCAN_CHANNEL_PREFIX = "OCTOMAP_RT_SCAN_"
+from .protocol_table import MAP_INFO_CHANNEL, SCAN_CHANNEL_PREFIX, STATUS_CHANNEL
 
 
 class ServerTimeout(TimeoutError):

@@ -9,12 +9,15 @@ from typing import Optional
 from ._types import (box_query_t, box_reply_t, grid_query_t, grid_t, occupancy_query_t,
                      occupancy_reply_t, ray_query_t, ray_reply_t)
 
-POINTS_CHANNEL = "OCTOMAP_RT_QUERY"
-RAYS_CHANNEL = "OCTOMAP_RT_QUERY_RAYS"
-BOXES_CHANNEL = "OCTOMAP_RT_QUERY_BOXES"
-GRID_CHANNEL = "OCTOMAP_RT_QUERY_GRID"
-REPLY_PREFIX = "OCTOMAP_RT_QUERY_REPLY_"
-MAX_POINTS, MAX_RAYS, MAX_BOXES = 5000, 2000, 1000  # per message (one 60 KB datagram)
+from .protocol_table import QUERY_BOXES_CHANNEL as BOXES_CHANNEL
+from .protocol_table import QUERY_CHANNEL as POINTS_CHANNEL
+from .protocol_table import QUERY_GRID_CHANNEL as GRID_CHANNEL
+from .protocol_table import QUERY_RAYS_CHANNEL as RAYS_CHANNEL
+from .protocol_table import QUERY_REPLY_PREFIX as REPLY_PREFIX
+# Per message (one 60 KB datagram).
+from .protocol_table import MAX_QUERY_BOXES as MAX_BOXES
+from .protocol_table import MAX_QUERY_POINTS as MAX_POINTS
+from .protocol_table import MAX_QUERY_RAYS as MAX_RAYS
 
 UNKNOWN, FREE, OCCUPIED = occupancy_reply_t.OCC_UNKNOWN, occupancy_reply_t.OCC_FREE, occupancy_reply_t.OCC_OCCUPIED
 

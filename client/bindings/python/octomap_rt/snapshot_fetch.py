@@ -9,8 +9,9 @@ from dataclasses import dataclass
 
 from ._types import map_chunk_t, map_request_t
 
-REQUEST_CHANNEL = "OCTOMAP_RT_MAP_REQUEST"
-REPLY_PREFIX = "OCTOMAP_RT_MAP_REPLY_"
+from .protocol_table import MAP_REPLY_PREFIX as REPLY_PREFIX
+from .protocol_table import MAX_REQUESTED_CHUNKS
+from .protocol_table import MAP_REQUEST_CHANNEL as REQUEST_CHANNEL
 FORMATS = {"bt": map_chunk_t.FORMAT_OCTOMAP_BINARY, "ot": map_chunk_t.FORMAT_OCTOMAP_FULL}
 
 
@@ -124,7 +125,7 @@ def fetch_snapshot(transport, fmt: str = "bt", timeout_s: float = 30.0, snapshot
                 if missing is None:
                     request(snapshot_id, [])  # the request (or every answer) was lost
                 else:
-                    request(assembly.first.snapshot_id, missing[:8192])
+                    request(assembly.first.snapshot_id, missing[:MAX_REQUESTED_CHUNKS])
         else:
             got = len(assembly.chunks)
             total = assembly.first.num_chunks if assembly.first else "?"

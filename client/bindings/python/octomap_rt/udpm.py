@@ -15,12 +15,12 @@ import time
 from typing import Callable, Dict, List, Optional, Tuple
 
 from .lcm_url import UdpmUrl, parse_udpm_url
+from .protocol_table import MAX_CHANNEL_LENGTH
 
 MAGIC_SHORT = 0x4C433032  # "LC02"
 MAGIC_LONG = 0x4C433033  # "LC03"
 SHORT_MESSAGE_MAX_SIZE = 65499
 FRAGMENT_MAX_PAYLOAD = 65487
-MAX_CHANNEL_LENGTH = 63
 _SHORT = struct.Struct(">II")
 _LONG = struct.Struct(">IIIIHH")
 

@@ -6,7 +6,7 @@
 
 #include "octomap_rt/map_request_t.hpp"
 
-namespace ort::daemon {
+namespace ort::protocol {
 
 enum class RequestRefusal : uint8_t {
   kNone,
@@ -29,4 +29,4 @@ RequestRefusal check_map_request(const octomap_rt::map_request_t& r);
 // Whether a refusal can be answered (the reply channel is usable).
 bool can_reply(const octomap_rt::map_request_t& r);
 
-}  // namespace ort::daemon
+}  // namespace ort::protocol

@@ -1,9 +1,10 @@
-#include "daemon/serving/map_request_rules.h"
+#include "protocol/map_request_rules.h"
 
 #include "octomap_rt/map_chunk_t.hpp"
-#include "protocol/map_protocol.h"
+#include "protocol/channels.h"
+#include "protocol/ids.h"
 
-namespace ort::daemon {
+namespace ort::protocol {
 
 const char* to_string(RequestRefusal r) {
   switch (r) {
@@ -22,14 +23,14 @@ const char* to_string(RequestRefusal r) {
 }
 
 bool can_reply(const octomap_rt::map_request_t& r) {
-  const std::string prefix = protocol::kMapReplyPrefix;
+  const std::string prefix = kMapReplyPrefix;
   return r.reply_channel.size() > prefix.size() && r.reply_channel.compare(0, prefix.size(), prefix) == 0 &&
-         protocol::valid_name(r.reply_channel);
+         valid_name(r.reply_channel);
 }
 
 RequestRefusal check_map_request(const octomap_rt::map_request_t& r) {
   using Chunk = octomap_rt::map_chunk_t;
-  if (!protocol::valid_name(r.client_id)) return RequestRefusal::kBadClientId;
+  if (!valid_name(r.client_id)) return RequestRefusal::kBadClientId;
   if (!can_reply(r)) return RequestRefusal::kBadReplyChannel;
   if (r.format != Chunk::FORMAT_OCTOMAP_BINARY && r.format != Chunk::FORMAT_OCTOMAP_FULL)
     return RequestRefusal::kUnknownFormat;
@@ -38,4 +39,4 @@ RequestRefusal check_map_request(const octomap_rt::map_request_t& r) {
   return RequestRefusal::kNone;
 }
 
-}  // namespace ort::daemon
+}  // namespace ort::protocol

@@ -12,9 +12,9 @@
 
 #include "octomap_rt/scan_t.hpp"
 
-namespace ort::daemon {
+namespace ort::protocol {
 
-// Decodes `data` (a message check_scan_wire accepted: fingerprint, counts and string lengths
+// Decodes `data` (a message check_scan_bytes accepted: fingerprint, counts and string lengths
 // consistent with `size`) into `out`, as scan_t::decode would. Returns the bytes used, or
 // < 0 where LCM's decode fails.
 int decode_scan(const uint8_t* data, size_t size, octomap_rt::scan_t& out);
@@ -22,4 +22,4 @@ int decode_scan(const uint8_t* data, size_t size, octomap_rt::scan_t& out);
 // Big-endian 32-bit words (LCM's float encoding) into host floats.
 void decode_be_floats(const uint8_t* src, float* dst, size_t count);
 
-}  // namespace ort::daemon
+}  // namespace ort::protocol

@@ -1,11 +1,11 @@
-#include "daemon/intake/scan_decode.h"
+#include "protocol/scan_decode.h"
 
 #include <cstring>
 #include <vector>
 
-#include "daemon/intake/scan_validation.h"
+#include "protocol/inbound_checks.h"
 
-namespace ort::daemon {
+namespace ort::protocol {
 namespace {
 
 // Inner loops of a fixed trip count: vectorized at -O2 (GCC's cheap cost model takes only
@@ -55,4 +55,4 @@ int decode_scan(const uint8_t* data, size_t size, octomap_rt::scan_t& out) {
   return used + static_cast<int>(xyz_end - kScanXyzOffset);
 }
 
-}  // namespace ort::daemon
+}  // namespace ort::protocol
