@@ -10,6 +10,7 @@
 #include "cli/commands.h"
 #include "cli/map_summary.h"
 #include "core/clock.h"
+#include "core/file_checks/octree_binary.h"
 #include "engine/engine_flags.h"
 #include "engine/engine_pipeline.h"
 #include "scene/scan_set.h"
@@ -36,7 +37,7 @@ void write_map(const octomap::OcTree& tree, const std::string& path) {
     throw std::runtime_error("output must end in .bt (OctoMap binary) or .ot (full, with log-odds): " + path);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw std::runtime_error("cannot create " + path + ": " + std::strerror(errno));
-  const bool written = bt ? tree.writeBinaryConst(out) : tree.write(out);
+  const bool written = bt ? write_octomap_binary(tree, out) : tree.write(out);
   errno = 0;
   out.close();
   if (!written || out.fail()) {

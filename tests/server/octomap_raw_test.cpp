@@ -1,4 +1,4 @@
-// octomap.raw_t for LCM's OctoMap viewers: at full depth its data is the map's .bt bytes and
+// octomap.raw_t for LCM's OctoMap viewers: at full depth its data is OctoMap's .bt of the map and
 // decodes with a type generated separately from the viewers' field list; too large, it is
 // depth-limited and still shows every occupied voxel; far too large, it is skipped with a note.
 #include <gtest/gtest.h>
@@ -23,9 +23,11 @@ octomap::OcTree random_map(int rays) {
   return tree;
 }
 
+// OctoMap's own .bt of the map: OcTree::writeBinary, on a copy (it prunes the tree it is given).
 std::string bt_bytes(const octomap::OcTree& tree) {
+  octomap::OcTree copy(tree);
   std::ostringstream out;
-  tree.writeBinaryConst(out);
+  copy.writeBinary(out);
   return out.str();
 }
 

@@ -3,16 +3,15 @@
 #include <cstdio>
 #include <sstream>
 
+#include "core/file_checks/octree_binary.h"
 #include "octree/region_sweep.h"
 
 namespace ort::daemon {
 namespace {
 
-std::string binary_bytes(const octomap::OcTree& tree) {
-  std::ostringstream out;
-  tree.writeBinaryConst(out);
-  return std::move(out).str();
-}
+// What OcTree::writeBinary writes (max likelihood, pruned: OctoMap's readers and test_io
+// expect it), without changing the map.
+std::string binary_bytes(const octomap::OcTree& tree) { return octomap_binary_bytes(tree); }
 
 octomap::raw_t message_of(const std::string& bytes, int64_t utime) {
   octomap::raw_t m;

@@ -1,8 +1,8 @@
-// The map as an `octomap.raw_t` message for LCM's OctoMap viewers: OcTree::writeBinaryConst
-// bytes (a .bt file), at full depth when it fits the size cap, else depth-limited (the tree
-// cut at a depth: each node there becomes a voxel of a coarser map with the node's value,
-// which is its most occupied child's, as OctoMap keeps inner nodes), else not at all, with a
-// note that says why.
+// The map as an `octomap.raw_t` message for LCM's OctoMap viewers: the .bt OctoMap's
+// OcTree::writeBinary writes (max likelihood, pruned; core/file_checks/octree_binary.h), at
+// full depth when it fits the size cap, else depth-limited (the tree cut at a depth: each node
+// there becomes a voxel of a coarser map with the node's value, which is its most occupied
+// child's, as OctoMap keeps inner nodes), else not at all, with a note that says why.
 #pragma once
 
 #include <cstddef>
