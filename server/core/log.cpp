@@ -1,5 +1,7 @@
 #include "core/log.h"
 
+#include <memory>
+#include <mutex>
 #include <ostream>
 
 namespace ort {
@@ -13,6 +15,8 @@ const char* to_string(LogLevel level) {
   return "?";
 }
 
+Log::Log(std::ostream& out) : Log(log_to(out)) {}
+
 void Log::lines(LogLevel level, std::string_view text) const {
   while (!text.empty()) {
     const size_t end = text.find('\n');
@@ -23,8 +27,17 @@ void Log::lines(LogLevel level, std::string_view text) const {
   }
 }
 
-Log log_to(std::ostream& out) {
-  return Log([&out](LogLevel, std::string_view message) { out << message << '\n'; });
+Log log_to(std::ostream& out, std::string program) {
+  auto mutex = std::make_shared<std::mutex>();
+  if (!program.empty()) program += ": ";
+  return Log([&out, mutex, program = std::move(program)](LogLevel level, std::string_view message) {
+    std::string line = program;
+    if (level != LogLevel::kInfo) (line += to_string(level)) += ": ";
+    line.append(message);
+    line += '\n';
+    std::lock_guard lock(*mutex);
+    out << line << std::flush;
+  });
 }
 
 Log log_into(std::string& text) {

@@ -31,13 +31,12 @@ std::string host_name() {
 
 }  // namespace
 
-MappingServer::MappingServer(const ServerConfig& cfg, std::ostream& log) : MappingServer(cfg, nullptr, log) {}
-MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM& shared, std::ostream& log)
-    : MappingServer(cfg, &shared, log) {}
+MappingServer::MappingServer(const ServerConfig& cfg, Log log) : MappingServer(cfg, nullptr, std::move(log)) {}
+MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM& shared, Log log) : MappingServer(cfg, &shared, log) {}
 
-MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ostream& log)
+MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
     : cfg_(cfg),
-      log_(log),
+      log_(std::move(log)),
       producers_(literal_prefix(cfg.scan_channels), producer_policy(cfg)),
       queue_(queue_budget(cfg), 8 * queue_budget(cfg)) {
   start_ = std::chrono::steady_clock::now();
@@ -52,7 +51,7 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ost
                              std::to_string(cfg_.max_points));
 
   load_or_create_map();  // first: a wrong map file fails before any device is opened
-  engine_ = std::make_unique<MapEngine>(cfg_.engine, log_to(log_));
+  engine_ = std::make_unique<MapEngine>(cfg_.engine, log_);
   if (!cfg_.applied_log.empty()) map_.order.open_live_log(cfg_.applied_log);
 
   if (shared) {
@@ -61,7 +60,7 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ost
   } else {
     const LcmUrlChoice c = choose_lcm_url(cfg_.lcm_url, cfg_.recv_buf_size);
     url_ = c.url;
-    if (!c.warning.empty()) log_ << c.warning << "\n";
+    if (!c.warning.empty()) log_.warning(c.warning);
     loop_ = std::make_unique<LcmLoop>(url_, log_);
   }
 }
@@ -70,7 +69,7 @@ MappingServer::~MappingServer() {
   try {
     stop();
   } catch (const std::exception& e) {
-    log_ << "octomap-rt-server: error while stopping: " << e.what() << "\n";
+    log_.error(text("while stopping: ", e.what()));
   }
 }
 
@@ -89,7 +88,7 @@ std::unique_ptr<octomap::OcTree> MappingServer::load_checked_map() {
     const std::string aside = move_map_aside(cfg_.map_path);
     if (std::filesystem::exists(cfg_.map_path + ".order"))
       std::filesystem::rename(cfg_.map_path + ".order", aside + ".order");
-    log_ << "octomap-rt-server: warning: " << e.what() << "; moved it to " << aside << " and starting a new map\n";
+    log_.warning(text(e.what(), "; moved it to ", aside, " and starting a new map"));
     return nullptr;
   }
 }
@@ -107,20 +106,20 @@ void MappingServer::load_or_create_map() {
     if (std::filesystem::exists(order_path)) {
       AppliedOrderFile f = read_applied_order(order_path);
       if (f.map_bytes >= 0 && static_cast<uint64_t>(f.map_bytes) != std::filesystem::file_size(cfg_.map_path))
-        log_ << "octomap-rt-server: warning: " << order_path
-             << " does not belong to this map file (the server stopped between writing the two); its "
-             << f.entries.size() << " entries are kept but may not match the map\n";
+        log_.warning(text(order_path,
+                          " does not belong to this map file (the server stopped between writing the two); its ",
+                          f.entries.size(), " entries are kept but may not match the map"));
       previous = std::move(f.entries);
     }
     map_.order.restore(std::move(previous));
     map_.version = map_.order.size();
     saved_version_ = map_.version;
-    log_ << "octomap-rt-server: loaded map " << cfg_.map_path << " (" << map_.tree->size() << " nodes, "
-         << map_.order.size() << " scans applied before)\n";
+    log_.info(text("loaded map ", cfg_.map_path, " (", map_.tree->size(), " nodes, ", map_.order.size(),
+                   " scans applied before)"));
   } else {
     map_.tree = std::make_unique<octomap::OcTree>(res);
     apply_sensor_model(*map_.tree, cfg_.engine.sensor);
-    if (!cfg_.map_path.empty()) log_ << "octomap-rt-server: new map, will be saved to " << cfg_.map_path << "\n";
+    if (!cfg_.map_path.empty()) log_.info(text("new map, will be saved to ", cfg_.map_path));
   }
 }
 
@@ -135,7 +134,7 @@ void MappingServer::start() {
   pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, log_, cfg_.pipeline,
                                              std::chrono::duration<double>(cfg_.latency_bound_s), cfg_.point_filters);
   pipeline_->start();
-  upkeep_ = std::make_unique<MapUpkeep>(map_, cfg_.upkeep, log_to(log_));
+  upkeep_ = std::make_unique<MapUpkeep>(map_, cfg_.upkeep, log_);
   upkeep_->start();
   intake_ =
       std::make_unique<ScanIntake>(*loop_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
@@ -157,20 +156,19 @@ void MappingServer::warm_up_engine() {
   // No scan may be larger than --max-points: a bigger warm-up would size buffers for nothing.
   const size_t points = std::min<size_t>(cfg_.warm_up_points, cfg_.max_points);
   if (points == 0) return;
-  char line[320];
   try {
     const WarmUpReport w = warm_up(*engine_, points);
-    std::snprintf(line, sizeof line,
-                  "octomap-rt-server: warmed up on a scan of %zu points (%llu voxels) on a scratch tree: stage 1 %.1f "
-                  "ms, stage 2 %.1f ms%s\n",
-                  w.points, (unsigned long long)w.voxels, w.shoot_ms, w.apply_ms,
-                  w.refused ? " (the engine refused the scan: the first scans may pay one-time costs)" : "");
+    char line[320];
+    std::snprintf(
+        line, sizeof line,
+        "warmed up on a scan of %zu points (%llu voxels) on a scratch tree: stage 1 %.1f ms, stage 2 %.1f ms%s",
+        w.points, (unsigned long long)w.voxels, w.shoot_ms, w.apply_ms,
+        w.refused ? " (the engine refused the scan: the first scans may pay one-time costs)" : "");
+    log_.info(line);
   } catch (const std::exception& e) {
     // The map is untouched either way; scans then meet the engine as they would have without.
-    std::snprintf(line, sizeof line, "octomap-rt-server: warning: the warm-up failed (%s); serving without it\n",
-                  e.what());
+    log_.warning(text("the warm-up failed (", e.what(), "); serving without it"));
   }
-  log_ << line;
 }
 
 void MappingServer::open_map_serving() {
@@ -231,7 +229,7 @@ bool MappingServer::stop() {
       save(true);
     } catch (const std::exception& e) {
       final_save_error_ = e.what();
-      log_ << "octomap-rt-server: error: the final save failed (the previous map file is intact): " << e.what() << "\n";
+      log_.error(text("the final save failed (the previous map file is intact): ", e.what()));
     }
   }
   set_state(Status::STATE_STOPPING,
@@ -259,8 +257,8 @@ void MappingServer::drain_until_deadline() {
   const std::vector<QueuedScan> left = queue_.take_all();
   for (const QueuedScan& s : left) producers_.count_dropped_in_flight(s.producer, Reject::kLeftAtShutdown);
   if (!left.empty())
-    log_ << "octomap-rt-server: drain deadline (" << cfg_.drain_timeout_s << " s) passed: " << left.size()
-         << " queued scans dropped (left at shutdown); saving the map as applied\n";
+    log_.warning(text("drain deadline (", cfg_.drain_timeout_s, " s) passed: ", left.size(),
+                      " queued scans dropped (left at shutdown); saving the map as applied"));
 }
 
 void MappingServer::set_state(int8_t state, std::string message) {
@@ -306,7 +304,7 @@ void MappingServer::run_save_loop() {
       save(false);
     } catch (const std::exception& e) {
       error = e.what();
-      log_ << "octomap-rt-server: save failed (the previous map file is intact): " << error << "\n";
+      log_.error(text("save failed (the previous map file is intact): ", error));
     }
     lock.lock();
     last_save_error_ = error;  // the status is DEGRADED while it is set
@@ -324,7 +322,7 @@ void MappingServer::run_status_loop() {
     try {
       publish_status();
     } catch (const std::exception& e) {
-      log_ << "octomap-rt-server: status failed: " << e.what() << "\n";
+      log_.error(text("status failed: ", e.what()));
     }
     lock.lock();
     if (exit) return;

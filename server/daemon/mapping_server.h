@@ -15,6 +15,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "core/log.h"
 #include "daemon/intake/producer_registry.h"
 #include "daemon/intake/scan_intake.h"
 #include "daemon/intake/scan_queue.h"
@@ -39,10 +40,10 @@ class MappingServer {
   // Own LCM on cfg.lcm_url (default: host-local udpm with a raised receive buffer).
   // Throws std::runtime_error with a clear message: map unreadable or of another
   // resolution, back end unavailable, LCM not usable.
-  MappingServer(const ServerConfig& cfg, std::ostream& log);
+  MappingServer(const ServerConfig& cfg, Log log);
   // On a shared LCM (tests: one memq:// instance shared with in-process producers). The
   // server's LCM loop is the only one that may call handle on it.
-  MappingServer(const ServerConfig& cfg, lcm::LCM& shared, std::ostream& log);
+  MappingServer(const ServerConfig& cfg, lcm::LCM& shared, Log log);
   ~MappingServer();
 
   void start();
@@ -76,7 +77,7 @@ class MappingServer {
   void print_summary(std::ostream& out);
 
  private:
-  MappingServer(const ServerConfig& cfg, lcm::LCM* shared, std::ostream& log);
+  MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log);
   void load_or_create_map();
   void open_map_serving();
   // The engine's warm-up scan (ServerConfig::warm_up_points), logged.
@@ -91,7 +92,7 @@ class MappingServer {
   void run_save_loop();
 
   ServerConfig cfg_;
-  std::ostream& log_;
+  Log log_;
   std::string url_;
   std::unique_ptr<LcmLoop> loop_;
   std::unique_ptr<MapEngine> engine_;

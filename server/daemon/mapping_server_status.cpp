@@ -68,6 +68,7 @@ StatusInputs MappingServer::gather_status() {
   in.shot_depth = pipeline_ ? static_cast<int32_t>(pipeline_->shot_depth()) : 0;
   in.kernel_rcvbuf_errors = read_udp_rcvbuf_errors();
   in.socket_rcvbuf_drops = read_own_udp_drops();
+  in.lcm_handler_errors = loop_->handler_errors();
   in.map_saves = saves_;
   if (map_service_) {
     const MapServiceStats ms = map_service_->stats();

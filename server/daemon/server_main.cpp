@@ -17,43 +17,45 @@
 #include <iostream>
 #include <thread>
 
+#include "core/clock.h"
+#include "core/log.h"
 #include "daemon/mapping_server.h"
 #include "daemon/server_cli.h"
 #include "protocol/channels.h"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 const char* signal_name(int sig) { return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "SIGQUIT"; }
 
 // The immediate exit: no drain, but the map as applied is saved when a save can be made
 // (an orderly save already running is waited for, not cut short).
-[[noreturn]] void exit_now(ort::daemon::MappingServer& server, int sig) {
-  std::cerr << "octomap-rt-server: " << signal_name(sig) << ": exiting now; saving the map as applied\n";
+[[noreturn]] void exit_now(ort::daemon::MappingServer& server, int sig, const ort::Log& log) {
+  log.warning(ort::text(signal_name(sig), ": exiting now; saving the map as applied"));
   int code = 2;
   try {
     server.save(false);
   } catch (const std::exception& e) {
-    std::cerr << "octomap-rt-server: the map could not be saved: " << e.what() << "\n";
+    log.error(ort::text("the map could not be saved: ", e.what()));
     code = 3;
   }
-  std::cerr.flush();
-  std::_Exit(code);
+  std::_Exit(code);  // the log's lines are flushed as they are written
 }
 
 // Takes every later signal while the orderly stop runs (detached: it ends with the process).
-void watch_signals(ort::daemon::MappingServer& server, sigset_t sigs, Clock::time_point drain_deadline) {
-  std::thread([&server, sigs, drain_deadline] {
+void watch_signals(ort::daemon::MappingServer& server, sigset_t sigs, ort::SteadyClock::time_point drain_deadline,
+                   ort::Log log) {
+  std::thread([&server, sigs, drain_deadline, log] {
     for (;;) {
       int sig = 0;
       if (sigwait(&sigs, &sig) != 0) continue;
-      const double left = std::chrono::duration<double>(drain_deadline - Clock::now()).count();
-      if (sig == SIGQUIT || left <= 0) exit_now(server, sig);
-      std::fprintf(stderr,
-                   "octomap-rt-server: %s: already stopping; queued scans are applied for %.1f s more, then the "
-                   "map is saved (SIGQUIT exits at once)\n",
-                   signal_name(sig), left);
+      const double left = std::chrono::duration<double>(drain_deadline - ort::SteadyClock::now()).count();
+      if (sig == SIGQUIT || left <= 0) exit_now(server, sig, log);
+      char line[200];
+      std::snprintf(line, sizeof line,
+                    "%s: already stopping; queued scans are applied for %.1f s more, then the map is saved (SIGQUIT "
+                    "exits at once)",
+                    signal_name(sig), left);
+      log.info(line);
     }
   }).detach();
 }
@@ -82,28 +84,31 @@ int main(int argc, char** argv) {
   sigaddset(&sigs, SIGQUIT);
   pthread_sigmask(SIG_BLOCK, &sigs, nullptr);
 
+  // Every message of the daemon's threads goes through this one sink (whole lines, stderr).
+  const ort::Log log = ort::log_to(std::cerr, "octomap-rt-server");
   try {
-    ort::daemon::MappingServer server(cfg, std::cerr);
+    ort::daemon::MappingServer server(cfg, log);
     server.start();
-    std::cerr << "octomap-rt-server: listening on " << server.lcm_url() << " for " << cfg.scan_channels
-              << "; status on " << cfg.status_channel << "; pid " << ::getpid() << "\n";
+    log.info(ort::text("listening on ", server.lcm_url(), " for ", cfg.scan_channels, "; status on ",
+                       cfg.status_channel, "; pid ", ::getpid()));
     int sig = 0;
     while (sigwait(&sigs, &sig) != 0) {}
-    if (sig == SIGQUIT) exit_now(server, sig);
-    std::cerr << "octomap-rt-server: " << signal_name(sig) << ": stopping intake, applying queued scans for at most "
-              << cfg.drain_timeout_s << " s, saving\n";
-    watch_signals(
-        server, sigs,
-        Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.drain_timeout_s)));
+    if (sig == SIGQUIT) exit_now(server, sig, log);
+    log.info(ort::text(signal_name(sig), ": stopping intake, applying queued scans for at most ", cfg.drain_timeout_s,
+                       " s, saving"));
+    watch_signals(server, sigs,
+                  ort::SteadyClock::now() + std::chrono::duration_cast<ort::SteadyClock::duration>(
+                                                std::chrono::duration<double>(cfg.drain_timeout_s)),
+                  log);
     const bool saved = server.stop();
     server.print_summary(std::cout);
     std::cout.flush();
     if (!saved) {
-      std::cerr << "octomap-rt-server: error: the final save failed (see the summary); exit status 1\n";
+      log.error("the final save failed (see the summary); exit status 1");
       return 1;
     }
   } catch (const std::exception& e) {
-    std::cerr << "octomap-rt-server: error: " << e.what() << "\n";
+    log.error(e.what());
     return 1;
   }
   return 0;

@@ -1,10 +1,14 @@
 // The status's map figures on a map big enough that its leaves are not counted at every
 // status (daemon/mapping_server_status.cpp: the count walks the whole tree under the map lock),
-// and the run summary's slowest scans as the pipeline records them.
+// the run summary's slowest scans as the pipeline records them, and the LCM thread's handler
+// errors as the status and the log report them.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <set>
 #include <sstream>
+#include <stdexcept>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -102,6 +106,39 @@ TEST(ServerStatusCounts, SlowestScansAreAppliedScansWithTheirParts) {
     EXPECT_GE(at, 0.0);
   }
   EXPECT_EQ(seqs.size(), std::min<size_t>(5, static_cast<size_t>(sent))) << summary.str();
+}
+
+// A handler that throws on the LCM thread is caught by the loop, logged once per message through
+// the server's log, counted, and the count reaches every later status and the summary.
+TEST(ServerStatusCounts, HandlerErrorsReachTheStatus) {
+  lcm::LCM lc("memq://");
+  auto cfg = test_config(0.1, true);
+  cfg.status_period_s = 0.02;
+  std::ostringstream log;
+  daemon::MappingServer server(cfg, lc, log);
+  server.start();
+  EXPECT_EQ(server.status().lcm_handler_errors, 0);
+  server.lcm_loop().subscribe("ORT_TEST_BROKEN_HANDLER", [](const lcm::ReceiveBuffer&, const std::string&) {
+    throw std::runtime_error("a service's handler failed");
+  });
+  const uint8_t byte = 0;
+  for (int i = 0; i < 3; ++i) lc.publish("ORT_TEST_BROKEN_HANDLER", &byte, 1);
+  for (int i = 0; i < 2000 && server.status().lcm_handler_errors < 3; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_EQ(server.status().lcm_handler_errors, 3);
+  server.stop();
+  std::ostringstream summary;
+  server.print_summary(summary);
+  EXPECT_NE(summary.str().find("LCM handler errors: 3 messages"), std::string::npos) << summary.str();
+  const std::string text = log.str();
+  size_t lines = 0;
+  for (size_t at = text.find("a service's handler failed"); at != std::string::npos;
+       at = text.find("a service's handler failed", at + 1))
+    ++lines;
+  EXPECT_EQ(lines, 3u) << text;
+  EXPECT_NE(text.find("error: unexpected error on ORT_TEST_BROKEN_HANDLER: a service's handler failed"),
+            std::string::npos)
+      << text;
 }
 
 }  // namespace

@@ -169,6 +169,7 @@ std::string status_json(const octomap_rt::server_status_t& s) {
       .num("overlapped_scans", s.overlapped_scans)
       .num("kernel_rcvbuf_errors", s.kernel_rcvbuf_errors)
       .num("socket_rcvbuf_drops", s.socket_rcvbuf_drops)
+      .num("lcm_handler_errors", s.lcm_handler_errors)
       .num("map_version", s.map_version)
       .num("latest_snapshot_id", s.latest_snapshot_id)
       .num("snapshots_taken", s.snapshots_taken)

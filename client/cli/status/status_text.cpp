@@ -52,6 +52,9 @@ void queue_and_kernel(std::ostringstream& o, const Status& s) {
   auto known = [](int64_t v) { return v < 0 ? std::string("unknown") : with_commas(v); };
   o << "  UDP       receive-buffer errors " << known(s.kernel_rcvbuf_errors) << " (all sockets), "
     << known(s.socket_rcvbuf_drops) << " dropped on the server's sockets\n";
+  if (s.lcm_handler_errors > 0)
+    o << "  LCM       " << with_commas(s.lcm_handler_errors)
+      << " messages whose handler failed (see the server's log)\n";
 }
 
 // The map service (snapshots, chunks) and the delta stream: what mirrors and map clients got.

@@ -25,14 +25,14 @@ void note_robot_seen(MapState& map, const std::string& robot, const octomap::poi
 }  // namespace
 
 ScanPipeline::ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, ProducerRegistry& producers,
-                           PipelineMetrics& metrics, std::ostream& log, bool pipelined,
+                           PipelineMetrics& metrics, Log log, bool pipelined,
                            std::chrono::duration<double> max_queue_age, const PointFilters& filters)
     : engine_(engine),
       map_(map),
       queue_(queue),
       producers_(producers),
       metrics_(metrics),
-      log_(log),
+      log_(std::move(log)),
       pipelined_(pipelined),
       max_queue_age_(max_queue_age),
       filters_(filters) {}
@@ -77,7 +77,7 @@ void ScanPipeline::join() {
 }
 
 void ScanPipeline::reject(size_t producer, Reject why, const char* what) {
-  if (why == Reject::kEngineError && engine_errors_++ < 10) log_ << "octomap-rt-server: engine error: " << what << "\n";
+  if (why == Reject::kEngineError && engine_errors_++ < 10) log_.error(text("engine error: ", what));
   producers_.count_rejected_in_flight(producer, why);
 }
 
@@ -115,7 +115,7 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
       ok = false;
     } else if (job.shot.shoot.walk_overruns && overrun_warnings_++ < 10) {
       // The shaders' step guard stopped a ray: the scan is applied, but this must never happen.
-      log_ << "octomap-rt-server: " << job.shot.shoot.walk_overruns << " ray walks hit the GPU step guard\n";
+      log_.warning(text(job.shot.shoot.walk_overruns, " ray walks hit the GPU step guard"));
     }
     if (ok && job.shot.refusal != ShotRefusal::kNone) {
       reject(item.producer, job.shot.refusal == ShotRefusal::kRayTooLong ? Reject::kRayTooLong : Reject::kTooMuchWork,

@@ -9,6 +9,7 @@
 #include <iosfwd>
 #include <thread>
 
+#include "core/log.h"
 #include "daemon/intake/producer_registry.h"
 #include "daemon/intake/scan_queue.h"
 #include "daemon/map/map_edit_item.h"
@@ -41,7 +42,7 @@ class ScanPipeline {
   // latency stays near the bound instead of growing without limit.
   // `log` is the daemon's log stream (engine errors, step-guard warnings).
   ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, ProducerRegistry& producers,
-               PipelineMetrics& metrics, std::ostream& log, bool pipelined,
+               PipelineMetrics& metrics, Log log, bool pipelined,
                std::chrono::duration<double> max_queue_age = std::chrono::duration<double>::zero(),
                const PointFilters& filters = {});
   ~ScanPipeline();
@@ -73,7 +74,7 @@ class ScanPipeline {
   ScanQueue& queue_;
   ProducerRegistry& producers_;
   PipelineMetrics& metrics_;
-  std::ostream& log_;
+  Log log_;
   bool pipelined_;
   BoundedHandoff<ShotJob> handoff_{1};
   LeafChanges changes_;  // stage 2's: what the scan being applied changed, for map_.observer

@@ -25,9 +25,8 @@ int64_t utime_now() {
 
 }  // namespace
 
-DeltaPublisher::DeltaPublisher(LcmLoop& loop, DeltaConfig cfg, std::function<int64_t()> latest_snapshot_id,
-                               std::ostream& log)
-    : loop_(loop), cfg_(std::move(cfg)), latest_snapshot_id_(std::move(latest_snapshot_id)), log_(log) {}
+DeltaPublisher::DeltaPublisher(LcmLoop& loop, DeltaConfig cfg, std::function<int64_t()> latest_snapshot_id, Log log)
+    : loop_(loop), cfg_(std::move(cfg)), latest_snapshot_id_(std::move(latest_snapshot_id)), log_(std::move(log)) {}
 
 DeltaPublisher::~DeltaPublisher() {
   try {
@@ -103,7 +102,7 @@ void DeltaPublisher::run() {
     try {
       flush();
     } catch (const std::exception& e) {
-      log_ << "octomap-rt-server: map delta failed: " << e.what() << "\n";
+      log_.error(text("map delta failed: ", e.what()));
     }
     lock.lock();
   }

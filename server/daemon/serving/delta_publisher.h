@@ -15,11 +15,11 @@
 #include <cstdint>
 #include <functional>
 #include <mutex>
-#include <ostream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "core/log.h"
 #include "daemon/map/map_state.h"
 #include "daemon/transport/lcm_loop.h"
 #include "octree/leaf_changes.h"
@@ -45,7 +45,7 @@ struct DeltaStats {
 
 class DeltaPublisher : public MapChangeObserver {
  public:
-  DeltaPublisher(LcmLoop& loop, DeltaConfig cfg, std::function<int64_t()> latest_snapshot_id, std::ostream& log);
+  DeltaPublisher(LcmLoop& loop, DeltaConfig cfg, std::function<int64_t()> latest_snapshot_id, Log log);
   ~DeltaPublisher() override;
   DeltaPublisher(const DeltaPublisher&) = delete;
   DeltaPublisher& operator=(const DeltaPublisher&) = delete;
@@ -71,7 +71,7 @@ class DeltaPublisher : public MapChangeObserver {
   LcmLoop& loop_;
   DeltaConfig cfg_;
   std::function<int64_t()> latest_snapshot_id_;
-  std::ostream& log_;
+  Log log_;
 
   mutable std::mutex mutex_;  // pending_, spare_, versions, stop_, stats_
   std::condition_variable cv_;

@@ -25,12 +25,12 @@ int64_t utime_now() {
 }  // namespace
 
 MapService::MapService(LcmLoop& loop, MapState& map, MapServiceConfig cfg, std::function<int64_t()> last_delta_seq,
-                       std::ostream& log)
+                       Log log)
     : loop_(loop),
       map_(map),
       cfg_(std::move(cfg)),
       last_delta_seq_(std::move(last_delta_seq)),
-      log_(log),
+      log_(std::move(log)),
       store_(cfg_.snapshots) {}
 
 MapService::~MapService() {
@@ -102,7 +102,7 @@ void MapService::run() {
       try {
         serve(req);
       } catch (const std::exception& e) {
-        log_ << "octomap-rt-server: map request " << req.request_id << " failed: " << e.what() << "\n";
+        log_.error(text("map request ", req.request_id, " failed: ", e.what()));
       }
       lock.lock();
     }

@@ -15,10 +15,10 @@
 #include <deque>
 #include <functional>
 #include <mutex>
-#include <ostream>
 #include <string>
 #include <thread>
 
+#include "core/log.h"
 #include "daemon/map/map_state.h"
 #include "daemon/serving/snapshot_store.h"
 #include "daemon/transport/lcm_loop.h"
@@ -51,8 +51,7 @@ struct MapServiceStats {
 class MapService {
  public:
   // `last_delta_seq` (may be empty) tells map_info_t the newest delta sent.
-  MapService(LcmLoop& loop, MapState& map, MapServiceConfig cfg, std::function<int64_t()> last_delta_seq,
-             std::ostream& log);
+  MapService(LcmLoop& loop, MapState& map, MapServiceConfig cfg, std::function<int64_t()> last_delta_seq, Log log);
   ~MapService();
   MapService(const MapService&) = delete;
   MapService& operator=(const MapService&) = delete;
@@ -75,7 +74,7 @@ class MapService {
   MapState& map_;
   MapServiceConfig cfg_;
   std::function<int64_t()> last_delta_seq_;
-  std::ostream& log_;
+  Log log_;
   SnapshotStore store_;
   LcmLoop::SubscriptionId sub_ = 0;
 

@@ -15,8 +15,8 @@ size_t octomap_raw_default_cap() {
   return rmem_default / 10 * 9;
 }
 
-OctomapRawPublisher::OctomapRawPublisher(const OctomapRawConfig& cfg, MapState& map, LcmLoop& loop, std::ostream& log)
-    : cfg_(cfg), map_(map), loop_(loop), log_(log) {
+OctomapRawPublisher::OctomapRawPublisher(const OctomapRawConfig& cfg, MapState& map, LcmLoop& loop, Log log)
+    : cfg_(cfg), map_(map), loop_(loop), log_(std::move(log)) {
   if (cfg_.max_bytes == 0) cfg_.max_bytes = octomap_raw_default_cap();
 }
 
@@ -24,8 +24,8 @@ OctomapRawPublisher::~OctomapRawPublisher() { stop(); }
 
 void OctomapRawPublisher::start() {
   if (cfg_.rate_hz <= 0 || thread_.joinable()) return;
-  log_ << "octomap-rt-server: publishing the map as octomap.raw_t on " << cfg_.channel << " at " << cfg_.rate_hz
-       << " Hz (cap " << cfg_.max_bytes / 1024 << " KiB)\n";
+  log_.info(text("publishing the map as octomap.raw_t on ", cfg_.channel, " at ", cfg_.rate_hz, " Hz (cap ",
+                 cfg_.max_bytes / 1024, " KiB)"));
   thread_ = std::thread([this] { run(); });
 }
 
@@ -56,7 +56,7 @@ void OctomapRawPublisher::encode_if_changed() {
     raw.message->encode(encoded_.data(), 0, static_cast<int>(encoded_.size()));
   }
   std::lock_guard lock(note_mutex_);
-  if (raw.note != note_ && !raw.note.empty()) log_ << "octomap-rt-server: " << raw.note << "\n";
+  if (raw.note != note_ && !raw.note.empty()) log_.warning(raw.note);
   note_ = raw.note;
 }
 
@@ -69,7 +69,7 @@ void OctomapRawPublisher::run() {
       encode_if_changed();
       if (!encoded_.empty() && loop_.publish(cfg_.channel, encoded_.data(), encoded_.size()) == 0) ++published_;
     } catch (const std::exception& e) {  // a failed encoding must not end the server
-      log_ << "octomap-rt-server: " << cfg_.channel << " not published: " << e.what() << "\n";
+      log_.error(text(cfg_.channel, " not published: ", e.what()));
     }
     lock.lock();
     wake_.wait_for(lock, period, [&] { return stop_; });

@@ -11,11 +11,11 @@
 #include <cstdint>
 #include <limits>
 #include <mutex>
-#include <ostream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "core/log.h"
 #include "daemon/map/map_state.h"
 #include "daemon/transport/lcm_loop.h"
 #include "protocol/channels.h"
@@ -41,7 +41,7 @@ size_t octomap_raw_default_cap();
 
 class OctomapRawPublisher {
  public:
-  OctomapRawPublisher(const OctomapRawConfig& cfg, MapState& map, LcmLoop& loop, std::ostream& log);
+  OctomapRawPublisher(const OctomapRawConfig& cfg, MapState& map, LcmLoop& loop, Log log);
   ~OctomapRawPublisher();
   OctomapRawPublisher(const OctomapRawPublisher&) = delete;
   OctomapRawPublisher& operator=(const OctomapRawPublisher&) = delete;
@@ -59,7 +59,7 @@ class OctomapRawPublisher {
   OctomapRawConfig cfg_;
   MapState& map_;
   LcmLoop& loop_;
-  std::ostream& log_;
+  Log log_;
   std::thread thread_;
   std::mutex mutex_;  // stop_
   std::condition_variable wake_;

@@ -158,6 +158,8 @@ void print_run_summary(std::ostream& out, const RunSummaryInputs& in) {
   out << line;
   out << "  kernel UDP drops: " << s.socket_rcvbuf_drops << " on the server's sockets, " << s.kernel_rcvbuf_errors
       << " in this network namespace (all programs; -1: unknown)\n";
+  if (s.lcm_handler_errors > 0)
+    out << "  LCM handler errors: " << s.lcm_handler_errors << " messages (each logged as it happened)\n";
   print_serving(out, in);
   print_files(out, in);
 }

@@ -131,6 +131,7 @@ octomap_rt::server_status_t make_status(const StatusInputs& in) {
   s.overlapped_scans = m.overlapped_scans;
   s.kernel_rcvbuf_errors = in.kernel_rcvbuf_errors;
   s.socket_rcvbuf_drops = in.socket_rcvbuf_drops;
+  s.lcm_handler_errors = in.lcm_handler_errors;
   s.map_saves = in.map_saves;
   s.last_save_utime = in.last_save_utime;
   s.latest_snapshot_id = in.latest_snapshot_id;

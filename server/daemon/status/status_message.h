@@ -25,6 +25,7 @@ struct StatusInputs {
   int32_t queue_depth = 0, shot_depth = 0;
   int64_t queue_bytes = 0, queue_budget_bytes = 0;
   int64_t kernel_rcvbuf_errors = -1, socket_rcvbuf_drops = -1;
+  int64_t lcm_handler_errors = 0;  // LcmLoop::handler_errors()
   int64_t map_saves = 0, last_save_utime = 0;
   int64_t map_version = 0, latest_snapshot_id = 0, requests_served = 0, requests_rejected = 0;
   int64_t snapshots_taken = 0, chunks_sent = 0, deltas_sent = 0, last_delta_seq = -1;

@@ -26,10 +26,10 @@ struct LcmLoop::Entry {
       handler(*rbuf, channel);
     } catch (const std::exception& e) {
       loop->handler_errors_++;
-      loop->log_ << "octomap-rt-server: unexpected error on " << channel << ": " << e.what() << "\n";
+      loop->log_.error(text("unexpected error on ", channel, ": ", e.what()));
     } catch (...) {
       loop->handler_errors_++;
-      loop->log_ << "octomap-rt-server: unexpected error on " << channel << "\n";
+      loop->log_.error(text("unexpected error on ", channel));
     }
   }
 };
@@ -52,11 +52,11 @@ int make_eventfd() {
 
 }  // namespace
 
-LcmLoop::LcmLoop(const std::string& url, std::ostream& log) : log_(log), lc_(open_lcm(own_, url)) {
+LcmLoop::LcmLoop(const std::string& url, Log log) : log_(std::move(log)), lc_(open_lcm(own_, url)) {
   wake_fd_ = make_eventfd();
 }
 
-LcmLoop::LcmLoop(lcm::LCM& shared, std::ostream& log) : log_(log), lc_(shared) { wake_fd_ = make_eventfd(); }
+LcmLoop::LcmLoop(lcm::LCM& shared, Log log) : log_(std::move(log)), lc_(shared) { wake_fd_ = make_eventfd(); }
 
 LcmLoop::~LcmLoop() {
   stop();
@@ -136,7 +136,7 @@ void LcmLoop::run_posted() {
 
 void LcmLoop::wake() {
   const uint64_t one = 1;
-  if (::write(wake_fd_, &one, sizeof one) < 0) log_ << "octomap-rt-server: eventfd write failed\n";
+  if (::write(wake_fd_, &one, sizeof one) < 0) log_.error("eventfd write failed");
 }
 
 void LcmLoop::start() {
@@ -171,20 +171,19 @@ void LcmLoop::run() {
     const int n = ::poll(fds, 2, -1);
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) {
-      log_ << "octomap-rt-server: poll: " << std::strerror(errno) << "\n";
+      log_.error(text("poll: ", std::strerror(errno)));
       failed_ = true;
       break;
     }
     if (fds[1].revents) {
       uint64_t count = 0;
-      if (::read(wake_fd_, &count, sizeof count) < 0 && errno != EAGAIN)
-        log_ << "octomap-rt-server: eventfd read failed\n";
+      if (::read(wake_fd_, &count, sizeof count) < 0 && errno != EAGAIN) log_.error("eventfd read failed");
       std::lock_guard lock(mutex_);
       run_posted();
       if (stopping_) break;
     }
     if (fds[0].revents && !drain_lcm()) {
-      log_ << "octomap-rt-server: LCM handle failed; the LCM thread stopped\n";
+      log_.error("LCM handle failed; the LCM thread stopped");
       failed_ = true;
       break;
     }

@@ -24,12 +24,13 @@
 #include <list>
 #include <memory>
 #include <mutex>
-#include <ostream>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include <lcm/lcm-cpp.hpp>
+
+#include "core/log.h"
 
 namespace ort::daemon {
 
@@ -43,10 +44,10 @@ class LcmLoop {
 
   // Own LCM on `url`. Throws std::runtime_error when LCM cannot start there (the message
   // says how to give loopback a multicast route).
-  LcmLoop(const std::string& url, std::ostream& log);
+  LcmLoop(const std::string& url, Log log);
   // On a shared LCM (tests: one memq:// instance with in-process producers). The loop's
   // thread must be the only one that calls handle on it.
-  LcmLoop(lcm::LCM& shared, std::ostream& log);
+  LcmLoop(lcm::LCM& shared, Log log);
   ~LcmLoop();
   LcmLoop(const LcmLoop&) = delete;
   LcmLoop& operator=(const LcmLoop&) = delete;
@@ -91,7 +92,7 @@ class LcmLoop {
   void do_unsubscribe(SubscriptionId id);
   void wake();
 
-  std::ostream& log_;
+  Log log_;
   std::unique_ptr<lcm::LCM> own_;
   lcm::LCM& lc_;
   int wake_fd_ = -1;

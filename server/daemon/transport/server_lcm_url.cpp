@@ -34,8 +34,8 @@ LcmUrlChoice choose_lcm_url(const std::string& requested, uint64_t wanted, int64
     c.url += "recv_buf_size=" + std::to_string(give);
   }
   if (rmem_max > 0 && static_cast<uint64_t>(rmem_max) < asked) {
-    c.warning = "octomap-rt-server: WARNING: the kernel caps UDP receive buffers at net.core.rmem_max = " +
-                std::to_string(rmem_max) + " bytes, below the " + std::to_string(asked) +
+    c.warning = "the kernel caps UDP receive buffers at net.core.rmem_max = " + std::to_string(rmem_max) +
+                " bytes, below the " + std::to_string(asked) +
                 " wanted. Multi-MB scans from several robots can then be lost whole (they show up as "
                 "kernel_rcvbuf_errors and scans_missed in the status). Raise it on this host with:\n"
                 "    sudo sysctl -w net.core.rmem_max=" +
