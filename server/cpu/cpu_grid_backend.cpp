@@ -9,7 +9,6 @@
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
-#include <cstring>
 #include <limits>
 #include <new>
 #include <thread>
@@ -48,7 +47,10 @@ class GridMemory {
     const uintptr_t base = (reinterpret_cast<uintptr_t>(mapped_) + kHugePage - 1) / kHugePage * kHugePage;
     words_ = reinterpret_cast<uint32_t*>(base);
     madvise(words_, bytes_, MADV_HUGEPAGE);  // a hint: without it the grid still works
-    std::memset(words_, 0, bytes_);          // fault it in now, not during the first scans
+    // Not faulted in here: the kernel's pages come zeroed, each window uses the grid from its
+    // start and leaves it zeroed, so only what the largest ray space so far needed is ever
+    // resident (a small machine's scans need a few MiB of the budget; issue 25). The first
+    // scan of each new size pays its page faults once (the daemon's warm-up scan takes them).
   }
   ~GridMemory() { munmap(mapped_, mapped_bytes_); }
   GridMemory(const GridMemory&) = delete;
