@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -22,6 +23,8 @@
 #include "cli/replay/scan_message.h"
 #include "octomap_rt/server_status_t.hpp"
 #include "protocol/channels.h"
+#include "scene/scan_set.h"
+#include "scene/scene_presets.h"
 #include "scene/synthetic_scene.h"
 
 namespace ort::cli {
@@ -82,16 +85,42 @@ double peak_rss_mib(pid_t pid) {
   return 0;
 }
 
-// Scans of `points` points: the synthetic scene's scans, thinned or repeated to that size.
-std::vector<PosedScan> load_scans(int points) {
-  const ScanSet scene = make_synthetic_rooms();
+double rss_mib(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("VmRSS:", 0) == 0) return std::atof(line.c_str() + 6) / 1024.0;
+  return 0;
+}
+
+// Scans of at most `points` points (thinned evenly; the synthetic scene's repeated up to it):
+// the scene's scans in their order.
+std::vector<PosedScan> load_scans(const LoadTestConfig& cfg) {
+  ScanSet scene;
+  if (cfg.scene == "synthetic") {
+    scene = make_synthetic_rooms();
+  } else if (is_preset(cfg.scene)) {
+    PresetOptions o;
+    o.data_dir = cfg.data_dir;
+    scene = make_preset(cfg.scene, o);
+  } else {
+    scene = load_scan_graph(cfg.scene);
+  }
   std::vector<PosedScan> out;
+  const size_t points = size_t(cfg.points);
   for (const PosedScan& src : scene.scans) {
     PosedScan s;
     s.pose = src.pose;
-    for (int i = 0; i < points && src.points.size(); ++i) s.points.push_back(src.points[size_t(i) % src.points.size()]);
+    if (src.points.size() == 0) continue;
+    if (cfg.scene == "synthetic") {
+      for (size_t i = 0; i < points; ++i) s.points.push_back(src.points[i % src.points.size()]);
+    } else {
+      const size_t step = std::max<size_t>(1, (src.points.size() + points - 1) / points);
+      for (size_t i = 0; i < src.points.size(); i += step) s.points.push_back(src.points[i]);
+    }
     out.push_back(std::move(s));
   }
+  if (out.empty()) throw std::runtime_error("the scene " + cfg.scene + " has no scans");
   return out;
 }
 
@@ -200,7 +229,7 @@ LoadReport run_load_test(const LoadTestConfig& cfg) {
   const std::string url = "udpm://239.255.76.67:" + std::to_string(cfg.port) + "?ttl=0";
   std::vector<std::string> argv = {cfg.server, "--lcm-url", url, "--status-period", "0.5"};
   argv.insert(argv.end(), cfg.server_args.begin(), cfg.server_args.end());
-  const std::vector<PosedScan> scans = load_scans(cfg.points);
+  const std::vector<PosedScan> scans = load_scans(cfg);
   StatusTracker status(url);
   const pid_t server = spawn(argv, cfg.log_path);
   for (int i = 0; i < 600 && status.latest().utime == 0; ++i)
@@ -212,6 +241,27 @@ LoadReport run_load_test(const LoadTestConfig& cfg) {
   }
   std::atomic<int64_t> published{0}, errors{0};
   const auto t0 = Clock::now();
+  std::atomic<bool> series_stop{false};
+  std::jthread series;
+  if (!cfg.series_path.empty()) {
+    series = std::jthread([&] {
+      std::ofstream out(cfg.series_path);
+      out << "t_s,rss_mib,peak_rss_mib,map_memory_mib,map_nodes,e2e_p99_ms,scans_applied\n";
+      int64_t last_seq = -1;
+      while (!series_stop) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(250));
+        const octomap_rt::server_status_t st = status.latest();
+        if (st.seq == last_seq) continue;
+        last_seq = st.seq;
+        char line[256];
+        std::snprintf(line, sizeof line, "%.2f,%.1f,%.1f,%.2f,%lld,%.2f,%lld\n",
+                      std::chrono::duration<double>(Clock::now() - t0).count(), rss_mib(server), peak_rss_mib(server),
+                      double(st.memory_bytes) / 1048576.0, (long long)st.num_nodes, double(st.end_to_end_ms_p99),
+                      (long long)st.scans_applied);
+        out << line << std::flush;
+      }
+    });
+  }
   {
     std::vector<std::jthread> producers;
     for (int i = 0; i < cfg.producers; ++i)
@@ -231,6 +281,8 @@ LoadReport run_load_test(const LoadTestConfig& cfg) {
   count_totals(status.latest(), r);
   status.fill(r);
   r.peak_rss_mib = peak_rss_mib(server);
+  series_stop = true;
+  if (series.joinable()) series.join();
   r.scans_per_s = publish_s > 0 ? r.applied / publish_s : 0;
   ::kill(server, SIGTERM);
   int st = 0;

@@ -22,6 +22,15 @@ struct LoadTestConfig {
   int port = 7667;        // udpm port inside the namespace
   double settle_s = 120;  // after publishing stops, wait this long for the queue to empty
   std::string log_path = "loadtest-server.log";
+  // What the robots scan: "synthetic" (the built-in rooms), a preset name (fr079-real, ...;
+  // scene/scene_presets.h) or a ScanGraph .graph file. Each producer goes round its poses
+  // again and again (robots circling the scene), from its own start.
+  std::string scene = "synthetic";
+  std::string data_dir;  // where fr079-real finds geb079.bt
+  // A CSV line per status message (the soak benchmark's time series): seconds since the
+  // publishing began, the server's RSS and peak RSS, its map memory and nodes, end-to-end
+  // p99, scans applied. "": none.
+  std::string series_path;
 };
 
 struct LoadReport {

@@ -28,6 +28,12 @@ int main(int argc, char** argv) {
   app.add_option("--settle", cfg.settle_s, "seconds to wait afterwards for the queue to empty")->capture_default_str();
   app.add_option("--server", cfg.server, "octomap-rt-server program")->capture_default_str();
   app.add_option("--log", cfg.log_path, "the server's log file")->capture_default_str();
+  app.add_option("--scene", cfg.scene,
+                 "what the robots scan, going round it: synthetic, a preset (fr079-real, ...) or a .graph file")
+      ->capture_default_str();
+  app.add_option("--data", cfg.data_dir, "where fr079-real finds octomap_share/geb079.bt");
+  app.add_option("--series", cfg.series_path,
+                 "CSV of the server's memory and latency at every status message (the soak benchmark's series)");
   app.add_option("server-args", server_args, "after --: the server's flags (default: -r 0.1)");
   CLI11_PARSE(app, argc, argv);
   if (!server_args.empty()) cfg.server_args = server_args;
