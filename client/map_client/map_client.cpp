@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -148,6 +150,21 @@ void MapClient::send_request(int64_t request_id, int64_t snapshot_id, int8_t for
   lcm_.publish(opts_.request_channel, &r);
 }
 
+namespace {
+
+// The seconds a busy refusal asks to wait ("... retry after 250 ms"); 0.2 s when it names none.
+double busy_retry_s(const std::string& error) {
+  const size_t at = error.find("retry after ");
+  if (at == std::string::npos) return 0.2;
+  try {
+    return std::clamp(std::stod(error.substr(at + 12)) / 1000.0, 0.05, 5.0);
+  } catch (const std::exception&) {
+    return 0.2;
+  }
+}
+
+}  // namespace
+
 FetchedSnapshot MapClient::fetch_snapshot(int8_t format, double timeout_s, const FetchProgress& progress,
                                           int64_t snapshot_id) {
   const auto t0 = Clock::now();
@@ -158,6 +175,8 @@ FetchedSnapshot MapClient::fetch_snapshot(int8_t format, double timeout_s, const
   send_request(next_request_id_++, snapshot_id, format, {});
   out.requests = 1;
   auto last_arrival = Clock::now();
+  auto retry_at = Clock::time_point::max();  // refused as busy: ask again then (max: not refused)
+  std::minstd_rand rng(static_cast<unsigned>(std::random_device{}()));
   while (!as.complete()) {
     if (seconds_since(t0) >= timeout_s) {
       std::ostringstream why;
@@ -180,6 +199,15 @@ FetchedSnapshot MapClient::fetch_snapshot(int8_t format, double timeout_s, const
           out.requests++;
           continue;
         }
+        // Busy (many clients at once): ask again after the time the server names, stretched
+        // by a random quarter to half so that clients refused together do not return together.
+        if (c.error.rfind("busy", 0) == 0) {
+          out.busy_replies++;
+          retry_at =
+              Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                                 busy_retry_s(c.error) * std::uniform_real_distribution<double>(1.25, 1.5)(rng)));
+          continue;
+        }
         throw FetchError(FetchError::kRefused, "the server refused the request: " + c.error);
       }
       if (opts_.drop_chunk && opts_.drop_chunk(c)) {
@@ -195,7 +223,16 @@ FetchedSnapshot MapClient::fetch_snapshot(int8_t format, double timeout_s, const
     // Before the first chunk the server may still be copying and compressing a big map: ask
     // again only after a longer silence, so as not to queue duplicate full sends.
     const double patience = as.started() ? opts_.rerequest_after_s : opts_.first_answer_after_s;
-    if (!as.complete() && seconds_since(last_arrival) >= patience) {
+    const bool refused = retry_at != Clock::time_point::max();
+    if (refused && Clock::now() >= retry_at) {
+      retry_at = Clock::time_point::max();
+      if (as.started())
+        send_request(next_request_id_++, as.snapshot_id(), format, as.missing());
+      else
+        send_request(next_request_id_++, snapshot_id, format, {});
+      out.requests++;
+      last_arrival = Clock::now();
+    } else if (!refused && !as.complete() && seconds_since(last_arrival) >= patience) {
       if (as.started())
         send_request(next_request_id_++, as.snapshot_id(), format, as.missing());
       else

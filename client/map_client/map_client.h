@@ -53,6 +53,7 @@ struct FetchedSnapshot {
   std::string bytes;  // decompressed: the .bt or .ot file's content
   int64_t compressed_size = 0;
   int32_t num_chunks = 0, requests = 0, chunks_dropped = 0;
+  int32_t busy_replies = 0;  // refusals as busy, each followed by a retry after the time it named
   double seconds = 0;
   // Parses bytes (either format). Throws FetchError(kCorrupt) when OctoMap cannot.
   std::unique_ptr<octomap::OcTree> tree() const;

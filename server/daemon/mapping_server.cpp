@@ -133,6 +133,7 @@ void MappingServer::start() {
   warm_up_engine();    // before the pipeline's threads use the engine and before the intake opens
   pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, log_, cfg_.pipeline,
                                              std::chrono::duration<double>(cfg_.latency_bound_s), cfg_.point_filters);
+  pipeline_->set_cost_bounds(cfg_.scan_costs);
   pipeline_->start();
   upkeep_ = std::make_unique<MapUpkeep>(map_, cfg_.upkeep, log_);
   upkeep_->start();
@@ -190,6 +191,9 @@ void MappingServer::open_map_serving() {
   m.request_channel = cfg_.map_request_channel;
   m.info_channel = cfg_.map_info_channel;
   m.snapshots = SnapshotPolicy{cfg_.snapshots_kept, cfg_.snapshot_zstd_level, cfg_.snapshot_min_interval_s};
+  m.fresh_interval_s = cfg_.fresh_snapshot_interval_s;
+  m.request_queue = cfg_.map_request_queue;
+  m.requests_per_client = cfg_.map_requests_per_client;
   m.chunk_interval_ms = cfg_.chunk_interval_ms;
   m.server_id = server_id_;
   m.resolution = cfg_.engine.resolution;
@@ -207,6 +211,7 @@ bool MappingServer::stop() {
   if (!started_ || stopped_) return final_save_error_.empty();
   stopped_ = true;
   set_state(Status::STATE_STOPPING, "stopping: intake closed, draining queued scans");
+  if (queries_) queries_->cut_running();  // no query holds the map past the drain bound
   intake_->close();
   queue_.close();
   drain_until_deadline();

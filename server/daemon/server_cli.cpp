@@ -1,6 +1,7 @@
 #include "daemon/server_cli.h"
 
 #include <cmath>
+#include <limits>
 #include <regex>
 #include <stdexcept>
 #include <string>
@@ -66,6 +67,19 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
       ->capture_default_str();
   add_grid_flags(app, s.queries.grid);
   add_point_filter_flags(app, s.point_filters);
+  app.add_option("--query-max-work", s.queries.bounds.max_work,
+                 "most nodes a query may visit or key steps its rays may walk; past it a ray or box query "
+                 "is cut (its reply says where), a region or grid refused")
+      ->capture_default_str()
+      ->check(CLI::Range(uint64_t{1}, std::numeric_limits<uint64_t>::max()));
+  app.add_option("--query-lock-ms", s.queries.bounds.lock_ms,
+                 "longest one query may hold the map's read lock [ms]; past it the query is cut as above")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 10000.0));
+  app.add_option("--query-max-reply-bytes", s.queries.bounds.max_reply_bytes,
+                 "most bytes of replies one region or grid query may make the server send")
+      ->capture_default_str()
+      ->check(CLI::Range(size_t{1024}, size_t{1} << 30));
   app.add_option("--latency-bound", s.latency_bound_s,
                  "overload bound [s]: a scan queued longer is dropped ('over latency bound') and the status is "
                  "DEGRADED while the end-to-end p99 exceeds it; 0: never drop for age")
@@ -76,6 +90,19 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
   app.add_option("--snapshot-min-interval", s.snapshot_min_interval_s,
                  "seconds between two new snapshots, however many clients ask")
       ->capture_default_str();
+  app.add_option("--fresh-snapshot-interval", s.fresh_snapshot_interval_s,
+                 "seconds between two new snapshots for fresh requests (snapshot_id -1): every fresh request "
+                 "waiting gets the next one, so a flood of them copies the map at most this often")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 3600.0));
+  app.add_option("--map-request-queue", s.map_request_queue,
+                 "map requests waiting, all clients; more are refused as busy (with a retry time)")
+      ->capture_default_str()
+      ->check(CLI::Range(size_t{1}, size_t{65536}));
+  app.add_option("--map-requests-per-client", s.map_requests_per_client,
+                 "map requests of one client waiting; more are refused as busy (one client cannot fill the queue)")
+      ->capture_default_str()
+      ->check(CLI::Range(size_t{1}, size_t{1024}));
   app.add_option("--chunk-interval-ms", s.chunk_interval_ms,
                  "pause between two snapshot chunks or delta parts (pacing for clients' receive buffers)")
       ->capture_default_str();
@@ -116,6 +143,25 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                  "most ray-walk steps one scan may cost (summed over its windows); a scan above it is rejected "
                  "as 'too much work'; 0: no limit")
       ->capture_default_str();
+  app.add_option("--max-origin-jump", s.scan_costs.max_origin_jump_m,
+                 "farthest a robot's scan origin may be from its last scan's [m] (plus --max-robot-speed for each "
+                 "second since); farther: rejected as 'origin jump'; 0: unchecked")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e7));
+  app.add_option("--max-robot-speed", s.scan_costs.max_speed_mps, "see --max-origin-jump [m/s]")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
+  app.add_option("--max-scan-voxels", s.scan_costs.max_scan_voxels,
+                 "most voxels one scan may update; more: rejected as 'too many voxels'; 0: no limit")
+      ->capture_default_str();
+  app.add_option("--max-new-nodes-per-s", s.scan_costs.max_new_nodes_per_s,
+                 "new octree nodes a second one robot may add, on average (allowance up to --new-node-burst); "
+                 "past it its scans are rejected as 'new-node rate' until the allowance refills; 0: no limit")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e12));
+  app.add_option("--new-node-burst", s.scan_costs.new_node_burst, "see --max-new-nodes-per-s")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e13));
   app.add_option("--max-producers", s.max_producers,
                  "most scan channels served at once; more are rejected (too many producers) unless an idle "
                  "one can be let go (--producer-idle-release)")

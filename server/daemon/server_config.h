@@ -9,6 +9,7 @@
 
 #include "daemon/map/map_upkeep.h"
 #include "daemon/pipeline/point_filters.h"
+#include "daemon/pipeline/scan_cost_gate.h"
 #include "daemon/queries/query_config.h"
 #include "daemon/serving/octomap_raw_publisher.h"
 #include "engine/map_engine.h"
@@ -39,6 +40,7 @@ struct ServerConfig {
   uint64_t queue_budget_bytes = 0;                             // per producer; 0: automatic_queue_budget()
   uint64_t max_points = ort::protocol::kDefaultMaxScanPoints;  // per scan
   size_t max_producers = 64;
+  ScanCostBounds scan_costs;                // per producer over time: origin jumps, voxels, new nodes a second
   double producer_idle_release_s = 600;     // an idle producer's slot goes to a new robot; <= 0: never
   std::vector<std::string> allowed_robots;  // --allow-robot; empty: any valid robot id
   int lcm_queue_capacity = 64;              // LCM's own per-subscription queue (messages)
@@ -47,13 +49,16 @@ struct ServerConfig {
   std::string map_request_channel = ort::protocol::kMapRequestChannel;
   std::string map_info_channel = ort::protocol::kMapInfoChannel;
   std::string map_delta_channel = ort::protocol::kMapDeltaChannel;
-  int snapshot_zstd_level = 3;           // 0: snapshots uncompressed
-  size_t snapshots_kept = 4;             // for re-sends of chunks
-  double snapshot_min_interval_s = 0.5;  // a new snapshot at most this often
-  double chunk_interval_ms = 1.5;        // pacing of snapshot chunks and delta parts
-  double delta_rate_hz = 10;             // most change sets a second; <= 0: no deltas
-  bool delta_exact = false;              // deltas carry every changed leaf's log-odds
-  QueryServiceConfig queries;            // queries and map edits (daemon/query_service.h)
+  int snapshot_zstd_level = 3;             // 0: snapshots uncompressed
+  size_t snapshots_kept = 4;               // for re-sends of chunks
+  double snapshot_min_interval_s = 0.5;    // a new snapshot at most this often
+  double fresh_snapshot_interval_s = 2.0;  // a new snapshot for fresh requests at most this often
+  size_t map_request_queue = 256;          // map requests waiting, all clients; more: busy
+  size_t map_requests_per_client = 2;      // map requests of one client waiting; more: busy
+  double chunk_interval_ms = 1.5;          // pacing of snapshot chunks and delta parts
+  double delta_rate_hz = 10;               // most change sets a second; <= 0: no deltas
+  bool delta_exact = false;                // deltas carry every changed leaf's log-odds
+  QueryServiceConfig queries;              // queries and map edits (daemon/query_service.h)
   // Overload: a scan that waited longer than this in the queue is dropped ("over latency
   // bound") instead of applied late, and the status is DEGRADED while the end-to-end p99
   // exceeds it. <= 0: never shed.

@@ -11,11 +11,14 @@
 
 #include "query/key_box.h"
 #include "query/query_types.h"
+#include "query/work_budget.h"
 
 namespace ort::query {
 
-BoxCounts count_box(const octomap::OcTree& tree, const KeyBox& box);
+// With a budget: one unit per node visited; when it runs out (budget->cut) the result is
+// partial and must not be reported.
+BoxCounts count_box(const octomap::OcTree& tree, const KeyBox& box, WorkBudget* budget = nullptr);
 // Stops at the first occupied voxel (a footprint check).
-bool any_occupied(const octomap::OcTree& tree, const KeyBox& box);
+bool any_occupied(const octomap::OcTree& tree, const KeyBox& box, WorkBudget* budget = nullptr);
 
 }  // namespace ort::query

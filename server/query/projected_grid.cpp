@@ -13,12 +13,13 @@ namespace {
 int64_t floor_div(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
 // Key range [lo, hi] of stored leaves in x and y; false for an empty tree.
-bool map_key_extent(const octomap::OcTree& tree, int lo[2], int hi[2]) {
+bool map_key_extent(const octomap::OcTree& tree, int lo[2], int hi[2], WorkBudget* budget) {
   if (!tree.getRoot()) return false;
   const unsigned top = tree.getTreeDepth();
   lo[0] = lo[1] = 1 << top;
   hi[0] = hi[1] = -1;
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (budget && !budget->charge(1)) return false;
     const NodeCube c = node_cube(it.getKey(), it.getDepth(), top);
     for (int i = 0; i < 2; ++i) {
       lo[i] = std::min<int>(lo[i], c.lo[i]);
@@ -34,7 +35,7 @@ void check_finite(double v, const char* what) {
 
 }  // namespace
 
-Grid2D projected_grid(const octomap::OcTree& tree, const GridRequest& req) {
+Grid2D projected_grid(const octomap::OcTree& tree, const GridRequest& req, WorkBudget* budget) {
   check_finite(req.z_min, "z min");
   check_finite(req.z_max, "z max");
   if (req.z_min > req.z_max) throw QueryError("z band min > max");
@@ -53,8 +54,8 @@ Grid2D projected_grid(const octomap::OcTree& tree, const GridRequest& req) {
     if (req.x_min > req.x_max || req.y_min > req.y_max) throw QueryError("grid window min > max");
     lo[0] = clamped_key(tree, req.x_min), lo[1] = clamped_key(tree, req.y_min);
     hi[0] = clamped_key(tree, req.x_max), hi[1] = clamped_key(tree, req.y_max);
-  } else if (!map_key_extent(tree, lo, hi)) {
-    return g;  // empty map: a 0 x 0 grid
+  } else if (!map_key_extent(tree, lo, hi, budget)) {
+    return g;  // empty map (or the budget ran out): a 0 x 0 grid
   }
   int first[2], count[2];
   for (int i = 0; i < 2; ++i) {
@@ -75,21 +76,24 @@ Grid2D projected_grid(const octomap::OcTree& tree, const GridRequest& req) {
   box.min = octomap::OcTreeKey(std::max(first[0], 0), std::max(first[1], 0), g.key_z0);
   box.max = octomap::OcTreeKey(std::min(first[0] + count[0] * m - 1, top_key),
                                std::min(first[1] + count[1] * m - 1, top_key), g.key_z1);
-  for_each_node_in(tree, box, 0, [&](const octomap::OcTreeNode& node, const NodeCube& c, int64_t) {
-    const VoxelState s = tree.isNodeOccupied(node) ? VoxelState::kOccupied : VoxelState::kFree;
-    int cell_lo[2], cell_hi[2];
-    for (int i = 0; i < 2; ++i) {
-      const int a = std::max<int>(c.lo[i], box.min[i]), b = std::min<int>(c.lo[i] + c.side - 1, box.max[i]);
-      cell_lo[i] = (a - first[i]) / m;
-      cell_hi[i] = (b - first[i]) / m;
-    }
-    for (int j = cell_lo[1]; j <= cell_hi[1]; ++j)
-      for (int i = cell_lo[0]; i <= cell_hi[0]; ++i) {
-        VoxelState& cell = g.cells[size_t(j) * g.width + i];
-        if (s == VoxelState::kOccupied || cell == VoxelState::kUnknown) cell = s;
-      }
-    return true;
-  });
+  for_each_node_in(
+      tree, box, 0,
+      [&](const octomap::OcTreeNode& node, const NodeCube& c, int64_t) {
+        const VoxelState s = tree.isNodeOccupied(node) ? VoxelState::kOccupied : VoxelState::kFree;
+        int cell_lo[2], cell_hi[2];
+        for (int i = 0; i < 2; ++i) {
+          const int a = std::max<int>(c.lo[i], box.min[i]), b = std::min<int>(c.lo[i] + c.side - 1, box.max[i]);
+          cell_lo[i] = (a - first[i]) / m;
+          cell_hi[i] = (b - first[i]) / m;
+        }
+        for (int j = cell_lo[1]; j <= cell_hi[1]; ++j)
+          for (int i = cell_lo[0]; i <= cell_hi[0]; ++i) {
+            VoxelState& cell = g.cells[size_t(j) * g.width + i];
+            if (s == VoxelState::kOccupied || cell == VoxelState::kUnknown) cell = s;
+          }
+        return true;
+      },
+      budget);
   return g;
 }
 

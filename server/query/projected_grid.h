@@ -10,6 +10,7 @@
 #include <octomap/OcTree.h>
 
 #include "query/query_types.h"
+#include "query/work_budget.h"
 
 namespace ort::query {
 
@@ -22,6 +23,8 @@ struct GridRequest {
 };
 
 // Throws QueryError: non-finite or inverted band or window, cell_voxels < 1, too many cells.
-Grid2D projected_grid(const octomap::OcTree& tree, const GridRequest& req);
+// With a budget (one unit per leaf visited, the map's extent included; the cells are
+// bounded by max_cells), a walk that runs out returns a partial grid with budget->cut set: not an answer.
+Grid2D projected_grid(const octomap::OcTree& tree, const GridRequest& req, WorkBudget* budget = nullptr);
 
 }  // namespace ort::query

@@ -7,6 +7,15 @@
 namespace ort::query {
 namespace {
 bool finite(const octomap::point3d& p) { return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()); }
+
+// The keys a walk from a to b stepped through: one per boundary crossed, plus the start.
+uint64_t key_steps(const octomap::OcTree& tree, const octomap::point3d& a, const octomap::point3d& b) {
+  uint64_t n = 1;
+  for (int i = 0; i < 3; ++i)
+    n += clamped_key(tree, b(i)) > clamped_key(tree, a(i)) ? clamped_key(tree, b(i)) - clamped_key(tree, a(i))
+                                                           : clamped_key(tree, a(i)) - clamped_key(tree, b(i));
+  return n;
+}
 }  // namespace
 
 RayAnswer cast_ray(const octomap::OcTree& tree, const octomap::point3d& origin, const octomap::point3d& direction,
@@ -32,15 +41,37 @@ RayAnswer cast_ray(const octomap::OcTree& tree, const octomap::point3d& origin, 
   return a;
 }
 
+uint64_t ray_walk_bound(const octomap::OcTree& tree, const octomap::point3d& direction, const RayBatchOptions& opt) {
+  const uint64_t edge = 3ull << tree.getTreeDepth();  // every key of the range, on each axis
+  const double norm = direction.norm();
+  if (!(opt.max_range > 0) || !(norm > 0)) return edge;
+  // The DDA steps once per voxel boundary crossed: |d|_1 / |d|_2 * range / resolution per
+  // ray, plus the start voxel and one boundary per axis at each end.
+  const double l1 = std::abs(direction.x()) + std::abs(direction.y()) + std::abs(direction.z());
+  const double steps = l1 / norm * opt.max_range / tree.getResolution() + 4;
+  return steps >= static_cast<double>(edge) ? edge : static_cast<uint64_t>(steps);
+}
+
 std::vector<RayAnswer> cast_rays(const octomap::OcTree& tree, std::span<const float> origins,
-                                 std::span<const float> directions, const RayBatchOptions& opt) {
+                                 std::span<const float> directions, const RayBatchOptions& opt, WorkBudget* budget) {
   if (origins.size() != directions.size() || origins.size() % 3 != 0)
     throw QueryError("ray origins and directions must be 3 numbers per ray, as many of each");
   std::vector<RayAnswer> out;
   out.reserve(origins.size() / 3);
-  for (size_t i = 0; i + 2 < origins.size(); i += 3)
-    out.push_back(cast_ray(tree, octomap::point3d(origins[i], origins[i + 1], origins[i + 2]),
-                           octomap::point3d(directions[i], directions[i + 1], directions[i + 2]), opt));
+  for (size_t i = 0; i + 2 < origins.size(); i += 3) {
+    const octomap::point3d origin(origins[i], origins[i + 1], origins[i + 2]);
+    const octomap::point3d direction(directions[i], directions[i + 1], directions[i + 2]);
+    if (budget) {
+      if (!budget->check_now()) break;
+      const uint64_t bound = ray_walk_bound(tree, direction, opt);
+      if (bound > budget->max_work || budget->used > budget->max_work) {
+        budget->stop_with(Cut::kWork);
+        break;
+      }
+    }
+    out.push_back(cast_ray(tree, origin, direction, opt));
+    if (budget) budget->charge(key_steps(tree, origin, out.back().end));
+  }
   return out;
 }
 

@@ -9,6 +9,7 @@
 #include <octomap/OcTree.h>
 
 #include "query/query_types.h"
+#include "query/work_budget.h"
 
 namespace ort::query {
 
@@ -22,8 +23,17 @@ struct RayBatchOptions {
 // non-finite origin or direction, or a zero direction.
 RayAnswer cast_ray(const octomap::OcTree& tree, const octomap::point3d& origin, const octomap::point3d& direction,
                    const RayBatchOptions& opt);
+// The most key steps castRay may take on this ray (its range, or the key range's edge where
+// there is none), what a budget must hold before the ray is cast: castRay cannot be stopped
+// once it runs.
+uint64_t ray_walk_bound(const octomap::OcTree& tree, const octomap::point3d& direction, const RayBatchOptions& opt);
+
 // origins, directions: x0 y0 z0 x1 ...; one answer per ray, in order.
+// With a budget: a ray is cast only while the budget is not spent and its walk bound fits
+// max_work; it then costs the key steps it took. Fewer answers than rays: budget->cut says
+// why, and the answers are those of the first rays.
 std::vector<RayAnswer> cast_rays(const octomap::OcTree& tree, std::span<const float> origins,
-                                 std::span<const float> directions, const RayBatchOptions& opt);
+                                 std::span<const float> directions, const RayBatchOptions& opt,
+                                 WorkBudget* budget = nullptr);
 
 }  // namespace ort::query

@@ -11,6 +11,7 @@
 
 #include "query/key_box.h"
 #include "query/query_types.h"
+#include "query/work_budget.h"
 
 namespace ort::query {
 
@@ -20,6 +21,9 @@ struct RegionOptions {
   size_t max_voxels = 1'000'000;  // more: QueryError (the reply would be too large)
 };
 
-std::vector<RegionVoxel> extract_region(const octomap::OcTree& tree, const KeyBox& box, const RegionOptions& opt);
+// With a budget (one unit per node visited), a walk that runs out returns what it found so
+// far with budget->cut set: not an answer.
+std::vector<RegionVoxel> extract_region(const octomap::OcTree& tree, const KeyBox& box, const RegionOptions& opt,
+                                        WorkBudget* budget = nullptr);
 
 }  // namespace ort::query

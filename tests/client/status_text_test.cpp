@@ -161,6 +161,16 @@ TEST(StatusText, NumbersForPeople) {
   EXPECT_EQ(state_name(9), "STATE 9");
 }
 
+// A robot that restarted (seq back to 0) shows it: its seq gap is not lost scans.
+TEST(StatusText, ShowsARobotsSeqRestarts) {
+  auto s = example_status();
+  s.robots[0].seq_restarts = 2;
+  const std::string text = format_status(s, s.utime + 2'000'000);
+  EXPECT_NE(text.find("seq restarts: 2"), std::string::npos) << text;
+  EXPECT_EQ(format_status(example_status(), s.utime).find("seq restarts"), std::string::npos);
+  EXPECT_NE(status_json(s).find("\"seq_restarts\":2"), std::string::npos) << status_json(s);
+}
+
 TEST(StatusJson, EveryFieldAndEscapedStrings) {
   const std::string json = status_json(example_status());
   EXPECT_EQ(json.front(), '{');

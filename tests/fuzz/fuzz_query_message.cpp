@@ -3,7 +3,9 @@
 // Besides memory errors and UB it checks the service's promises: when the raw-byte checks
 // pass, the generated decode() consumes the message exactly and does not throw; a query
 // that validate_query() accepts is answered on a small map without throwing anything but
-// query::QueryError (which the service turns into a BAD_REQUEST reply).
+// query::QueryError (which the service turns into a BAD_REQUEST reply), and within its cost
+// bounds: the work its walks charge, its time under the (would-be) map lock, its reply bytes.
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -12,6 +14,7 @@
 
 #include <octomap/OcTree.h>
 
+#include "core/clock.h"
 #include "daemon/queries/query_answers.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/grid_query_t.hpp"
@@ -59,11 +62,32 @@ void exercise(const uint8_t* data, size_t size, ort::protocol::WireCheck (*check
   const QueryMessage q(msg);
   (void)header_of(q);
   if (!validate_query(q, 0.1).empty()) return;
+  // The cost bounds, tight enough that the fuzzer reaches them on the small map.
+  QueryBounds bounds;
+  bounds.max_work = 20'000;
+  bounds.lock_ms = 10;
+  bounds.max_reply_bytes = 256 * 1024;
+  ort::query::WorkBudget budget;
+  budget.max_work = bounds.max_work;
+  budget.deadline = ort::SteadyClock::now() + std::chrono::milliseconds(10);
+  const octomap::OcTree& map = small_map();
+  const int64_t cpu0 = ort::thread_cpu_ns();
   try {
-    (void)answer_query(small_map(), q, MapStamp{1, 0}, "fuzz");
+    const EncodedReplies r = answer_query(map, q, MapStamp{1, 0}, "fuzz", bounds, budget);
+    // Bytes: a region or grid's replies within the bound (plus one message's framing).
+    size_t bytes = 0;
+    for (const auto& m : r.messages) bytes += m.size();
+    if (bytes > bounds.max_reply_bytes + 64 * 1024 + 256 * r.messages.size()) std::abort();
   } catch (const ort::query::QueryError&) {
     // answered with BAD_REQUEST by the service
   }
+  // Work: what the walks charged stays within the bound, plus one ray's walk bound (a ray is
+  // cast whole once admitted; its bound is at most max_work).
+  if (budget.used > 2 * bounds.max_work + 1) std::abort();
+  // Time under the (would-be) lock: 10x the bound (one ray's walk past the deadline
+  // included), generous for sanitizers; CPU time, so that a fuzzer starved of a core on a
+  // shared machine does not report the machine.
+  if (static_cast<double>(ort::thread_cpu_ns() - cpu0) / 1e6 > 10 * (bounds.lock_ms + 90)) std::abort();
 }
 
 }  // namespace

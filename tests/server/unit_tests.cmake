@@ -6,9 +6,11 @@ octomap_rt_add_test(server_validation_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/sca
 octomap_rt_add_test(server_memq_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_memq_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/server_status_counts_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/server_published_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/map_request_bounds_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 600)
 octomap_rt_lcm_handler_sources(server_memq_test ${CMAKE_CURRENT_LIST_DIR}/server_memq_test.cpp
-                               ${CMAKE_CURRENT_LIST_DIR}/server_published_test.cpp)
+                               ${CMAKE_CURRENT_LIST_DIR}/server_published_test.cpp
+                               ${CMAKE_CURRENT_LIST_DIR}/map_request_bounds_test.cpp)
 octomap_rt_add_test(server_persistence_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_store_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/server_persistence_test.cpp ${CMAKE_CURRENT_LIST_DIR}/map_file_integrity_test.cpp
                     ${SERVER_TEST_FIXTURES}
@@ -24,13 +26,17 @@ octomap_rt_add_test(server_producer_registry_test SOURCES ${CMAKE_CURRENT_LIST_D
 octomap_rt_add_test(server_degraded_causes_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/degraded_causes_test.cpp
                     LIBS octomap_rt_daemon TIMEOUT 60)
 octomap_rt_add_test(server_hardening_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_hardening_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/scan_costs_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 600)
+octomap_rt_lcm_handler_sources(server_hardening_test ${CMAKE_CURRENT_LIST_DIR}/scan_costs_test.cpp)
 octomap_rt_add_test(server_shutdown_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_shutdown_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
 # The query service (issue 11): answers, read-your-writes, edits, bad queries, over memq://.
 octomap_rt_add_test(server_query_service_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/query_service_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/query_bounds_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
-octomap_rt_lcm_handler_sources(server_query_service_test ${CMAKE_CURRENT_LIST_DIR}/query_service_test.cpp)
+octomap_rt_lcm_handler_sources(server_query_service_test ${CMAKE_CURRENT_LIST_DIR}/query_service_test.cpp
+                               ${CMAKE_CURRENT_LIST_DIR}/query_bounds_test.cpp)
 # ... its counters in the status and the grid it publishes at a rate (issue 11).
 octomap_rt_add_test(server_query_status_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/query_status_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 120)

@@ -63,6 +63,7 @@ std::string robot_json(const octomap_rt::robot_stats_t& r) {
       .num("scans_rejected", r.scans_rejected)
       .num("scans_dropped", r.scans_dropped)
       .num("scans_missed", r.scans_missed)
+      .num("seq_restarts", r.seq_restarts)
       .num("points_applied", r.points_applied)
       .num("queue_depth", int64_t(r.queue_depth))
       .num("queue_bytes", r.queue_bytes)

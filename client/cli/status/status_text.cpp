@@ -81,6 +81,9 @@ void robots(std::ostringstream& o, const Status& s, int64_t now) {
              with_commas(r.scans_rejected).c_str(), with_commas(r.scans_dropped).c_str(),
              with_commas(r.scans_missed).c_str(), r.queue_depth, (long long)r.last_seq, r.last_end_to_end_ms,
              age_text(r.last_scan_utime, now).c_str());
+    // A robot that restarted (its seq went back to 0 or jumped) is worth a line: its gaps
+    // before and after are not lost scans.
+    if (r.seq_restarts > 0) o << "    seq restarts: " << with_commas(r.seq_restarts) << "\n";
     const size_t n = std::min(r.reject_reason.size(), r.reject_count.size());
     if (n) {
       o << "    rejected:";

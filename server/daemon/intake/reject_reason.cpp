@@ -29,6 +29,9 @@ const char* to_string(Reject r) {
     case Reject::kEngineError: return "engine error";
     case Reject::kRayTooLong: return "ray too long";
     case Reject::kTooMuchWork: return "too much work";
+    case Reject::kTooManyVoxels: return "too many voxels";
+    case Reject::kOriginJump: return "origin jump";
+    case Reject::kNewNodeRate: return "new-node rate";
     case Reject::kQueueFull: return "queue full";
     case Reject::kOverLatencyBound: return "over latency bound";
     case Reject::kLeftAtShutdown: return "left at shutdown";

@@ -38,6 +38,9 @@ enum class Reject {
   kEngineError,       // the engine threw while shooting or applying this scan
   kRayTooLong,        // a ray's walk is longer than OctoMap's KeyRay holds (points km away at fine -r)
   kTooMuchWork,       // the scan's ray walks exceed the per-scan work bound (--max-scan-work)
+  kTooManyVoxels,     // the shot scan updates more voxels than --max-scan-voxels
+  kOriginJump,        // the origin is farther from the robot's last scan than it could have moved
+  kNewNodeRate,       // the robot's new nodes passed --max-new-nodes-per-s (its allowance is spent)
   // Why a valid scan was dropped (counted as dropped, not rejected).
   kQueueFull,         // the producer's queue budget was full on arrival
   kOverLatencyBound,  // waited in the queue longer than --max-queue-age (overload shedding)

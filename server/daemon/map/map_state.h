@@ -45,6 +45,7 @@ struct MapState {
   // also adds 1: the id changes whenever the map does.
   uint64_t version = 0;
   int64_t last_scan_utime = 0;            // utime of the newest applied scan
+  octomap::point3d last_scan_origin;      // its sensor origin (where a clipped grid is centred)
   MapChangeObserver* observer = nullptr;  // set before the pipeline starts
   // Where each robot's newest applied scan was taken from and when it was applied (the
   // daemon's steady clock): clearing by distance keeps what is near the robots seen lately

@@ -76,6 +76,11 @@ void ScanPipeline::join() {
   if (stage2_.joinable()) stage2_.join();
 }
 
+void ScanPipeline::refuse_cost(size_t producer, Reject why, const std::string& detail) {
+  if (cost_refusals_logged_++ < 10) log_.warning(text("scan refused (", to_string(why), "): ", detail));
+  producers_.count_rejected_in_flight(producer, why);
+}
+
 void ScanPipeline::reject(size_t producer, Reject why, const char* what) {
   if (why == Reject::kEngineError && engine_errors_++ < 10) log_.error(text("engine error: ", what));
   producers_.count_rejected_in_flight(producer, why);
@@ -94,6 +99,14 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
   job.waits.queue_ms = ms_between(decoded, t0);
   bool ok = true;
   try {
+    std::string detail;
+    job.origin = scan_pose(item.msg).trans();
+    if (const Reject why = gate_.admit_origin(item.producer, job.origin, t0, detail); why != Reject::kNone) {
+      refuse_cost(item.producer, why, detail);
+      metrics_.overlap().end(0, token);
+      set_busy(0, false);
+      return false;
+    }
     const double max_range = effective_max_range(item.msg.max_range, engine_.options().max_range);
     if (filters_.active()) {
       job.filtered = shoot_filtered(engine_, item.msg, filters_, max_range, filter_scratch_, job.shot);
@@ -121,6 +134,13 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
       reject(item.producer, job.shot.refusal == ShotRefusal::kRayTooLong ? Reject::kRayTooLong : Reject::kTooMuchWork,
              "");
       ok = false;
+    }
+    if (ok) {
+      if (const Reject why = gate_.admit_voxels(job.shot.free_voxels + job.shot.occupied_voxels, detail);
+          why != Reject::kNone) {
+        refuse_cost(item.producer, why, detail);
+        ok = false;
+      }
     }
   } catch (const std::exception& e) {
     reject(item.producer, Reject::kEngineError, e.what());
@@ -175,6 +195,11 @@ void ScanPipeline::apply(ShotJob& job) {
   const auto t0 = Clock::now();
   job.waits.handoff_ms = ms_between(job.shot_at, t0);
   set_busy(1, true);
+  if (std::string detail; gate_.admit_allowance(job.producer, t0, detail) != Reject::kNone) {
+    set_busy(1, false);
+    metrics_.overlap().end(1, token);
+    return refuse_cost(job.producer, Reject::kNewNodeRate, detail);
+  }
   Stage2Parts parts;
   int64_t new_nodes = 0;
   try {
@@ -183,9 +208,14 @@ void ScanPipeline::apply(ShotJob& job) {
     const auto nodes_before = static_cast<int64_t>(map_.tree->size());
     engine_.apply(job.shot, *map_.tree, map_.observer ? &changes_ : nullptr);
     new_nodes = static_cast<int64_t>(map_.tree->size()) - nodes_before;
-    map_.order.append(AppliedEntry{job.robot_id, job.seq, job.utime});
+    // A scan stamped in the far future must not pin the map's time there: its utime in the
+    // map (order, snapshots, replies) is bounded by the daemon's clock plus the clock skew
+    // robots may have.
+    const int64_t utime = std::min(job.utime, now_utime() + gate_.max_future_us());
+    map_.order.append(AppliedEntry{job.robot_id, job.seq, utime});
     map_.version++;
-    map_.last_scan_utime = std::max(map_.last_scan_utime, job.utime);
+    map_.last_scan_utime = std::max(map_.last_scan_utime, utime);
+    map_.last_scan_origin = job.origin;
     const auto updated = Clock::now();
     if (map_.observer) map_.observer->applied(changes_, *map_.tree, map_.version);
     const std::string robot = lower_case(job.robot_id);
@@ -218,6 +248,7 @@ void ScanPipeline::apply(ShotJob& job) {
   t.voxels = job.shot.free_voxels + job.shot.occupied_voxels;
   t.new_nodes = new_nodes;
   metrics_.record(t);
+  gate_.applied(job.producer, new_nodes, t1);
   producers_.count_applied(job.producer, static_cast<int64_t>(job.shot.prepare.rays), t.end_to_end_ms,
                            point_drops(job.shot.prepare, job.filtered));
 }

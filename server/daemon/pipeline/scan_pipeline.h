@@ -17,6 +17,7 @@
 #include "daemon/pipeline/bounded_handoff.h"
 #include "daemon/pipeline/filtered_shoot.h"
 #include "daemon/pipeline/pipeline_metrics.h"
+#include "daemon/pipeline/scan_cost_gate.h"
 #include "engine/map_engine.h"
 
 namespace ort::daemon {
@@ -46,6 +47,8 @@ class ScanPipeline {
                std::chrono::duration<double> max_queue_age = std::chrono::duration<double>::zero(),
                const PointFilters& filters = {});
   ~ScanPipeline();
+  // What one producer's scans may cost (pipeline/scan_cost_gate.h); call before start().
+  void set_cost_bounds(const ScanCostBounds& b) { gate_ = ScanCostGate(b); }
   void start();
   // Call after queue.close(): returns once every queued scan was applied or rejected.
   void join();
@@ -62,6 +65,8 @@ class ScanPipeline {
   void apply(ShotJob& job);
   void apply_edit(MapEditItem& edit);
   void reject(size_t producer, Reject why, const char* what);
+  // A scan refused by the cost gate: counted, the first few logged with the detail.
+  void refuse_cost(size_t producer, Reject why, const std::string& detail);
   void run_stage1();
   void run_stage2();
   void run_sequential();
@@ -77,6 +82,8 @@ class ScanPipeline {
   Log log_;
   bool pipelined_;
   BoundedHandoff<ShotJob> handoff_{1};
+  ScanCostGate gate_{ScanCostBounds{}};
+  int64_t cost_refusals_logged_ = 0;
   LeafChanges changes_;  // stage 2's: what the scan being applied changed, for map_.observer
   std::thread stage1_, stage2_;
   std::atomic<int64_t> engine_errors_{0}, shed_{0};

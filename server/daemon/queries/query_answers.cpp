@@ -23,10 +23,19 @@ namespace {
 using Reply = octomap_rt::occupancy_reply_t;
 using Box = octomap_rt::box_query_t;
 constexpr int kRegionChunk = protocol::kRegionChunkVoxels, kGridChunkCells = protocol::kGridChunkCells;
+// A region voxel on the wire: state, depth and its center's three floats.
+constexpr size_t kRegionVoxelBytes = 1 + 1 + 12;
+constexpr int64_t kMaxGridCells = 4'000'000;
 
 int64_t now_us() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
+}
+
+EncodedReplies replies_on(const std::string& channel) {
+  EncodedReplies out;
+  out.channel = channel;
+  return out;
 }
 
 template <class M>
@@ -47,6 +56,7 @@ void stamp_reply(M& m, const QueryHeader& h, const MapStamp& s, const std::strin
   m.server_id = server_id;
   m.client_id = h.client_id;
   m.error = error;
+  if constexpr (requires { m.cut_at; }) m.cut = Reply::CUT_NONE, m.cut_at = -1;
 }
 
 template <class V>
@@ -108,17 +118,51 @@ EncodedReplies points(const octomap::OcTree& t, const octomap_rt::occupancy_quer
     r.occupancy.push_back(static_cast<int8_t>(a.state));
     r.probability.push_back(a.probability);
   }
-  return {h.reply_channel, {encode(r)}};
+  EncodedReplies out = replies_on(h.reply_channel);
+  out.messages.push_back(encode(r));
+  return out;
+}
+
+// A reply that answers the first `done` of `asked` items: cut there when fewer, with why.
+template <class M>
+void mark_cut(M& r, EncodedReplies& out, size_t done, size_t asked, const char* item, const query::WorkBudget& b,
+              const QueryBounds& bounds) {
+  r.cut = Reply::CUT_NONE, r.cut_at = -1;
+  if (done >= asked) return;
+  r.cut = static_cast<int8_t>(b.cut), r.cut_at = static_cast<int32_t>(done);
+  r.error = "cut at " + std::string(item) + " " + std::to_string(done) + " of " + std::to_string(asked) + ": " +
+            cut_reason(b, bounds);
+  out.cut = true, out.error = r.error;
+}
+
+// A region or grid past its bound is refused whole: BUSY when time ran out (it may fit
+// another turn), BAD_REQUEST when its work never fits.
+EncodedReplies refused_by_budget(const QueryMessage& q, const query::WorkBudget& b, const QueryBounds& bounds,
+                                 const MapStamp& s, const std::string& id) {
+  const int8_t status = b.cut == query::Cut::kWork ? Reply::REPLY_BAD_REQUEST : Reply::REPLY_BUSY;
+  const std::string why = "refused: " + cut_reason(b, bounds) + "; ask for a smaller box or a coarser cell";
+  EncodedReplies out = error_reply(q, status, why, s, id);
+  out.status = status, out.error = why;
+  return out;
 }
 
 EncodedReplies rays(const octomap::OcTree& t, const octomap_rt::ray_query_t& q, const QueryHeader& h, const MapStamp& s,
-                    const std::string& id) {
+                    const std::string& id, const QueryBounds& bounds, query::WorkBudget& budget) {
   query::RayBatchOptions opt;
   opt.ignore_unknown = q.ignore_unknown != 0;
   opt.max_range = q.max_range;
-  const auto answers = query::cast_rays(t, q.origin_xyz, q.direction_xyz, opt);
+  const auto answers = query::cast_rays(t, q.origin_xyz, q.direction_xyz, opt, &budget);
+  const size_t asked = q.origin_xyz.size() / 3;
+  if (answers.empty() && asked > 0 && budget.cut == query::Cut::kWork)
+    throw query::QueryError("ray 0 may walk " +
+                            std::to_string(query::ray_walk_bound(
+                                t, octomap::point3d(q.direction_xyz[0], q.direction_xyz[1], q.direction_xyz[2]), opt)) +
+                            " keys, over the query's work bound of " + std::to_string(bounds.max_work) +
+                            " (--query-max-work): give it a shorter max_range");
   octomap_rt::ray_reply_t r;
+  EncodedReplies out = replies_on(h.reply_channel);
   stamp_reply(r, h, s, id, Reply::REPLY_OK, "");
+  mark_cut(r, out, answers.size(), asked, "ray", budget, bounds);
   r.num_rays = static_cast<int32_t>(answers.size());
   for (const query::RayAnswer& a : answers) {
     r.hit.push_back(a.hit);
@@ -126,35 +170,53 @@ EncodedReplies rays(const octomap::OcTree& t, const octomap_rt::ray_query_t& q, 
     r.end_xyz.insert(r.end_xyz.end(), {a.end.x(), a.end.y(), a.end.z()});
   }
   r.num_xyz = static_cast<int32_t>(r.end_xyz.size());
-  return {h.reply_channel, {encode(r)}};
+  out.messages.push_back(encode(r));
+  return out;
 }
 
 EncodedReplies box_counts(const octomap::OcTree& t, const octomap_rt::box_query_t& q, const QueryHeader& h,
-                          const MapStamp& s, const std::string& id) {
+                          const MapStamp& s, const std::string& id, const QueryBounds& bounds,
+                          query::WorkBudget& budget) {
   octomap_rt::box_reply_t r;
+  EncodedReplies out = replies_on(h.reply_channel);
   stamp_reply(r, h, s, id, Reply::REPLY_OK, "");
   for (size_t i = 0; i + 5 < q.boxes.size(); i += 6) {
+    // A box the budget ran out in is not answered: its counts would be partial.
+    if (!budget.check_now()) break;
     const query::KeyBox b = query::key_box(t, &q.boxes[i], &q.boxes[i + 3]);
     if (q.mode == Box::MODE_ANY_OCCUPIED) {
+      const bool any = query::any_occupied(t, b, &budget);
+      if (budget.cut != query::Cut::kNone && !any) break;
       r.occupied.push_back(-1), r.free.push_back(-1), r.unknown.push_back(-1);
-      r.any_occupied.push_back(query::any_occupied(t, b));
+      r.any_occupied.push_back(any);
     } else {
-      const query::BoxCounts c = query::count_box(t, b);
+      const query::BoxCounts c = query::count_box(t, b, &budget);
+      if (budget.cut != query::Cut::kNone) break;
       r.occupied.push_back(c.occupied), r.free.push_back(c.free), r.unknown.push_back(c.unknown);
       r.any_occupied.push_back(c.any_occupied());
     }
   }
+  const size_t asked = q.boxes.size() / 6;
+  if (r.occupied.empty() && asked > 0 && budget.cut != query::Cut::kNone) {
+    if (budget.cut == query::Cut::kWork)
+      throw query::QueryError("box 0 alone passes the query's work bound: " + cut_reason(budget, bounds));
+    return refused_by_budget(QueryMessage(q), budget, bounds, s, id);
+  }
+  mark_cut(r, out, r.occupied.size(), asked, "box", budget, bounds);
   r.num_boxes = static_cast<int32_t>(r.occupied.size());
-  return {h.reply_channel, {encode(r)}};
+  out.messages.push_back(encode(r));
+  return out;
 }
 
 EncodedReplies region(const octomap::OcTree& t, const octomap_rt::box_query_t& q, const QueryHeader& h,
-                      const MapStamp& s, const std::string& id) {
+                      const MapStamp& s, const std::string& id, const QueryBounds& bounds, query::WorkBudget& budget) {
   query::RegionOptions opt;
   opt.depth = q.depth;
   opt.include_free = q.include_free != 0;
-  const auto voxels = query::extract_region(t, query::key_box(t, &q.boxes[0], &q.boxes[3]), opt);
-  EncodedReplies out{h.reply_channel, {}};
+  opt.max_voxels = std::max<size_t>(1, bounds.max_reply_bytes / kRegionVoxelBytes);
+  const auto voxels = query::extract_region(t, query::key_box(t, &q.boxes[0], &q.boxes[3]), opt, &budget);
+  if (budget.cut != query::Cut::kNone) return refused_by_budget(QueryMessage(q), budget, bounds, s, id);
+  EncodedReplies out = replies_on(h.reply_channel);
   const int chunks = std::max<int>(1, static_cast<int>((voxels.size() + kRegionChunk - 1) / kRegionChunk));
   for (int c = 0; c < chunks; ++c) {
     octomap_rt::region_chunk_t m;
@@ -175,15 +237,16 @@ EncodedReplies region(const octomap::OcTree& t, const octomap_rt::box_query_t& q
 }
 
 EncodedReplies grid(const octomap::OcTree& t, const octomap_rt::grid_query_t& q, const QueryHeader& h,
-                    const MapStamp& s, const std::string& id) {
+                    const MapStamp& s, const std::string& id, const QueryBounds& bounds, query::WorkBudget& budget) {
   query::GridRequest req;
   req.z_min = q.z_min, req.z_max = q.z_max;
   req.cell_voxels = q.cell_size > 0 ? static_cast<int>(std::lround(q.cell_size / t.getResolution())) : 1;
   req.window = q.use_window != 0;
   req.x_min = q.window_min[0], req.y_min = q.window_min[1], req.x_max = q.window_max[0], req.y_max = q.window_max[1];
-  req.max_cells = 4'000'000;
-  const query::Grid2D g = query::projected_grid(t, req);
-  EncodedReplies out{h.reply_channel, {}};
+  req.max_cells = std::min<int64_t>(kMaxGridCells, static_cast<int64_t>(bounds.max_reply_bytes));
+  const query::Grid2D g = query::projected_grid(t, req, &budget);
+  if (budget.cut != query::Cut::kNone) return refused_by_budget(QueryMessage(q), budget, bounds, s, id);
+  EncodedReplies out = replies_on(h.reply_channel);
   const int rows_per = std::max(1, kGridChunkCells / std::max(1, g.width));
   const int chunks = std::max(1, (g.height + rows_per - 1) / rows_per);
   for (int c = 0; c < chunks; ++c) {
@@ -221,19 +284,34 @@ std::string validate_query(const QueryMessage& q, double resolution) {
   return std::visit([&](const auto& m) { return validate(m, resolution); }, q);
 }
 
-EncodedReplies answer_query(const octomap::OcTree& t, const QueryMessage& q, const MapStamp& s, const std::string& id) {
+EncodedReplies answer_query(const octomap::OcTree& t, const QueryMessage& q, const MapStamp& s, const std::string& id,
+                            const QueryBounds& bounds, query::WorkBudget& budget) {
   const QueryHeader h = header_of(q);
+  // Points are bounded by the message (at most 64 KiB of them, one search each).
   if (auto* p = std::get_if<octomap_rt::occupancy_query_t>(&q)) return points(t, *p, h, s, id);
-  if (auto* p = std::get_if<octomap_rt::ray_query_t>(&q)) return rays(t, *p, h, s, id);
+  if (auto* p = std::get_if<octomap_rt::ray_query_t>(&q)) return rays(t, *p, h, s, id, bounds, budget);
   if (auto* p = std::get_if<octomap_rt::box_query_t>(&q))
-    return p->mode == Box::MODE_REGION ? region(t, *p, h, s, id) : box_counts(t, *p, h, s, id);
-  return grid(t, std::get<octomap_rt::grid_query_t>(q), h, s, id);
+    return p->mode == Box::MODE_REGION ? region(t, *p, h, s, id, bounds, budget)
+                                       : box_counts(t, *p, h, s, id, bounds, budget);
+  return grid(t, std::get<octomap_rt::grid_query_t>(q), h, s, id, bounds, budget);
+}
+
+std::string cut_reason(const query::WorkBudget& b, const QueryBounds& bounds) {
+  switch (b.cut) {
+    case query::Cut::kWork:
+      return "the work bound of " + std::to_string(bounds.max_work) + " node visits or ray steps (--query-max-work)";
+    case query::Cut::kTime:
+      return "the time bound under the map lock of " + std::to_string(bounds.lock_ms) + " ms (--query-lock-ms)";
+    case query::Cut::kStopping: return "the server is stopping";
+    case query::Cut::kNone: break;
+  }
+  return "not cut";
 }
 
 EncodedReplies error_reply(const QueryMessage& q, int8_t status, const std::string& error, const MapStamp& s,
                            const std::string& id) {
   const QueryHeader h = header_of(q);
-  EncodedReplies out{h.reply_channel, {}};
+  EncodedReplies out = replies_on(h.reply_channel);
   auto one = [&](auto m) {
     stamp_reply(m, h, s, id, status, error);
     out.messages.push_back(encode(m));

@@ -10,6 +10,8 @@
 #include <octomap/OcTree.h>
 
 #include "daemon/queries/query_clients.h"
+#include "daemon/queries/query_config.h"
+#include "query/work_budget.h"
 
 namespace ort::daemon {
 
@@ -31,11 +33,21 @@ struct MapStamp {
 struct EncodedReplies {
   std::string channel;
   std::vector<std::vector<uint8_t>> messages;  // in order; several for regions and grids
+  // What the replies say, for the counters: REPLY_OK (cut: answered in part, `error` says
+  // where and why), or the refusal of a region or grid past its bound.
+  int8_t status = 0;
+  bool cut = false;
+  std::string error;
 };
 
-// Under the map lock. Throws query::QueryError (the caller replies BAD_REQUEST with it).
+// Under the map lock, within `budget` (its max_work and deadline; regions and grids also
+// within bounds.max_reply_bytes). Throws query::QueryError (the caller replies BAD_REQUEST
+// with it).
 EncodedReplies answer_query(const octomap::OcTree& tree, const QueryMessage& q, const MapStamp& stamp,
-                            const std::string& server_id);
+                            const std::string& server_id, const QueryBounds& bounds, query::WorkBudget& budget);
+// Why a budget cut a query, with the bound's flag ("the work bound of 4000000 node visits or
+// ray steps (--query-max-work)").
+std::string cut_reason(const query::WorkBudget& budget, const QueryBounds& bounds);
 // A reply of q's type with `status` (occupancy_reply_t.REPLY_*) and `error`, no results.
 EncodedReplies error_reply(const QueryMessage& q, int8_t status, const std::string& error, const MapStamp& stamp,
                            const std::string& server_id);

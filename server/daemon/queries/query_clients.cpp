@@ -1,5 +1,6 @@
 #include "daemon/queries/query_clients.h"
 
+#include <algorithm>
 #include <cctype>
 
 namespace ort::daemon {
@@ -21,14 +22,42 @@ std::string reason_key(QueryClients::Count what, const std::string& error) {
 
 }  // namespace
 
-QueryClients::QueryClients(size_t per_client_queue, size_t max_clients)
-    : per_client_queue_(per_client_queue), max_clients_(max_clients) {}
+QueryClients::QueryClients(size_t per_client_queue, size_t max_clients, int64_t idle_expiry_us)
+    : per_client_queue_(per_client_queue), max_clients_(max_clients), idle_expiry_us_(idle_expiry_us) {}
+
+namespace {
+// Entries that are no client of their own: no usable address, past the limit, expired.
+bool special(const std::string& id) { return id == "?" || id == "*" || id == "~"; }
+}  // namespace
+
+size_t QueryClients::named_clients() const {
+  size_t n = clients_.size();
+  for (const char* s : {"?", "*", "~"}) n -= clients_.count(s);
+  return n;
+}
+
+void QueryClients::expire_idle(int64_t now_us) {
+  auto oldest = clients_.end();
+  for (auto it = clients_.begin(); it != clients_.end(); ++it)
+    if (!special(it->first) && it->second.queue.empty() && now_us - it->second.stats.last_utime >= idle_expiry_us_ &&
+        (oldest == clients_.end() || it->second.stats.last_utime < oldest->second.stats.last_utime))
+      oldest = it;
+  if (oldest == clients_.end()) return;
+  QueryClientStats& f = clients_["~"].stats;
+  const QueryClientStats& o = oldest->second.stats;
+  f.client_id = "~";
+  f.received += o.received, f.answered += o.answered, f.cut += o.cut, f.bad += o.bad, f.busy += o.busy;
+  f.not_ready += o.not_ready, f.dropped += o.dropped, f.edits_applied += o.edits_applied;
+  f.edits_refused += o.edits_refused;
+  f.last_utime = std::max(f.last_utime, o.last_utime);
+  clients_.erase(oldest);
+}
 
 QueryClients::Client& QueryClients::at(const std::string& client) {
   auto it = clients_.find(client);
   if (it != clients_.end()) return it->second;
   // Past max_clients every new id shares one entry, "*", so the map stays bounded.
-  const std::string key = clients_.size() >= max_clients_ ? "*" : client;
+  const std::string key = named_clients() >= max_clients_ && !special(client) ? "*" : client;
   Client& c = clients_[key];
   c.stats.client_id = key;
   return c;
@@ -70,6 +99,7 @@ size_t QueryClients::queued() const {
 
 void QueryClients::received(const std::string& client, const std::string& reply_channel, int64_t utime) {
   std::lock_guard lock(mutex_);
+  if (!clients_.count(client) && named_clients() >= max_clients_) expire_idle(utime);
   QueryClientStats& s = at(client).stats;
   s.received++;
   s.reply_channel = reply_channel;
@@ -84,6 +114,7 @@ void QueryClients::count(const std::string& client, Count what, const std::strin
 void QueryClients::bump(QueryClientStats& s, Count what, const std::string& error) {
   switch (what) {
     case Count::kAnswered: s.answered++; break;
+    case Count::kAnsweredCut: s.answered++, s.cut++; break;
     case Count::kBad: s.bad++; break;
     case Count::kBusy: s.busy++; break;
     case Count::kNotReady: s.not_ready++; break;
@@ -119,6 +150,7 @@ void print_query_summary(std::ostream& out, const std::vector<QueryClientStats>&
   for (const QueryClientStats& c : clients) {
     out << "    " << c.client_id << ": received " << c.received << ", answered " << c.answered << ", bad " << c.bad
         << ", busy " << c.busy << ", not ready " << c.not_ready << ", dropped " << c.dropped;
+    if (c.cut) out << ", cut " << c.cut;
     if (c.edits_applied || c.edits_refused)
       out << ", edits applied " << c.edits_applied << " refused " << c.edits_refused;
     if (!c.last_error.empty()) out << " (last: " << c.last_error << ")";

@@ -34,6 +34,7 @@ struct PendingQuery {
 struct QueryClientStats {
   std::string client_id;  // "?": messages that named no usable client
   int64_t received = 0, answered = 0, bad = 0, busy = 0, not_ready = 0, dropped = 0;
+  int64_t cut = 0;  // answered in part: past a bound (also counted in answered)
   int64_t edits_applied = 0, edits_refused = 0;
   int64_t last_utime = 0;     // when its last message arrived [us since the epoch]
   int64_t queue_depth = 0;    // queued now (filled by snapshot())
@@ -52,7 +53,11 @@ struct QueryServiceStats {
 
 class QueryClients {
  public:
-  QueryClients(size_t per_client_queue, size_t max_clients);
+  // With max_clients named clients tracked, a new one takes the slot of the one heard from
+  // least recently if that one has been idle (nothing queued) for idle_expiry_us: its
+  // counters are folded into client "~" so that the totals still add up. Otherwise new
+  // clients share "*".
+  QueryClients(size_t per_client_queue, size_t max_clients, int64_t idle_expiry_us = int64_t(600) * 1'000'000);
   // Queues q for its client; false (counted busy) when that client's queue is full.
   bool push(const std::string& client, PendingQuery&& q);
   // The next query, clients taken in turn; nullopt when none is queued.
@@ -61,7 +66,9 @@ class QueryClients {
 
   // A message with a usable address arrived from `client`, to be answered on `reply_channel`.
   void received(const std::string& client, const std::string& reply_channel, int64_t utime);
-  enum class Count { kAnswered, kBad, kBusy, kNotReady, kDropped, kEditApplied, kEditRefused };
+  // kAnsweredCut: answered in part (past a bound); counts as answered and as cut, its
+  // error is a reason.
+  enum class Count { kAnswered, kAnsweredCut, kBad, kBusy, kNotReady, kDropped, kEditApplied, kEditRefused };
   // `error` says why (refusals); it becomes the client's last_error and a refusal reason.
   void count(const std::string& client, Count what, const std::string& error = "");
   std::vector<QueryClientStats> snapshot() const;
@@ -74,10 +81,13 @@ class QueryClients {
     std::deque<PendingQuery> queue;
   };
   Client& at(const std::string& client);                                 // under mutex_
+  size_t named_clients() const;                                          // under mutex_
+  void expire_idle(int64_t now_us);                                      // under mutex_
   void bump(QueryClientStats& s, Count what, const std::string& error);  // under mutex_
 
   mutable std::mutex mutex_;
   size_t per_client_queue_, max_clients_;
+  int64_t idle_expiry_us_;
   std::map<std::string, Client> clients_;
   std::string next_;  // round-robin position: first client after this name
   size_t queued_ = 0;

@@ -17,16 +17,26 @@ struct GridPublishConfig {
   std::string channel = ort::protocol::kGridChannel;
 };
 
+// What one query may cost (docs/RELIABILITY.md, "Bounded cost"). Past max_work or lock_ms a
+// ray or box query is cut (its reply says where), a region or grid query refused.
+struct QueryBounds {
+  uint64_t max_work = 4'000'000;       // nodes visited or ray key steps (--query-max-work)
+  double lock_ms = 10;                 // time under the map's read lock (--query-lock-ms)
+  size_t max_reply_bytes = 16u << 20;  // a region's or grid's replies (--query-max-reply-bytes)
+};
+
 struct QueryServiceConfig {
   std::string points_channel = ort::protocol::kQueryChannel;
   std::string rays_channel = ort::protocol::kQueryRaysChannel;
   std::string boxes_channel = ort::protocol::kQueryBoxesChannel;
   std::string grid_channel = ort::protocol::kQueryGridChannel;
   std::string edit_channel = ort::protocol::kMapEditChannel;
-  std::string control_token;     // "": every edit is refused
-  size_t per_client_queue = 16;  // queued queries per client; more get BUSY
-  size_t max_clients = 256;      // distinct client ids tracked; the rest share "*"
-  int max_wait_ms = 30000;       // longest wait_timeout_ms honoured
+  std::string control_token;          // "": every edit is refused
+  size_t per_client_queue = 16;       // queued queries per client; more get BUSY
+  size_t max_clients = 256;           // distinct client ids tracked; the rest share "*"
+  double client_idle_expiry_s = 600;  // a client idle this long gives its slot to a new one
+  int max_wait_ms = 30000;            // longest wait_timeout_ms honoured
+  QueryBounds bounds;
   GridPublishConfig grid;
 };
 

@@ -44,8 +44,8 @@ QueryService::QueryService(const QueryServiceConfig& cfg, MapState& map, ScanQue
       loop_(loop),
       server_id_(std::move(server_id)),
       resolution_(resolution),
-      clients_(cfg.per_client_queue, cfg.max_clients),
-      grids_(cfg.grid, map, loop, server_id_) {}
+      clients_(cfg.per_client_queue, cfg.max_clients, static_cast<int64_t>(cfg.client_idle_expiry_s * 1e6)),
+      grids_(cfg.grid, cfg.bounds, map, loop, server_id_) {}
 
 QueryService::~QueryService() { stop(); }
 
@@ -80,7 +80,10 @@ void QueryService::start() {
   grids_.start();
 }
 
+void QueryService::cut_running() { cut_now_ = true; }
+
 void QueryService::stop() {
+  cut_now_ = true;
   {
     std::lock_guard lock(wake_mutex_);
     stopping_ = true;
@@ -209,14 +212,26 @@ bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& o
     out.push_back(error_reply(q.msg, Reply::REPLY_NOT_READY, why, stamp, server_id_));
     return true;
   }
+  // Its own bounds, checked inside the walk: work, time under the lock, the server stopping.
+  query::WorkBudget budget;
+  budget.max_work = cfg_.bounds.max_work;
+  budget.deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                       std::chrono::duration<double, std::milli>(cfg_.bounds.lock_ms));
+  budget.stop = &cut_now_;
   try {
-    out.push_back(answer_query(*map_.tree, q.msg, stamp, server_id_));
+    out.push_back(answer_query(*map_.tree, q.msg, stamp, server_id_, cfg_.bounds, budget));
   } catch (const std::exception& e) {  // query::QueryError: a query the map cannot answer
     clients_.count(h.client_id, Count::kBad, e.what());
     out.push_back(error_reply(q.msg, Reply::REPLY_BAD_REQUEST, e.what(), stamp, server_id_));
     return true;
   }
-  clients_.count(h.client_id, Count::kAnswered);
+  const EncodedReplies& r = out.back();
+  if (r.status == Reply::REPLY_BUSY)
+    clients_.count(h.client_id, Count::kBusy, r.error);
+  else if (r.status != Reply::REPLY_OK)
+    clients_.count(h.client_id, Count::kBad, r.error);
+  else
+    clients_.count(h.client_id, r.cut ? Count::kAnsweredCut : Count::kAnswered, r.error);
   return true;
 }
 

@@ -10,7 +10,8 @@
 // Worker thread: clients in turn; a query waits (parked, up to its timeout) until the map
 // state is >= min_snapshot_id and the robot's wait_seq was applied (read-your-writes), then
 // is answered under a shared map lock, with every other query ready then (a turn of at most
-// 10 ms: stage 2 may be waiting), and its replies are published after the lock, each naming
+// 10 ms: stage 2 may be waiting; each query within its own bounds, QueryBounds, checked
+// inside its walk), and its replies are published after the lock, each naming
 // the map state (snapshot_id = MapState::version).
 // With --grid-rate, its GridPublisher also publishes the 2D grid on OCTOMAP_RT_GRID.
 #pragma once
@@ -43,6 +44,9 @@ class QueryService {
   void open();
   void start();
   void stop();
+  // The server is stopping: the query under the lock now, and every later one, is cut at
+  // once (CUT_STOPPING), so that no query holds the map past the drain bound.
+  void cut_running();
   std::vector<QueryClientStats> stats() const { return clients_.snapshot(); }
   QueryServiceStats service_stats() const;
 
@@ -71,6 +75,7 @@ class QueryService {
   std::mutex wake_mutex_;
   std::condition_variable wake_;
   bool stopping_ = false;
+  std::atomic<bool> cut_now_{false};
 };
 
 }  // namespace ort::daemon

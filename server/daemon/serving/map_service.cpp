@@ -1,7 +1,9 @@
 #include "daemon/serving/map_service.h"
 
+#include <algorithm>
 #include <chrono>
 #include <exception>
+#include <shared_mutex>
 
 #include "octomap_rt/map_chunk_t.hpp"
 #include "octomap_rt/map_info_t.hpp"
@@ -13,6 +15,14 @@
 
 namespace ort::daemon {
 namespace {
+
+using protocol::chunks_to_send;
+using protocol::next_fresh_due;
+using protocol::next_servable;
+using protocol::queued_of;
+using protocol::QueuedMapRequest;
+using protocol::RequestRefusal;
+using protocol::SnapshotClock;
 
 using Chunk = octomap_rt::map_chunk_t;
 using Clock = std::chrono::steady_clock;
@@ -78,29 +88,62 @@ void MapService::on_request(const lcm::ReceiveBuffer& rbuf) {
     refuse(nullptr, protocol::RequestRefusal::kUndecodable, "");
     return;
   }
+  RequestRefusal busy = RequestRefusal::kNone;
+  size_t waiting = 0;
   {
     std::lock_guard lock(mutex_);
-    if (queue_.size() < cfg_.request_queue) {
-      queue_.push_back(std::move(req));
+    waiting = queue_.size();
+    if (queue_.size() >= cfg_.request_queue)
+      busy = RequestRefusal::kBusy;
+    else if (queued_of(queue_, req.client_id) >= cfg_.requests_per_client)
+      busy = RequestRefusal::kClientBusy;
+    if (busy == RequestRefusal::kNone) {
+      queue_.push_back({std::move(req), Clock::now()});
       cv_.notify_all();
       return;
     }
   }
-  refuse(&req, protocol::RequestRefusal::kBusy, "");
+  // The client's cue (client/map_client retries after it, with jitter): about the time the
+  // requests ahead of it take, at least 100 ms.
+  const int64_t retry_ms = std::max<int64_t>(100, static_cast<int64_t>(waiting) * 50);
+  refuse(&req, busy, "retry after " + std::to_string(retry_ms) + " ms");
+}
+
+protocol::SnapshotClock MapService::snapshot_clock() {
+  protocol::SnapshotClock c;
+  c.now = Clock::now();
+  c.newest_taken = store_.taken_at();
+  c.fresh_interval = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(std::max(cfg_.fresh_interval_s, cfg_.snapshots.min_interval_s)));
+  if (store_.latest_id() >= 0) {
+    std::shared_lock lock(map_.mutex);
+    c.newest_is_current = static_cast<int64_t>(map_.version) == store_.latest_id();
+  }
+  return c;
 }
 
 void MapService::run() {
   auto next_info = Clock::now();
   std::unique_lock lock(mutex_);
   while (!stop_) {
-    cv_.wait_until(lock, next_info, [&] { return stop_ || !queue_.empty(); });
+    // The store is only touched on this thread: its clock may be read without the lock.
+    lock.unlock();
+    const SnapshotClock clock = snapshot_clock();
+    lock.lock();
+    const size_t pick = next_servable(queue_, clock);
+    if (pick == SIZE_MAX) {
+      const auto wake = std::min(next_info, next_fresh_due(queue_, clock));
+      const size_t seen = queue_.size();
+      cv_.wait_until(lock, wake, [&] { return stop_ || queue_.size() != seen; });
+    }
     if (stop_) break;
-    if (!queue_.empty()) {
-      const octomap_rt::map_request_t req = std::move(queue_.front());
-      queue_.pop_front();
+    if (pick != SIZE_MAX) {
+      const QueuedMapRequest queued = std::move(queue_[pick]);
+      const octomap_rt::map_request_t& req = queued.req;
+      queue_.erase(queue_.begin() + static_cast<std::ptrdiff_t>(pick));
       lock.unlock();
       try {
-        serve(req);
+        serve(queued);
       } catch (const std::exception& e) {
         log_.error(text("map request ", req.request_id, " failed: ", e.what()));
       }
@@ -116,14 +159,21 @@ void MapService::run() {
   }
 }
 
-void MapService::serve(const octomap_rt::map_request_t& req) {
+void MapService::serve(const protocol::QueuedMapRequest& queued) {
+  const octomap_rt::map_request_t& req = queued.req;
   protocol::RequestRefusal why = protocol::check_map_request(req);
   if (why != protocol::RequestRefusal::kNone) return refuse(&req, why, "");
   bool took_new = false;
   // snapshot_id: < 0 a fresh snapshot, 0 the latest kept (maybe older than the map), > 0 that one.
-  std::shared_ptr<const SnapshotBlob> blob = req.snapshot_id <= 0
-                                                 ? store_.latest(map_, req.format, req.snapshot_id < 0, took_new)
-                                                 : store_.find(static_cast<uint64_t>(req.snapshot_id), req.format);
+  // A fresh request comes out of the queue only once the newest snapshot is fresh enough for
+  // it (taken after it arrived: that one, no new copy) or a new one may be taken.
+  std::shared_ptr<const SnapshotBlob> blob;
+  if (req.snapshot_id < 0 && store_.latest_id() >= 0 && store_.taken_at() >= queued.arrived)
+    blob = store_.newest(req.format);
+  else if (req.snapshot_id <= 0)
+    blob = store_.latest(map_, req.format, false, took_new);
+  else
+    blob = store_.find(static_cast<uint64_t>(req.snapshot_id), req.format);
   if (!blob)
     return refuse(&req, protocol::RequestRefusal::kUnknownSnapshot,
                   "snapshot " + std::to_string(req.snapshot_id) + " is not kept; the latest is " +
@@ -171,9 +221,7 @@ void MapService::refuse(const octomap_rt::map_request_t* req, protocol::RequestR
 void MapService::send_chunks(const octomap_rt::map_request_t& req, const SnapshotBlob& blob) {
   const size_t chunk = protocol::kChunkDataBytes;
   const int32_t n = blob.num_chunks(chunk);
-  std::vector<int32_t> indices = req.chunk_indices;
-  if (indices.empty())
-    for (int32_t i = 0; i < n; ++i) indices.push_back(i);
+  const std::vector<int32_t> indices = chunks_to_send(req.chunk_indices, n);
   const auto interval =
       std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::milli>(cfg_.chunk_interval_ms));
   auto next = Clock::now();
@@ -210,7 +258,7 @@ void MapService::publish_info() {
   m.protocol_version = protocol::kProtocolVersion;
   m.utime = utime_now();
   {
-    std::lock_guard lock(map_.mutex);
+    std::shared_lock lock(map_.mutex);
     m.map_version = static_cast<int64_t>(map_.version);
   }
   m.delta_seq = last_delta_seq_ ? last_delta_seq_() : -1;
@@ -243,6 +291,7 @@ void MapService::publish_info() {
     }
   }
   m.num_producers = static_cast<int32_t>(m.producer_id.size());
+  if (const auto b = store_.last_made()) m.num_producers_total = static_cast<int32_t>(b->contents.producers_total);
   loop_.publish(cfg_.info_channel, m);
 }
 

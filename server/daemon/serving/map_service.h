@@ -3,9 +3,11 @@
 // default socket receive buffer keeps up, and announces the map on OCTOMAP_RT_MAP_INFO at
 // 1 Hz and after each new snapshot (docs/PROTOCOL.md).
 //
-// Threads: its handler on the LCM loop only checks and queues a request (bounded; a flood
-// is counted as busy); the service's own thread takes snapshots (copy under the map lock,
-// serialize and compress outside it), sends the paced chunks and the info messages.
+// Threads: its handler on the LCM loop only checks and queues a request (bounded in all and
+// per client; a flood is counted as busy, the reply saying when to retry); the service's own
+// thread takes snapshots (copy under the map lock, serialize and compress outside it), sends
+// the paced chunks (each requested chunk once) and the info messages. Fresh requests share
+// one snapshot per fresh_interval_s and wait for it without holding up the others.
 #pragma once
 
 #include <array>
@@ -34,7 +36,11 @@ struct MapServiceConfig {
   SnapshotPolicy snapshots;
   double chunk_interval_ms = 1.5;  // between two chunks sent (pacing)
   double info_period_s = 1.0;
-  size_t request_queue = 32;  // requests waiting; more are refused as busy
+  size_t request_queue = 256;      // requests waiting, all clients; more are refused as busy
+  size_t requests_per_client = 2;  // requests of one client waiting; more are refused as busy
+  // Fresh snapshots (snapshot_id < 0) for a flood of requests: at most one per this interval
+  // (each copies the map under its lock); every fresh request waiting then gets that one.
+  double fresh_interval_s = 2.0;
   std::string server_id, map_frame = "map";
   double resolution = 0;
   double region_min[3] = {0, 0, 0}, region_max[3] = {0, 0, 0};  // set by the server
@@ -64,7 +70,8 @@ class MapService {
  private:
   void on_request(const lcm::ReceiveBuffer& rbuf);
   void run();
-  void serve(const octomap_rt::map_request_t& req);
+  void serve(const protocol::QueuedMapRequest& queued);
+  protocol::SnapshotClock snapshot_clock();
   void refuse(const octomap_rt::map_request_t* req, protocol::RequestRefusal why, const std::string& detail);
   void send_chunks(const octomap_rt::map_request_t& req, const SnapshotBlob& blob);
   void publish_info();
@@ -80,7 +87,7 @@ class MapService {
 
   mutable std::mutex mutex_;  // queue_, stop_, stats_
   std::condition_variable cv_;
-  std::deque<octomap_rt::map_request_t> queue_;
+  std::deque<protocol::QueuedMapRequest> queue_;
   bool stop_ = false;
   MapServiceStats stats_;
   std::thread thread_;

@@ -1,5 +1,7 @@
 #include "daemon/serving/snapshot_blob.h"
 
+#include <algorithm>
+
 #include <chrono>
 #include <map>
 #include <sstream>
@@ -35,12 +37,17 @@ std::string serialize(const octomap::OcTree& tree, int8_t format) {
 SnapshotContents describe_snapshot(const octomap::OcTree& tree, const std::vector<AppliedEntry>& order) {
   SnapshotContents c;
   c.scans = order.size();
-  std::map<std::string, int64_t> last;
-  for (const AppliedEntry& e : order) {
-    last[e.robot_id] = e.seq;
-    c.map_utime = std::max(c.map_utime, e.utime);
+  std::map<std::string, std::pair<size_t, int64_t>> last;  // robot id -> (index of its newest scan, seq)
+  for (size_t i = 0; i < order.size(); ++i) {
+    last[order[i].robot_id] = {i, order[i].seq};
+    c.map_utime = std::max(c.map_utime, order[i].utime);
   }
-  c.producer_last_seq.assign(last.begin(), last.end());
+  std::vector<std::pair<size_t, std::pair<std::string, int64_t>>> recent;
+  for (const auto& [id, at] : last) recent.push_back({at.first, {id, at.second}});
+  std::sort(recent.begin(), recent.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  if (recent.size() > SnapshotContents::kMaxListedProducers) recent.resize(SnapshotContents::kMaxListedProducers);
+  for (auto& r : recent) c.producer_last_seq.push_back(std::move(r.second));
+  c.producers_total = static_cast<int64_t>(last.size());
   if (tree.size() > 0) {
     tree.getMetricMin(c.bbox_min[0], c.bbox_min[1], c.bbox_min[2]);
     tree.getMetricMax(c.bbox_max[0], c.bbox_max[1], c.bbox_max[2]);

@@ -20,8 +20,13 @@ struct SnapshotContents {
   size_t scans = 0;
   int64_t map_utime = 0;
   double bbox_min[3] = {0, 0, 0}, bbox_max[3] = {0, 0, 0};
-  std::vector<std::pair<std::string, int64_t>> producer_last_seq;  // robot id, newest seq in it
-  double copy_lock_ms = 0;                                         // how long taking the copy held the map lock
+  // Robot id and newest seq in it, of the kMaxListedProducers producers with the most recent
+  // scans in it (most recent first): map_info_t must fit one datagram however many robots
+  // the map has seen. producers_total: how many there are.
+  std::vector<std::pair<std::string, int64_t>> producer_last_seq;
+  int64_t producers_total = 0;
+  static constexpr size_t kMaxListedProducers = 64;
+  double copy_lock_ms = 0;  // how long taking the copy held the map lock
 };
 
 struct SnapshotBlob {

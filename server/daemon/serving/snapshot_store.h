@@ -31,6 +31,10 @@ class SnapshotStore {
   // With `fresh`, waits out min_interval instead, so the snapshot is at least as new as the
   // map was at the call.
   std::shared_ptr<const SnapshotBlob> latest(MapState& map, int8_t format, bool fresh, bool& took_new);
+  // The newest kept snapshot in `format`, never a new copy; nullptr before the first.
+  std::shared_ptr<const SnapshotBlob> newest(int8_t format) {
+    return kept_.empty() ? nullptr : blob_of(kept_.back(), format);
+  }
   // A kept snapshot by id, in `format` (made from the newest's copy if that is the one);
   // nullptr when no longer kept.
   std::shared_ptr<const SnapshotBlob> find(uint64_t id, int8_t format);
@@ -38,6 +42,8 @@ class SnapshotStore {
   std::shared_ptr<const SnapshotBlob> last_made() const { return last_made_; }
 
   int64_t latest_id() const { return latest_id_; }
+  // When the newest snapshot was copied from the map ({} before the first).
+  std::chrono::steady_clock::time_point taken_at() const { return taken_at_; }
   int64_t taken() const { return taken_; }
 
  private:

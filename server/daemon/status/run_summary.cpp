@@ -11,10 +11,10 @@ void print_producers(std::ostream& out, const StatusInputs& s) {
   for (const ProducerStats& p : s.producers) {
     std::snprintf(line, sizeof line,
                   "    %-16s received %lld = applied %lld + rejected %lld + dropped %lld%s; missed (seq gaps) %lld; "
-                  "points %lld\n",
+                  "seq restarts %lld; points %lld\n",
                   p.robot_id.c_str(), (long long)p.received, (long long)p.applied, (long long)p.rejected,
                   (long long)p.dropped, p.in_flight ? (" + in flight " + std::to_string(p.in_flight)).c_str() : "",
-                  (long long)p.missed, (long long)p.points_applied);
+                  (long long)p.missed, (long long)p.seq_restarts, (long long)p.points_applied);
     out << line;
     std::string reasons;
     for (size_t k = 0; k < kRejectReasonCount; ++k)

@@ -12,6 +12,7 @@ octomap_rt::query_client_stats_t client_message(const QueryClientStats& c) {
   octomap_rt::query_client_stats_t m;
   m.received = c.received;
   m.answered = c.answered;
+  m.cut = c.cut;
   m.bad = c.bad;
   m.busy = c.busy;
   m.not_ready = c.not_ready;
@@ -65,11 +66,12 @@ octomap_rt::robot_stats_t robot_message(const ProducerStats& p, int64_t queue_by
 }
 
 void add_queries(octomap_rt::server_status_t& s, const QueryServiceStats& q) {
-  s.queries_received = s.queries_answered = s.queries_bad = s.queries_busy = s.queries_not_ready = 0;
+  s.queries_received = s.queries_answered = s.queries_cut = s.queries_bad = s.queries_busy = s.queries_not_ready = 0;
   s.queries_dropped = s.edits_applied = s.edits_refused = 0;
   for (const QueryClientStats& c : q.clients) {
     s.queries_received += c.received;
     s.queries_answered += c.answered;
+    s.queries_cut += c.cut;
     s.queries_bad += c.bad;
     s.queries_busy += c.busy;
     s.queries_not_ready += c.not_ready;

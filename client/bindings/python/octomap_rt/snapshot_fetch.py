@@ -4,6 +4,7 @@ still missing after a silence, size and FNV-1a hash checked, zstd undone."""
 
 import os
 import random
+import re
 import time
 from dataclasses import dataclass
 
@@ -82,7 +83,8 @@ class _Assembly:
 
 
 def fetch_snapshot(transport, fmt: str = "bt", timeout_s: float = 30.0, snapshot_id: int = -1,
-                   client_id: str = "", rerequest_after_s: float = 0.25) -> Snapshot:
+                   client_id: str = "", rerequest_after_s: float = 0.25,
+                   first_answer_after_s: float = 3.0) -> Snapshot:
     """A snapshot: fresh (snapshot_id -1), the latest kept (0) or a kept one by id."""
     if fmt not in FORMATS:
         raise ValueError(f"format must be one of {sorted(FORMATS)}, got {fmt!r}")
@@ -114,14 +116,33 @@ def fetch_snapshot(transport, fmt: str = "bt", timeout_s: float = 30.0, snapshot
     start = time.monotonic()
     try:
         request(snapshot_id, [])
+        retry_at = None  # refused as busy: ask again then
         while time.monotonic() - start < timeout_s:
             transport.handle(0.05)
+            if assembly.error.startswith("busy"):
+                # Many clients at once: wait what the server names, stretched by a random
+                # quarter to half so that clients refused together do not return together.
+                match = re.search(r"retry after (\d+) ms", assembly.error)
+                wait_s = min(5.0, int(match.group(1)) / 1000.0) if match else 0.2
+                retry_at = time.monotonic() + wait_s * random.uniform(1.25, 1.5)
+                assembly.error = ""
             if assembly.error:
                 raise FetchError(f"the server refused the snapshot request: {assembly.error}")
             missing = assembly.missing()
             if missing == []:
                 break
-            if time.monotonic() - assembly.last_arrival > rerequest_after_s:
+            if retry_at is not None:
+                if time.monotonic() >= retry_at:
+                    retry_at = None
+                    if missing is None:
+                        request(snapshot_id, [])
+                    else:
+                        request(assembly.first.snapshot_id, missing[:8192])
+                continue
+            # Before the first chunk the server may be copying a big map or waiting for its
+            # next fresh snapshot: ask again only after a longer silence.
+            patience = rerequest_after_s if missing is not None else first_answer_after_s
+            if time.monotonic() - assembly.last_arrival > patience:
                 if missing is None:
                     request(snapshot_id, [])  # the request (or every answer) was lost
                 else:

@@ -1,0 +1,135 @@
+// What one robot's scans may cost the map over time (issue 21), in the whole server over
+// memq://: a scan far from where its robot has been is refused before it adds millions of
+// nodes; repeated far-reaching scans stop at the robot's new-node allowance; a scan over the
+// voxel bound is refused whole; each refusal is counted with its reason for that producer;
+// a scan stamped years ahead does not pin the map's utime.
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "core/clock.h"
+#include "protocol/channels.h"
+#include "server/query_test_support.h"
+#include "server/scan_fixtures.h"
+
+namespace ort::test {
+namespace {
+
+using daemon::Reject;
+
+int64_t rejected(const daemon::MappingServer& s, Reject r) {
+  int64_t n = 0;
+  for (const auto& p : s.producer_stats()) n += p.rejects[static_cast<size_t>(r)];
+  return n;
+}
+
+int64_t applied(const daemon::MappingServer& s) {
+  int64_t n = 0;
+  for (const auto& p : s.producer_stats()) n += p.applied;
+  return n;
+}
+
+// `n` points `distance` metres from a sensor at `at`, in random directions (seeded by seq).
+octomap_rt::scan_t reaching_scan(int64_t seq, const octomap::point3d& at, double distance, int n) {
+  std::mt19937 rng(static_cast<unsigned>(seq) + 11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  PosedScan s;
+  s.pose = octomap::pose6d(at.x(), at.y(), at.z(), 0.0, 0.0, 0.0);
+  for (int i = 0; i < n; ++i) {
+    const double d[3] = {g(rng), g(rng), g(rng)};
+    const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    s.points.push_back(float(d[0] / len * distance), float(d[1] / len * distance), float(d[2] / len * distance));
+  }
+  return scan_message(s, "alpha", seq);
+}
+
+int64_t nodes(daemon::MappingServer& s) {
+  return s.with_map([](const octomap::OcTree& t) { return static_cast<int64_t>(t.size()); });
+}
+
+TEST(ScanCosts, AScanFarFromWhereItsRobotHasBeenIsRefused) {
+  lcm::LCM lc("memq://");
+  std::ostringstream log;
+  daemon::MappingServer server(test_config(0.1, true), lc, log);
+  server.start();
+  const auto near = reaching_scan(0, {1, 2, 0.5f}, 5, 100);
+  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &near);
+  ASSERT_TRUE(wait_until_done(server, 1));
+  const int64_t before = nodes(server);
+  // 3 km away a moment later, its points 300 m around: ~300 K new voxels from 100 points.
+  const auto far = reaching_scan(1, {3000, 2, 0.5f}, 300, 100);
+  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &far);
+  ASSERT_TRUE(wait_until_done(server, 2));
+  EXPECT_EQ(rejected(server, Reject::kOriginJump), 1) << log.str();
+  EXPECT_EQ(nodes(server), before);
+  // Back where it was: applied.
+  const auto back = reaching_scan(2, {1.5f, 2, 0.5f}, 5, 100);
+  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &back);
+  ASSERT_TRUE(wait_until_done(server, 3));
+  EXPECT_EQ(applied(server), 2);
+  server.stop();
+  expect_counts_balance(server.producer_stats());
+  EXPECT_NE(log.str().find("origin jump"), std::string::npos) << log.str();
+}
+
+TEST(ScanCosts, RepeatedFarReachingScansStopAtTheRobotsNewNodeAllowance) {
+  lcm::LCM lc("memq://");
+  auto cfg = test_config(0.1, true);
+  cfg.scan_costs.max_new_nodes_per_s = 1000;  // refills nothing to speak of during the test
+  cfg.scan_costs.new_node_burst = 100'000;
+  daemon::MappingServer server(cfg, lc, std::cerr);
+  server.start();
+  // From one place, 100 points 300 m around: each scan adds ~300 K nodes (at 1 km, ~1 M:
+  // repeated, the review's OOM).
+  for (int64_t k = 0; k < 4; ++k) {
+    const auto s = reaching_scan(k, {1, 2, 0.5f}, 300, 100);
+    lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);
+  }
+  ASSERT_TRUE(wait_until_done(server, 4, std::chrono::seconds(120)));
+  // The first spends the allowance (and more: a scan is applied whole or not at all); the
+  // rest are refused.
+  EXPECT_EQ(applied(server), 1);
+  EXPECT_EQ(rejected(server, Reject::kNewNodeRate), 3);
+  server.stop();
+  expect_counts_balance(server.producer_stats());
+}
+
+TEST(ScanCosts, AScanOverTheVoxelBoundIsRefusedWhole) {
+  lcm::LCM lc("memq://");
+  auto cfg = test_config(0.1, true);
+  cfg.scan_costs.max_scan_voxels = 2000;
+  daemon::MappingServer server(cfg, lc, std::cerr);
+  server.start();
+  const auto big = reaching_scan(0, {1, 2, 0.5f}, 30, 200);  // ~300 voxels a ray
+  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &big);
+  const auto small = reaching_scan(1, {1, 2, 0.5f}, 2, 20);
+  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &small);
+  ASSERT_TRUE(wait_until_done(server, 2));
+  EXPECT_EQ(rejected(server, Reject::kTooManyVoxels), 1);
+  EXPECT_EQ(applied(server), 1);
+  server.stop();
+}
+
+TEST(ScanCosts, AScanFromTheFarFutureDoesNotPinTheMapsUtime) {
+  lcm::LCM lc("memq://");
+  daemon::MappingServer server(test_config(0.1, true), lc, std::cerr);
+  Replies replies(server);
+  server.start();
+  auto future = wall_scan(0);
+  future.utime = now_utime() + int64_t(10) * 365 * 24 * 3600 * 1'000'000;  // ten years ahead
+  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &future);
+  ASSERT_TRUE(wait_until_done(server, 1));
+  auto q = point_query(1, {3.05f, 0.f, 0.05f});
+  lc.publish(protocol::kQueryChannel, &q);
+  const auto r = replies.wait_for<Reply>(1);
+  server.stop();
+  ASSERT_EQ(r.status, Reply::REPLY_OK) << r.error;
+  EXPECT_LE(r.map_utime, now_utime() + int64_t(61) * 1'000'000);
+  EXPECT_GT(r.map_utime, now_utime() - int64_t(60) * 1'000'000);
+}
+
+}  // namespace
+}  // namespace ort::test
