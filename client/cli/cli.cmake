@@ -14,4 +14,5 @@ target_link_libraries(octomap_rt_client PUBLIC octomap_rt_status octomap_rt_rend
                       octomap_rt_map_client)
 
 add_executable(octomap-rt ${CMAKE_CURRENT_LIST_DIR}/main.cpp)
+target_compile_definitions(octomap-rt PRIVATE OCTOMAP_RT_VERSION="${PROJECT_VERSION}")
 target_link_libraries(octomap-rt PRIVATE octomap_rt_client octomap_rt_allocator octomap_rt_huge_pages)

@@ -4,10 +4,13 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/commands.h"
+#include "protocol/version.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"octomap-rt: GPU-accelerated OctoMap building, and the client of octomap-rt-server"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("octomap-rt ") + OCTOMAP_RT_VERSION + " (protocol version " +
+                                        std::to_string(ort::protocol::kProtocolVersion) + ")");
   ort::cli::register_build_command(app);
   ort::cli::register_replay_command(app);
   ort::cli::register_bench_command(app);

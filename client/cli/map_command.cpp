@@ -9,6 +9,7 @@
 
 #include "cli/commands.h"
 #include "cli/map_commands.h"
+#include "cli/namespace_flag.h"
 #include "cli/progress_bar.h"
 #include "map_client/map_client.h"
 #include "protocol/lcm_url.h"
@@ -27,7 +28,8 @@ int8_t format_of(const std::string& path) {
 
 void run_get(const MapArgs& a, const std::string& out_path) {
   const int8_t format = format_of(out_path);
-  client::MapClient c(ort::protocol::lcm_url_or_default(a.lcm_url));
+  client::MapClient c(ort::protocol::lcm_url_or_default(a.lcm_url),
+                      client::ClientOptions{}.in_namespace(protocol::namespace_from(a.ns)));
   std::unique_ptr<ProgressBar> bar;
   auto progress = [&](int64_t got, int64_t total) {
     if (a.quiet || a.json) return;
@@ -52,7 +54,8 @@ void run_get(const MapArgs& a, const std::string& out_path) {
 }
 
 void run_info(const MapArgs& a) {
-  client::MapClient c(ort::protocol::lcm_url_or_default(a.lcm_url));
+  client::MapClient c(ort::protocol::lcm_url_or_default(a.lcm_url),
+                      client::ClientOptions{}.in_namespace(protocol::namespace_from(a.ns)));
   const auto m = c.wait_info(a.timeout_s);
   if (!m)
     throw std::runtime_error("no map_info_t within " + std::to_string(a.timeout_s) + " s (is the server running?)");
@@ -82,6 +85,7 @@ void run_info(const MapArgs& a) {
 void add_common(CLI::App* cmd, MapArgs& a) {
   cmd->add_option("--lcm-url", a.lcm_url,
                   std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + ort::protocol::kDefaultLcmUrl + ")");
+  add_namespace_flag(cmd, a.ns);
   cmd->add_option("--timeout", a.timeout_s, "seconds to wait for the server")->capture_default_str();
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   cmd->add_flag("-q,--quiet", a.quiet, "no progress output");

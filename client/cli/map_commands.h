@@ -7,6 +7,7 @@ namespace ort::cli {
 
 struct MapArgs {
   std::string lcm_url;
+  std::string ns;  // --namespace
   double timeout_s = 30;
   bool json = false, quiet = false;
   double seconds = 0;  // watch: 0 = until Ctrl-C

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "cli/commands.h"
+#include "cli/namespace_flag.h"
 #include "octomap_rt/map_edit_t.hpp"
 #include "protocol/lcm_url.h"
 #include "query_client/query_args.h"
@@ -16,7 +17,7 @@ namespace ort::cli {
 namespace {
 
 struct EditArgs {
-  std::string lcm_url, token, box, to = "free";
+  std::string lcm_url, token, box, to = "free", ns;
   double timeout_s = 10;
   bool json = false;
 };
@@ -25,7 +26,8 @@ void run_edit(const EditArgs& a, int8_t op) {
   client::Box b{};
   if (op != octomap_rt::map_edit_t::OP_RESET) b = client::parse_box(a.box);
   client::QueryClient c(ort::protocol::lcm_url_or_default(a.lcm_url), "cli-" + std::to_string(::getpid()),
-                        std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)));
+                        std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)),
+                        protocol::namespace_from(a.ns));
   const auto ack = c.edit(op, b, a.token);
   if (a.json) client::write_edit_json(std::cout, ack);
   if (ack.status != 0) {
@@ -38,6 +40,7 @@ void run_edit(const EditArgs& a, int8_t op) {
 void add_common(CLI::App* cmd, EditArgs& a) {
   cmd->add_option("--token", a.token, "the server's --control-token")->required();
   cmd->add_option("--lcm-url", a.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else the host-local udpm URL)");
+  add_namespace_flag(cmd, a.ns);
   cmd->add_option("--timeout", a.timeout_s, "seconds to wait for the acknowledgement")->capture_default_str();
   cmd->add_flag("--json", a.json, "one JSON document on stdout");
 }

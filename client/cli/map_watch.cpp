@@ -8,6 +8,7 @@
 
 #include "cli/map_commands.h"
 #include "map_client/map_mirror.h"
+#include "protocol/channels.h"
 #include "protocol/lcm_url.h"
 
 namespace ort::cli {
@@ -40,7 +41,11 @@ void run_map_watch(const MapArgs& a) {
   sigaddset(&sigs, SIGINT);
   sigaddset(&sigs, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &sigs, nullptr);
-  client::MapClient c(ort::protocol::lcm_url_or_default(a.lcm_url));
+  // `map watch | head`: when the reader goes away, a write fails (EPIPE) instead of killing the
+  // process, the watch ends and --save still writes the mirror.
+  ::signal(SIGPIPE, SIG_IGN);
+  client::MapClient c(ort::protocol::lcm_url_or_default(a.lcm_url),
+                      client::ClientOptions{}.in_namespace(protocol::namespace_from(a.ns)));
   client::MirrorOptions o;
   o.fetch_timeout_s = a.timeout_s;
   client::MapMirror m(c, o);
@@ -49,7 +54,8 @@ void run_map_watch(const MapArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   int64_t last_deltas = 0, last_bytes = 0;
-  while (!interrupted(sigs) && (a.seconds <= 0 || elapsed() < a.seconds)) {
+  bool reader_gone = false;
+  while (!reader_gone && !interrupted(sigs) && (a.seconds <= 0 || elapsed() < a.seconds)) {
     m.spin(1.0);
     const client::MirrorStats& s = m.stats();
     const ClassCounts k = count_classes(m.tree());
@@ -65,13 +71,14 @@ void run_map_watch(const MapArgs& a) {
           "snapshots %lld\n",
           elapsed(), (long long)m.version(), (long long)(s.deltas_applied - last_deltas),
           (s.delta_bytes - last_bytes) / 1000.0, k.occupied, k.free, (long long)s.gaps, (long long)s.snapshots);
-    std::fflush(stdout);
+    reader_gone = std::fflush(stdout) != 0 || std::ferror(stdout);
     last_deltas = s.deltas_applied;
     last_bytes = s.delta_bytes;
   }
   if (!a.save.empty()) {
     if (!m.tree().write(a.save)) throw std::runtime_error("cannot write '" + a.save + "'");
-    std::printf("mirror at version %lld saved to %s\n", (long long)m.version(), a.save.c_str());
+    std::fprintf(reader_gone ? stderr : stdout, "mirror at version %lld saved to %s\n", (long long)m.version(),
+                 a.save.c_str());
   }
 }
 

@@ -7,6 +7,7 @@
 
 #include "cli/commands.h"
 #include "cli/grid_picture.h"
+#include "cli/namespace_flag.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "protocol/lcm_url.h"
 #include "query_client/query_args.h"
@@ -19,7 +20,7 @@ namespace {
 using namespace ort::client;
 
 struct CommonArgs {
-  std::string lcm_url, client_id;
+  std::string lcm_url, client_id, ns;
   double timeout_s = 5;
   bool json = false;
   std::string wait_robot;
@@ -29,6 +30,7 @@ struct CommonArgs {
 
 void add_common(CLI::App* cmd, CommonArgs& a) {
   cmd->add_option("--lcm-url", a.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else the host-local udpm URL)");
+  add_namespace_flag(cmd, a.ns);
   cmd->add_option("--timeout", a.timeout_s, "seconds to wait for the answer")->capture_default_str();
   cmd->add_flag("--json", a.json, "one JSON document on stdout");
   cmd->add_option("--client-id", a.client_id, "client name (default cli-<pid>); replies come on OCTOMAP_RT_REPLY_<ID>");
@@ -40,7 +42,8 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
 std::unique_ptr<QueryClient> connect(const CommonArgs& a) {
   const std::string id = a.client_id.empty() ? "cli-" + std::to_string(::getpid()) : a.client_id;
   return std::make_unique<QueryClient>(ort::protocol::lcm_url_or_default(a.lcm_url), id,
-                                       std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)));
+                                       std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)),
+                                       protocol::namespace_from(a.ns));
 }
 
 WaitFor wait_for(const CommonArgs& a) {

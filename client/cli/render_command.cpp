@@ -64,12 +64,14 @@ void register_render_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "PNG file to write")->required();
   const std::map<std::string, render::View> views{{"top", render::View::top}, {"oblique", render::View::oblique}};
   cmd->add_option("--view", args->options.view, "top (straight down) or oblique (3D, from above at an angle)")
-      ->transform(CLI::CheckedTransformer(views));
+      ->transform(CLI::CheckedTransformer(views).description(""))
+      ->option_text("{top,oblique}");
   cmd->add_option("--z", args->z_range, "Height range MIN:MAX [m] to draw (and colour by); either side may be empty");
   const std::map<std::string, render::FreeSpace> free{{"faint", render::FreeSpace::faint},
                                                       {"hidden", render::FreeSpace::hidden}};
   cmd->add_option("--free", args->options.free, "Free space: faint (footprint on the floor) or hidden")
-      ->transform(CLI::CheckedTransformer(free));
+      ->transform(CLI::CheckedTransformer(free).description(""))
+      ->option_text("{faint,hidden}");
   cmd->add_option("--width", args->options.width, "Picture width [px]")->check(CLI::Range(200, 20000));
   cmd->add_option("--azimuth", args->options.azimuth_deg, "Oblique view: camera direction [deg from +x, ccw]");
   cmd->add_option("--elevation", args->options.elevation_deg, "Oblique view: camera elevation [deg]")

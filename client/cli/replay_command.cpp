@@ -14,6 +14,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "cli/commands.h"
+#include "cli/namespace_flag.h"
 #include "cli/progress_bar.h"
 #include "cli/replay/lcm_log_scans.h"
 #include "cli/replay/lcm_server_wait.h"
@@ -39,6 +40,7 @@ struct ReplayArgs {
   bool rate_given = false;  // logs: --rate replaces the recorded timing
   double speed = 1.0;       // logs: playback speed factor on the recorded timing
   std::string lcm_url;
+  std::string ns;  // --namespace
   std::string channel_prefix = ort::protocol::kScanChannelPrefix;
   std::string status_channel = ort::protocol::kStatusChannel;
   double max_range = -1.0;
@@ -241,6 +243,9 @@ void check_numbers(const ReplayArgs& a) {
 
 int run_replay(ReplayArgs a) {
   check_numbers(a);
+  const std::string ns = protocol::channels_in(protocol::namespace_from(a.ns)).ns;
+  a.channel_prefix = protocol::in_namespace(ns, a.channel_prefix);
+  a.status_channel = protocol::in_namespace(ns, a.status_channel);
   if (!a.part.empty()) {
     if (std::string why = parse_part(a.part, a.sel); !why.empty()) throw CLI::ValidationError("--part", why);
   }
@@ -288,7 +293,9 @@ void register_replay_command(CLI::App& app) {
   cmd->add_option("--speed", args->speed, "logs: speed factor on the recorded timing")->capture_default_str();
   cmd->add_option("--lcm-url", args->lcm_url,
                   std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + ort::protocol::kDefaultLcmUrl + ")");
-  cmd->add_option("--channel-prefix", args->channel_prefix, "scan channel prefix")->capture_default_str();
+  cmd->add_option("--channel-prefix", args->channel_prefix, "scan channel prefix (in the --namespace)")
+      ->capture_default_str();
+  add_namespace_flag(cmd, args->ns);
   cmd->add_option("--status-channel", args->status_channel, "the server's status channel (for --wait-for-server)")
       ->capture_default_str();
   cmd->add_option("--max-range", args->max_range, "max range sent with each scan [m]; <= 0: the server's applies")

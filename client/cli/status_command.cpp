@@ -10,6 +10,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "cli/commands.h"
+#include "cli/namespace_flag.h"
 #include "cli/status/status_json.h"
 #include "cli/status/status_text.h"
 #include "core/clock.h"
@@ -21,7 +22,7 @@ namespace ort::cli {
 namespace {
 
 struct StatusArgs {
-  std::string lcm_url, channel = ort::protocol::kStatusChannel;
+  std::string lcm_url, channel = ort::protocol::kStatusChannel, ns;
   bool watch = false, json = false;
   double timeout_s = 5;
   int64_t count = 0;  // --watch: stop after this many statuses (0: never)
@@ -118,7 +119,8 @@ int run_watch(const StatusArgs& a, lcm::LCM& lc, const std::string& url, Inbox& 
   return 0;
 }
 
-int run_status(const StatusArgs& a) {
+int run_status(StatusArgs a) {
+  a.channel = protocol::in_namespace(protocol::channels_in(protocol::namespace_from(a.ns)).ns, a.channel);
   const std::string url = ort::protocol::lcm_url_or_default(a.lcm_url);
   std::optional<lcm::LCM> slot;
   lcm::LCM& lc = open_lcm(slot, url);
@@ -137,7 +139,8 @@ void register_status_command(CLI::App& app) {
   cmd->add_flag("-w,--watch", args->watch, "Keep showing the newest status, refreshed in place");
   cmd->add_flag("--json", args->json, "One line of JSON per status instead of text");
   cmd->add_option("--lcm-url", args->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else the host-local udpm URL)");
-  cmd->add_option("--channel", args->channel, "Status channel")->capture_default_str();
+  cmd->add_option("--channel", args->channel, "Status channel (in the --namespace)")->capture_default_str();
+  add_namespace_flag(cmd, args->ns);
   cmd->add_option("--timeout", args->timeout_s, "Without --watch: seconds to wait for a status")
       ->check(CLI::Range(0.1, 3600.0))
       ->capture_default_str();

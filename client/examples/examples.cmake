@@ -3,6 +3,7 @@
 # library (built out of tree by install_integration_test).
 add_executable(octomap-rt-plan ${CMAKE_CURRENT_LIST_DIR}/grid_planner.cpp)
 target_link_libraries(octomap-rt-plan PRIVATE octomap_rt_client)
+target_compile_definitions(octomap-rt-plan PRIVATE OCTOMAP_RT_VERSION="${PROJECT_VERSION}")
 install(TARGETS octomap-rt-plan RUNTIME DESTINATION bin)
 
 # The C++ producer of README's "Connect your robot" (publish_scan.cpp): built by default, run by

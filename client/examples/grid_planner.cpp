@@ -14,7 +14,10 @@
 #include <CLI/CLI.hpp>
 
 #include "octomap_rt/box_query_t.hpp"
+#include "protocol/channels.h"
 #include "protocol/lcm_url.h"
+#include "protocol/limits.h"
+#include "protocol/version.h"
 #include "query_client/query_args.h"
 #include "query_client/query_client.h"
 
@@ -72,8 +75,9 @@ std::vector<Cell> astar(const Grid& g, const std::vector<bool>& blocked, Cell fr
 
 int main(int argc, char** argv) {
   CLI::App app{"octomap-rt-plan: A* on the server's 2D grid, footprint checked with box queries"};
-  std::string from_s, to_s, z_s = "0.1:1.5", lcm_url;
+  std::string from_s, to_s, z_s = "0.1:1.5", lcm_url, ns;
   double cell = 0, radius = 0.3, timeout_s = 10;
+  bool json = false;
   app.add_option("--from", from_s, "start X,Y [m]")->required();
   app.add_option("--to", to_s, "goal X,Y [m]")->required();
   app.add_option("--z", z_s, "z band MIN:MAX [m] the robot occupies")->capture_default_str();
@@ -81,13 +85,29 @@ int main(int argc, char** argv) {
   app.add_option("--radius", radius, "footprint half-width [m]")->capture_default_str();
   app.add_option("--lcm-url", lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else the host-local udpm URL)");
   app.add_option("--timeout", timeout_s, "seconds to wait for each answer")->capture_default_str();
+  app.add_option("--namespace", ns,
+                 std::string("the server's namespace (its --namespace); default: $") + ort::protocol::kNamespaceEnv);
+  app.add_flag("--json", json,
+               "one JSON document on stdout: {\"found\", \"reason\", \"snapshot_id\", \"cells\", \"length_m\", "
+               "\"attempts\", \"path\": [[x, y], ...]}");
+  app.set_version_flag("--version", std::string("octomap-rt-plan ") + OCTOMAP_RT_VERSION + " (protocol version " +
+                                        std::to_string(ort::protocol::kProtocolVersion) + ")");
   CLI11_PARSE(app, argc, argv);
+  // Text for people, or one JSON document for scripts (--json).
+  auto no_path = [&](const std::string& why, int64_t snapshot) {
+    if (json)
+      std::printf("{\"found\": false, \"reason\": \"%s\", \"snapshot_id\": %lld}\n", why.c_str(), (long long)snapshot);
+    else
+      std::printf("%s\n", why.c_str());
+    return 3;
+  };
   try {
     const auto from = ort::client::parse_numbers(from_s, 2), to = ort::client::parse_numbers(to_s, 2);
     double z0, z1;
     ort::client::parse_range(z_s, z0, z1);
     ort::client::QueryClient client(ort::protocol::lcm_url_or_default(lcm_url), "planner-" + std::to_string(::getpid()),
-                                    std::chrono::milliseconds(static_cast<int64_t>(timeout_s * 1000)));
+                                    std::chrono::milliseconds(static_cast<int64_t>(timeout_s * 1000)),
+                                    ort::protocol::namespace_from(ns));
     const Grid g = client.grid(z0, z1, cell, nullptr);
     if (g.header.status != 0) throw std::runtime_error("grid refused: " + g.header.error);
     const double cs = g.header.cell_size;
@@ -97,23 +117,27 @@ int main(int argc, char** argv) {
     auto centre = [&](Cell c, int k) {
       return (k ? g.header.origin_y + (c.j + 0.5) * cs : g.header.origin_x + (c.i + 0.5) * cs);
     };
-    std::printf("grid: %d x %d cells of %g m, map state %lld\n", g.header.width, g.header.height, cs,
-                (long long)g.header.snapshot_id);
+    if (!json)
+      std::printf("grid: %d x %d cells of %g m, map state %lld\n", g.header.width, g.header.height, cs,
+                  (long long)g.header.snapshot_id);
     std::vector<bool> blocked(g.cells.size(), false);
     for (int attempt = 1; attempt <= 8; ++attempt) {
       const std::vector<Cell> path = astar(g, blocked, cell_of(from[0], from[1]), cell_of(to[0], to[1]));
       if (path.empty()) {
-        std::printf("no path from (%g, %g) to (%g, %g) through free cells\n", from[0], from[1], to[0], to[1]);
-        return 3;
+        char why[160];
+        std::snprintf(why, sizeof why, "no path from (%g, %g) to (%g, %g) through free cells", from[0], from[1], to[0],
+                      to[1]);
+        return no_path(why, g.header.snapshot_id);
       }
       std::vector<ort::client::Box> boxes;
       for (const Cell& c : path)
         boxes.push_back(
             {{centre(c, 0) - radius, centre(c, 1) - radius, z0}, {centre(c, 0) + radius, centre(c, 1) + radius, z1}});
       int failed = 0;
-      for (size_t first = 0; first < boxes.size(); first += 1000) {
+      const size_t per_query = ort::protocol::kMaxQueryBoxes;
+      for (size_t first = 0; first < boxes.size(); first += per_query) {
         const std::vector<ort::client::Box> part(boxes.begin() + first,
-                                                 boxes.begin() + std::min(boxes.size(), first + 1000));
+                                                 boxes.begin() + std::min(boxes.size(), first + per_query));
         const auto r = client.boxes(part, octomap_rt::box_query_t::MODE_ANY_OCCUPIED);
         if (r.status != 0) throw std::runtime_error("box query refused: " + r.error);
         for (int k = 0; k < r.num_boxes; ++k)
@@ -124,20 +148,30 @@ int main(int argc, char** argv) {
           }
       }
       if (failed) {
-        std::printf("attempt %d: %zu cells, %d fail the %g m footprint check; replanning\n", attempt, path.size(),
-                    failed, radius);
+        if (!json)
+          std::printf("attempt %d: %zu cells, %d fail the %g m footprint check; replanning\n", attempt, path.size(),
+                      failed, radius);
         continue;
       }
       double length = 0;
       for (size_t k = 1; k < path.size(); ++k)
         length += cs * std::hypot(path[k].i - path[k - 1].i, path[k].j - path[k - 1].j);
+      if (json) {
+        std::printf(
+            "{\"found\": true, \"snapshot_id\": %lld, \"cells\": %zu, \"length_m\": %.3f, \"attempts\": %d, "
+            "\"path\": [",
+            (long long)g.header.snapshot_id, path.size(), length, attempt);
+        for (size_t k = 0; k < path.size(); ++k)
+          std::printf("%s[%.3f, %.3f]", k ? ", " : "", centre(path[k], 0), centre(path[k], 1));
+        std::printf("]}\n");
+        return 0;
+      }
       std::printf("path: %zu cells, %.2f m, footprint %g m clear (%d box queries)\n", path.size(), length, radius,
                   attempt);
       for (const Cell& c : path) std::printf("  %.3f %.3f\n", centre(c, 0), centre(c, 1));
       return 0;
     }
-    std::printf("no footprint-clear path after 8 attempts\n");
-    return 3;
+    return no_path("no footprint-clear path after 8 attempts", g.header.snapshot_id);
   } catch (const std::exception& e) {
     std::cerr << "octomap-rt-plan: " << e.what() << "\n";
     return 1;

@@ -41,6 +41,14 @@ struct ClientOptions {
   std::string info_channel = ort::protocol::kMapInfoChannel;
   std::string delta_channel = ort::protocol::kMapDeltaChannel;
   std::string reply_prefix = ort::protocol::kMapReplyPrefix;  // + the client id: the reply channel
+  // The four channels above in namespace `ns` (the server's --namespace; "" = today's names).
+  // Throws std::invalid_argument for a namespace protocol::channels_in refuses.
+  ClientOptions& in_namespace(const std::string& ns) {
+    const protocol::Channels c = protocol::channels_in(ns);
+    request_channel = c.map_request, info_channel = c.map_info, delta_channel = c.map_delta;
+    reply_prefix = c.map_reply_prefix;
+    return *this;
+  }
   // Test hooks in the receive path, after validation: return true to treat the message as
   // lost on the way (loss tests without netem).
   std::function<bool(const octomap_rt::map_chunk_t&)> drop_chunk;

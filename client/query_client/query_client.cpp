@@ -28,11 +28,15 @@ std::string upper(std::string s) {
 
 }  // namespace
 
-QueryClient::QueryClient(const std::string& url, std::string client_id, std::chrono::milliseconds timeout)
-    : lcm_(std::make_unique<lcm::LCM>(url)), client_id_(std::move(client_id)), timeout_(timeout) {
+QueryClient::QueryClient(const std::string& url, std::string client_id, std::chrono::milliseconds timeout,
+                         const std::string& ns)
+    : lcm_(std::make_unique<lcm::LCM>(url)),
+      channels_(protocol::channels_in(ns)),
+      client_id_(std::move(client_id)),
+      timeout_(timeout) {
   if (!lcm_->good()) throw std::runtime_error("LCM could not start on '" + url + "'");
   if (std::string why = protocol::check_client_id(client_id_); !why.empty()) throw std::invalid_argument(why);
-  reply_channel_ = std::string(ort::protocol::kQueryReplyPrefix) + upper(client_id_);
+  reply_channel_ = channels_.query_reply_prefix + upper(client_id_);
   if (std::string why = protocol::check_channel_length(reply_channel_); !why.empty())
     throw std::invalid_argument("client id '" + client_id_ + "': " + why);
   // Request ids differ between runs of the same client id (stale replies are ignored).
@@ -100,8 +104,7 @@ octomap_rt::occupancy_reply_t QueryClient::points(const std::vector<float>& xyz,
   q.depth = depth;
   q.xyz = xyz;
   q.num_xyz = static_cast<int32_t>(xyz.size());
-  return exchange<octomap_rt::occupancy_reply_t>(ort::protocol::kQueryChannel, q, one<octomap_rt::occupancy_reply_t>)
-      .front();
+  return exchange<octomap_rt::occupancy_reply_t>(channels_.query_points, q, one<octomap_rt::occupancy_reply_t>).front();
 }
 
 octomap_rt::ray_reply_t QueryClient::rays(const std::vector<float>& origins, const std::vector<float>& directions,
@@ -113,7 +116,7 @@ octomap_rt::ray_reply_t QueryClient::rays(const std::vector<float>& origins, con
   q.origin_xyz = origins;
   q.direction_xyz = directions;
   q.num_xyz = static_cast<int32_t>(origins.size());
-  return exchange<octomap_rt::ray_reply_t>(ort::protocol::kQueryRaysChannel, q, one<octomap_rt::ray_reply_t>).front();
+  return exchange<octomap_rt::ray_reply_t>(channels_.query_rays, q, one<octomap_rt::ray_reply_t>).front();
 }
 
 octomap_rt::box_reply_t QueryClient::boxes(const std::vector<Box>& boxes, int8_t mode, const WaitFor& w) {
@@ -123,7 +126,7 @@ octomap_rt::box_reply_t QueryClient::boxes(const std::vector<Box>& boxes, int8_t
   for (const Box& b : boxes)
     q.boxes.insert(q.boxes.end(), {b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]});
   q.num_values = static_cast<int32_t>(q.boxes.size());
-  return exchange<octomap_rt::box_reply_t>(ort::protocol::kQueryBoxesChannel, q, one<octomap_rt::box_reply_t>).front();
+  return exchange<octomap_rt::box_reply_t>(channels_.query_boxes, q, one<octomap_rt::box_reply_t>).front();
 }
 
 std::vector<octomap_rt::region_chunk_t> QueryClient::region(const Box& b, int depth, bool include_free,
@@ -135,7 +138,7 @@ std::vector<octomap_rt::region_chunk_t> QueryClient::region(const Box& b, int de
   q.include_free = include_free;
   q.boxes = {b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]};
   q.num_values = 6;
-  auto chunks = exchange<octomap_rt::region_chunk_t>(ort::protocol::kQueryBoxesChannel, q, [](const auto& r) {
+  auto chunks = exchange<octomap_rt::region_chunk_t>(channels_.query_boxes, q, [](const auto& r) {
     return !r.empty() && (r[0].status != 0 || static_cast<int>(r.size()) >= r[0].num_chunks);
   });
   std::sort(chunks.begin(), chunks.end(), [](const auto& a, const auto& b) { return a.chunk_index < b.chunk_index; });
@@ -151,7 +154,7 @@ Grid QueryClient::grid(double z_min, double z_max, double cell_size, const Box* 
     q.window_min[0] = window->min[0], q.window_min[1] = window->min[1];
     q.window_max[0] = window->max[0], q.window_max[1] = window->max[1];
   }
-  auto rows = exchange<octomap_rt::grid_t>(ort::protocol::kQueryGridChannel, q, [](const auto& r) {
+  auto rows = exchange<octomap_rt::grid_t>(channels_.query_grid, q, [](const auto& r) {
     return !r.empty() && (r[0].status != 0 || static_cast<int>(r.size()) >= r[0].num_chunks);
   });
   Grid g;
@@ -175,8 +178,7 @@ octomap_rt::map_edit_ack_t QueryClient::edit(int8_t op, const Box& b, const std:
   e.client_id = client_id_;
   e.reply_channel = reply_channel_;
   e.token = token;
-  return exchange<octomap_rt::map_edit_ack_t>(ort::protocol::kMapEditChannel, e, one<octomap_rt::map_edit_ack_t>)
-      .front();
+  return exchange<octomap_rt::map_edit_ack_t>(channels_.map_edit, e, one<octomap_rt::map_edit_ack_t>).front();
 }
 
 }  // namespace ort::client

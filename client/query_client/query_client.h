@@ -18,6 +18,7 @@
 #include "octomap_rt/occupancy_reply_t.hpp"
 #include "octomap_rt/ray_reply_t.hpp"
 #include "octomap_rt/region_chunk_t.hpp"
+#include "protocol/channels.h"
 
 namespace ort::client {
 
@@ -47,7 +48,9 @@ struct Grid {
 class QueryClient {
  public:
   // `url`: as ort::protocol::lcm_url_or_default(); `client_id`: 1..64 of [A-Za-z0-9_.-].
-  QueryClient(const std::string& url, std::string client_id, std::chrono::milliseconds timeout);
+  // `ns`: the server's namespace (protocol/channels.h; "" = today's channel names).
+  QueryClient(const std::string& url, std::string client_id, std::chrono::milliseconds timeout,
+              const std::string& ns = "");
   ~QueryClient();
 
   octomap_rt::occupancy_reply_t points(const std::vector<float>& xyz, int depth = 0, const WaitFor& w = {});
@@ -71,6 +74,7 @@ class QueryClient {
   void address(Request& r, const WaitFor& w);
 
   std::unique_ptr<lcm::LCM> lcm_;
+  protocol::Channels channels_;
   std::string client_id_, reply_channel_;
   std::chrono::milliseconds timeout_;
   int64_t next_request_ = 1;

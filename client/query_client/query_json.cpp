@@ -91,8 +91,16 @@ void write_grid_json(std::ostream& out, const Grid& g, const std::string& png_pa
   for (int8_t c : g.cells) counts[c >= 0 && c <= 2 ? c : 0]++;
   out << ", \"width\": " << g.header.width << ", \"height\": " << g.header.height
       << ", \"cell_size\": " << g.header.cell_size << ", \"origin\": [" << g.header.origin_x << ", "
-      << g.header.origin_y << "], \"cells\": {\"unknown\": " << counts[0] << ", \"free\": " << counts[1]
-      << ", \"occupied\": " << counts[2] << "}, \"png\": " << quoted(png_path) << "}\n";
+      << g.header.origin_y << "], \"counts\": {\"unknown\": " << counts[0] << ", \"free\": " << counts[1]
+      << ", \"occupied\": " << counts[2] << "}, \"cell_values\": {\"unknown\": 0, \"free\": 1, \"occupied\": 2}"
+      << ", \"png\": " << quoted(png_path) << ", \"cells\": [";
+  // The cells themselves, one row (+y) after another, each row from -x to +x.
+  for (int j = 0; j < g.header.height; ++j) {
+    out << (j ? ", [" : "[");
+    for (int i = 0; i < g.header.width; ++i) out << (i ? "," : "") << int(g.cells[size_t(j) * g.header.width + i]);
+    out << "]";
+  }
+  out << "]}\n";
 }
 
 void write_edit_json(std::ostream& out, const octomap_rt::map_edit_ack_t& a) {

@@ -13,3 +13,4 @@ octomap_rt_lcm_handler_sources(octomap_rt_daemon ${DAEMON_DIR}/transport/lcm_loo
 # that `octomap-rt build` and the server take the same names and defaults.
 add_executable(octomap-rt-server ${DAEMON_DIR}/server_main.cpp ${DAEMON_DIR}/server_cli.cpp)
 target_link_libraries(octomap-rt-server PRIVATE octomap_rt_daemon octomap_rt_allocator)
+target_compile_definitions(octomap-rt-server PRIVATE OCTOMAP_RT_VERSION="${PROJECT_VERSION}")

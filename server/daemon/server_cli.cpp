@@ -1,19 +1,26 @@
 #include "daemon/server_cli.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <regex>
 #include <stdexcept>
 #include <string>
 
 #include "daemon/queries/query_answers.h"
+#include "protocol/channels.h"
 #include "protocol/ids.h"
 #include "protocol/lcm_url.h"
 
 namespace ort::daemon {
 
 void add_server_flags(CLI::App& app, ServerFlags& f) {
-  app.set_config("--config", "", "read flags from this TOML/INI file (keys: the long flag names)");
+  app.set_config("--config", "",
+                 "read flags from this TOML/INI file (keys: the long flag names; an unknown key is refused)");
+  app.allow_config_extras(CLI::config_extras_mode::error);
+  app.add_flag("--print-config", f.print_config,
+               "print the effective configuration (every key of --config with its value) and exit");
   ort::cli::add_engine_flags(app, f.engine, /*require_resolution=*/true);
   ServerConfig& s = f.server;
   app.add_option("--map", s.map_path,
@@ -29,6 +36,12 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
   app.add_option("--lcm-url", s.lcm_url,
                  std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + ort::protocol::kDefaultLcmUrl +
                      "); udpm URLs get recv_buf_size=min(--recv-buf-size, net.core.rmem_max) unless they set it");
+  app.add_option(
+      "--namespace", f.ns,
+      std::string("prefix NS_ for every channel of the protocol, the viewer's OCTOMAP and the reply channels "
+                  "included (NS: letters, digits, _), so that servers in different namespaces share one LCM "
+                  "URL; default: $") +
+          ort::protocol::kNamespaceEnv + ", else none (today's names)");
   app.add_option("--recv-buf-size", s.recv_buf_size, "UDP receive buffer wanted [bytes]")->capture_default_str();
   app.add_option("--scan-channels", s.scan_channels,
                  "regex of scan channels; the part after its literal prefix is the robot id")
@@ -225,8 +238,77 @@ void add_grid_flags(CLI::App& app, GridPublishConfig& g) {
       ->capture_default_str();
 }
 
+// Every channel of `c` (today's names, or the ones given by flag) as NS_ + the name, each checked
+// against LCM's 63 characters: a server that could not publish or hear one does not start.
+void apply_namespace(ServerConfig& c, const std::string& ns) {
+  try {
+    (void)protocol::channels_in(ns);  // the rule: NS's characters, the fixed names' lengths
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError("--namespace", e.what());
+  }
+  c.ns = ns;
+  for (std::string* channel :
+       {&c.status_channel, &c.map_request_channel, &c.map_info_channel, &c.map_delta_channel, &c.octomap_raw.channel,
+        &c.queries.points_channel, &c.queries.rays_channel, &c.queries.boxes_channel, &c.queries.grid_channel,
+        &c.queries.edit_channel, &c.queries.grid.channel}) {
+    *channel = protocol::in_namespace(ns, *channel);
+    if (const std::string why = protocol::check_channel_length(*channel); !why.empty())
+      throw CLI::ValidationError("--namespace", why);
+  }
+  c.scan_channels = protocol::in_namespace(ns, c.scan_channels);
+  c.queries.status_channel = c.status_channel;
+  c.queries.scan_prefix = protocol::in_namespace(ns, protocol::kScanChannelPrefix);
+}
+
+namespace {
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace
+
+std::string nearest_option(const CLI::App& app, const std::string& key) {
+  std::string best;
+  size_t best_distance = SIZE_MAX;
+  for (const CLI::Option* o : app.get_options()) {
+    for (const std::string& name : o->get_lnames()) {
+      const size_t d = edit_distance(key, name);
+      if (d < best_distance) best_distance = d, best = name;
+    }
+  }
+  return best;
+}
+
+std::string parse_server_flags(CLI::App& app, int argc, const char* const* argv) {
+  static const std::string kExtras = "INI was not able to parse ";
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ConfigError& e) {
+    const std::string what = e.what();
+    if (what.rfind(kExtras, 0) != 0) return what;
+    const std::string key = what.substr(kExtras.size());
+    return "--config: unknown key '" + key + "' (did you mean '" + nearest_option(app, key) + "'?)";
+  }
+  return "";
+}
+
+std::string effective_config(const CLI::App& app) { return app.config_to_str(/*default_also=*/true, false); }
+
 ServerConfig to_server_config(const ServerFlags& f) {
   ServerConfig c = f.server;
+  apply_namespace(c, protocol::namespace_from(f.ns));
   c.engine = ort::cli::to_engine_options(f.engine);
   c.pipeline = !f.no_pipeline;
   // Stage 1 shoots beside stage 2's octree update: the octree stage leaves it a core (a

@@ -15,6 +15,8 @@ struct ServerFlags {
   bool no_pipeline = false;
   double queue_mib = 0;
   double octomap_raw_max_kib = 0;  // 0: automatic
+  std::string ns;                  // --namespace; "": $OCTOMAP_RT_NAMESPACE, else none
+  bool print_config = false;       // --print-config: the effective configuration on stdout, then exit
   uint64_t max_scan_work = EngineOptions{}.max_scan_walk_keys;
 };
 
@@ -25,5 +27,14 @@ void add_point_filter_flags(CLI::App& app, PointFilters& f);
 void add_grid_flags(CLI::App& app, GridPublishConfig& g);
 // Validates and converts (after parsing); throws CLI::ValidationError with a clear message.
 ServerConfig to_server_config(const ServerFlags& f);
+
+// Parses the command line (and --config FILE, whose unknown keys are refused) into `f`: "" when
+// the flags are good, else the message to print (an unknown key names the nearest valid one).
+// Throws CLI::CallForHelp / CallForVersion like CLI::App::parse.
+std::string parse_server_flags(CLI::App& app, int argc, const char* const* argv);
+// The configuration as a --config file would give it, every key with its value (--print-config).
+std::string effective_config(const CLI::App& app);
+// The long option name nearest to `key` (edit distance), without its dashes.
+std::string nearest_option(const CLI::App& app, const std::string& key);
 
 }  // namespace ort::daemon

@@ -19,8 +19,10 @@
 namespace ort::daemon {
 
 struct ServerConfig {
-  PointFilters point_filters;          // octomap_server's pass-through and a min range, before preparation
-  EngineOptions engine;                // resolution, sensor model, max range, back end
+  PointFilters point_filters;  // octomap_server's pass-through and a min range, before preparation
+  EngineOptions engine;        // resolution, sensor model, max range, back end
+  // Every channel below is NS_ + its name when ns is set (--namespace; protocol/channels.h).
+  std::string ns;
   std::string lcm_url;                 // "": $LCM_DEFAULT_URL, else host-local udpm
   uint64_t recv_buf_size = 16u << 20;  // udpm receive buffer wanted (capped by rmem_max)
   std::string scan_channels =

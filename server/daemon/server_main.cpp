@@ -22,6 +22,7 @@
 #include "daemon/mapping_server.h"
 #include "daemon/server_cli.h"
 #include "protocol/channels.h"
+#include "protocol/version.h"
 
 namespace {
 
@@ -68,12 +69,21 @@ int main(int argc, char** argv) {
                " (watch it with tools/octomap-rt-spy)."};
   ort::daemon::ServerFlags flags;
   ort::daemon::add_server_flags(app, flags);
+  app.set_version_flag("--version", std::string("octomap-rt-server ") + OCTOMAP_RT_VERSION + " (protocol version " +
+                                        std::to_string(ort::protocol::kProtocolVersion) + ")");
   ort::daemon::ServerConfig cfg;
   try {
-    app.parse(argc, argv);
+    if (const std::string bad = ort::daemon::parse_server_flags(app, argc, argv); !bad.empty()) {
+      std::cerr << "octomap-rt-server: " << bad << "\n";
+      return 2;
+    }
     cfg = ort::daemon::to_server_config(flags);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  }
+  if (flags.print_config) {
+    std::cout << ort::daemon::effective_config(app);
+    return 0;
   }
 
   // Signals are taken by sigwait only: block them before any thread starts.

@@ -19,6 +19,7 @@ if(PYTHON3 AND LCM_LOGGER)
   octomap_rt_add_python_test(python_map_service_test test_map_service 300)
   octomap_rt_add_python_test(python_queries_test test_queries 300)
   octomap_rt_add_python_test(python_planner_test test_planner 300)
+  octomap_rt_add_python_test(python_namespaces_test test_namespaces 300)
   # README's "Connect your robot": the C++ and the Python producer examples against a real server.
   octomap_rt_add_python_test(python_producers_test test_producers 300)
 else()

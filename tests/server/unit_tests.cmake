@@ -63,3 +63,6 @@ octomap_rt_add_test(region_store_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/region_s
 # Issue 24: octomap_server's filters (map-frame and sensor-frame pass-through, min range) against OctoMap.
 octomap_rt_add_test(server_point_filters_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/point_filters_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
+# The server's command line: --namespace, --config's unknown keys, --print-config (issue 24).
+octomap_rt_add_test(server_cli_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_cli_test.cpp
+                    ${CMAKE_SOURCE_DIR}/server/daemon/server_cli.cpp LIBS octomap_rt_daemon TIMEOUT 60)

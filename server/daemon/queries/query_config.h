@@ -31,6 +31,9 @@ struct QueryServiceConfig {
   std::string boxes_channel = ort::protocol::kQueryBoxesChannel;
   std::string grid_channel = ort::protocol::kQueryGridChannel;
   std::string edit_channel = ort::protocol::kMapEditChannel;
+  // The server's own inputs and heartbeat: a reply_channel naming one of them is refused.
+  std::string scan_prefix = ort::protocol::kScanChannelPrefix;
+  std::string status_channel = ort::protocol::kStatusChannel;
   std::string control_token;          // "": every edit is refused
   size_t per_client_queue = 16;       // queued queries per client; more get BUSY
   size_t max_clients = 256;           // distinct client ids tracked; the rest share "*"

@@ -102,7 +102,7 @@ std::string QueryService::check_addressing(const std::string& client, const std:
        {&cfg_.points_channel, &cfg_.rays_channel, &cfg_.boxes_channel, &cfg_.grid_channel, &cfg_.edit_channel})
     if (channel == *own) return "reply_channel is one of the server's request channels";
   if (channel == cfg_.grid.channel) return "reply_channel is the server's grid channel";
-  if (channel.rfind(ort::protocol::kScanChannelPrefix, 0) == 0 || channel == ort::protocol::kStatusChannel)
+  if (channel.rfind(cfg_.scan_prefix, 0) == 0 || channel == cfg_.status_channel)
     return "reply_channel is one of the server's scan or status channels";
   return "";
 }

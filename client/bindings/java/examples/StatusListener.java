@@ -3,7 +3,7 @@
 // subscribe and decode like any LCM type.
 //
 //   java -cp /usr/share/java/lcm.jar:/usr/local/share/java/lcmtypes_octomap_rt.jar:octomap_rt_java_examples.jar \
-//        StatusListener [URL] [COUNT]
+//        StatusListener [URL] [COUNT]       (OCTOMAP_RT_NAMESPACE=NS: the server's --namespace)
 import java.io.IOException;
 
 import lcm.lcm.LCM;
@@ -39,12 +39,19 @@ public class StatusListener implements LCMSubscriber {
     while (wanted == 0 || received < wanted) wait();
   }
 
+  // The server's namespace (its --namespace) from $OCTOMAP_RT_NAMESPACE: NS_ + the name, or the
+  // name itself without one (docs/PROTOCOL.md, "The protocol's home").
+  static String inNamespace(String name) {
+    String ns = System.getenv(ProtocolTable.NAMESPACE_ENV);
+    return ns == null || ns.isEmpty() ? name : ns + "_" + name;
+  }
+
   public static void main(String[] args) throws Exception {
     String url = args.length > 0 ? args[0] : ProtocolTable.DEFAULT_LCM_URL;
     int count = args.length > 1 ? Integer.parseInt(args[1]) : 0;
     LCM lcm = new LCM(url);
     StatusListener listener = new StatusListener(count);
-    lcm.subscribe(ProtocolTable.STATUS_CHANNEL, listener);
+    lcm.subscribe(inNamespace(ProtocolTable.STATUS_CHANNEL), listener);
     listener.awaitAll();
     lcm.close();
   }

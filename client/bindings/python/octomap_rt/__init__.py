@@ -4,6 +4,7 @@ transport that needs no LCM runtime, and MapClient for octomap-rt-server."""
 from ._types import *  # noqa: F401,F403  (lcm-gen's own package imports: scan_t, server_status_t, ...)
 from .lcm_url import HOST_LOCAL_URL, LcmUrlError, default_url, parse_udpm_url  # noqa: F401
 from .transport import open_transport  # noqa: F401
+from .channels import Channels, namespace_from  # noqa: F401
 from .bt_reader import BtFormatError, BtMap, read_bt, read_bt_file  # noqa: F401
 from .map_client import MapClient, ServerTimeout  # noqa: F401
 from .snapshot_fetch import FetchError, Snapshot  # noqa: F401

@@ -10,7 +10,7 @@ from .bt_reader import BtMap, read_bt
 from .snapshot_fetch import Snapshot, fetch_snapshot, new_client_id
 from .transport import open_transport
 
-from .protocol_table import MAP_INFO_CHANNEL, SCAN_CHANNEL_PREFIX, STATUS_CHANNEL
+from .channels import Channels
 
 
 class ServerTimeout(TimeoutError):
@@ -26,12 +26,15 @@ class MapClient:
 
     `url`: LCM URL (default $LCM_DEFAULT_URL, else the host-local udpm URL); add
     `recv_buf_size=` to receive multi-MB messages. `transport`: any object with publish,
-    subscribe, unsubscribe and handle (default: open_transport(url))."""
+    subscribe, unsubscribe and handle (default: open_transport(url)). `namespace`: the server's
+    (its --namespace; default $OCTOMAP_RT_NAMESPACE, else none): every channel is NS_ + its name."""
 
-    def __init__(self, url: Optional[str] = None, transport=None, client_id: str = ""):
+    def __init__(self, url: Optional[str] = None, transport=None, client_id: str = "",
+                 namespace: Optional[str] = None):
+        self.channels = Channels(namespace)
         self.transport = transport or open_transport(url)
         self.client_id = client_id or new_client_id()
-        self.queries = queries.QueryChannel(self.transport, self.client_id)
+        self.queries = queries.QueryChannel(self.transport, self.client_id, channels=self.channels)
         self._scan_seq = {}
 
     def close(self) -> None:
@@ -77,16 +80,16 @@ class MapClient:
 
     def status(self, timeout_s: float = 5.0) -> server_status_t:
         """The server's next status message (it sends one a second)."""
-        return self.wait_for(STATUS_CHANNEL, server_status_t.decode, timeout_s=timeout_s)
+        return self.wait_for(self.channels.status, server_status_t.decode, timeout_s=timeout_s)
 
     def map_info(self, timeout_s: float = 5.0) -> map_info_t:
         """The server's next map_info_t (1 Hz and after each snapshot)."""
-        return self.wait_for(MAP_INFO_CHANNEL, map_info_t.decode, timeout_s=timeout_s)
+        return self.wait_for(self.channels.map_info, map_info_t.decode, timeout_s=timeout_s)
 
     def fetch_snapshot(self, format: str = "bt", timeout_s: float = 30.0, snapshot_id: int = -1) -> Snapshot:
         """The map as a .bt ("bt") or .ot ("ot") file's bytes in Snapshot.data: fresh
         (snapshot_id -1), the latest kept (0) or a kept one by id. Raises FetchError."""
-        return fetch_snapshot(self.transport, format, timeout_s, snapshot_id, self.client_id)
+        return fetch_snapshot(self.transport, format, timeout_s, snapshot_id, self.client_id, channels=self.channels)
 
     def fetch_map(self, timeout_s: float = 30.0) -> BtMap:
         """A fresh snapshot's occupied and free voxel centres as numpy arrays (read_bt)."""
@@ -114,7 +117,7 @@ class MapClient:
                      orientation: Sequence[float] = (1.0, 0.0, 0.0, 0.0), points_in_map_frame: bool = False,
                      max_range: float = -1.0, seq: Optional[int] = None, utime: Optional[int] = None,
                      map_frame: str = "map") -> int:
-        """Sends one scan as robot `robot_id` (channel OCTOMAP_RT_SCAN_<ROBOT_ID>): `points` an
+        """Sends one scan as robot `robot_id` (channel [NS_]OCTOMAP_RT_SCAN_<ROBOT_ID>): `points` an
         (N, 3) array in the sensor frame (or the map frame), `origin` the sensor position and
         `orientation` its unit quaternion (w, x, y, z) in the map frame. Returns its seq
         (0, 1, 2, ... per robot unless given)."""
@@ -133,5 +136,5 @@ class MapClient:
         msg.num_xyz = len(msg.xyz)
         msg.robot_id = robot_id
         msg.map_frame = map_frame
-        self.transport.publish(SCAN_CHANNEL_PREFIX + robot_id.upper(), msg.encode())
+        self.transport.publish(self.channels.scan_prefix + robot_id.upper(), msg.encode())
         return msg.seq

@@ -9,11 +9,7 @@ from typing import Optional
 from ._types import (box_query_t, box_reply_t, grid_query_t, grid_t, occupancy_query_t,
                      occupancy_reply_t, ray_query_t, ray_reply_t)
 
-from .protocol_table import QUERY_BOXES_CHANNEL as BOXES_CHANNEL
-from .protocol_table import QUERY_CHANNEL as POINTS_CHANNEL
-from .protocol_table import QUERY_GRID_CHANNEL as GRID_CHANNEL
-from .protocol_table import QUERY_RAYS_CHANNEL as RAYS_CHANNEL
-from .protocol_table import QUERY_REPLY_PREFIX as REPLY_PREFIX
+from .channels import Channels
 # Per message (one 60 KB datagram).
 from .protocol_table import MAX_QUERY_BOXES as MAX_BOXES
 from .protocol_table import MAX_QUERY_POINTS as MAX_POINTS
@@ -29,10 +25,12 @@ class QueryError(RuntimeError):
 class QueryChannel:
     """Sends a query and collects the reply messages with its request_id."""
 
-    def __init__(self, transport, client_id: str, timeout_s: float = 10.0, retry_after_s: float = 1.0):
+    def __init__(self, transport, client_id: str, timeout_s: float = 10.0, retry_after_s: float = 1.0,
+                 channels: Optional[Channels] = None):
         self.transport = transport
         self.client_id = client_id
-        self.reply_channel = REPLY_PREFIX + client_id
+        self.channels = channels or Channels()
+        self.reply_channel = self.channels.reply_channel(self.channels.query_reply_prefix, client_id)
         self.timeout_s = timeout_s
         self.retry_after_s = retry_after_s
         self._next_id = int(time.time() * 1000) * 1000
@@ -103,7 +101,7 @@ def query_points(q: QueryChannel, points, depth: int = 0, min_snapshot_id: int =
         m.depth = depth
         m.xyz = _float_list(pts[start:start + MAX_POINTS], np)
         m.num_xyz = len(m.xyz)
-        r = q.ask(POINTS_CHANNEL, m, occupancy_reply_t, min_snapshot_id)[0]
+        r = q.ask(q.channels.query_points, m, occupancy_reply_t, min_snapshot_id)[0]
         occ.extend(r.occupancy)
         prob.extend(r.probability)
     return np.asarray(occ, dtype=np.int8), np.asarray(prob, dtype=np.float32)
@@ -125,7 +123,7 @@ def cast_rays(q: QueryChannel, origins, directions, max_range: float = -1.0, ign
         m.origin_xyz = _float_list(orig[start:start + MAX_RAYS], np)
         m.direction_xyz = _float_list(dirs[start:start + MAX_RAYS], np)
         m.num_xyz = len(m.origin_xyz)
-        r = q.ask(RAYS_CHANNEL, m, ray_reply_t, min_snapshot_id)[0]
+        r = q.ask(q.channels.query_rays, m, ray_reply_t, min_snapshot_id)[0]
         hit.extend(r.hit)
         state.extend(r.end_state)
         ends.extend(r.end_xyz)
@@ -145,7 +143,7 @@ def box_counts(q: QueryChannel, boxes, min_snapshot_id: int = 0):
         m.mode = box_query_t.MODE_COUNTS
         m.boxes = b[start:start + MAX_BOXES].reshape(-1).tolist()
         m.num_values = len(m.boxes)
-        r = q.ask(BOXES_CHANNEL, m, box_reply_t, min_snapshot_id)[0]
+        r = q.ask(q.channels.query_boxes, m, box_reply_t, min_snapshot_id)[0]
         for key in out:
             out[key].extend(getattr(r, key))
     return {k: np.asarray(v, dtype=np.int64) for k, v in out.items()}
@@ -162,7 +160,7 @@ def grid(q: QueryChannel, z_min: float, z_max: float, cell_size: float = 0.0,
     m.use_window = 1 if window else 0
     (x0, y0), (x1, y1) = window if window else ((0.0, 0.0), (0.0, 0.0))
     m.window_min, m.window_max = [float(x0), float(y0)], [float(x1), float(y1)]
-    parts = q.ask(GRID_CHANNEL, m, grid_t, min_snapshot_id,
+    parts = q.ask(q.channels.query_grid, m, grid_t, min_snapshot_id,
                   complete=lambda rs: len({r.chunk_index for r in rs}) >= rs[0].num_chunks)
     first = parts[0]
     cells = np.full((first.height, first.width), UNKNOWN, dtype=np.int8)

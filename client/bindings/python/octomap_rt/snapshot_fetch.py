@@ -6,13 +6,13 @@ import os
 import random
 import re
 import time
+from typing import Optional
 from dataclasses import dataclass
 
 from ._types import map_chunk_t, map_request_t
 
-from .protocol_table import MAP_REPLY_PREFIX as REPLY_PREFIX
 from .protocol_table import MAX_REQUESTED_CHUNKS
-from .protocol_table import MAP_REQUEST_CHANNEL as REQUEST_CHANNEL
+from .channels import Channels
 FORMATS = {"bt": map_chunk_t.FORMAT_OCTOMAP_BINARY, "ot": map_chunk_t.FORMAT_OCTOMAP_FULL}
 
 
@@ -84,12 +84,13 @@ class _Assembly:
 
 def fetch_snapshot(transport, fmt: str = "bt", timeout_s: float = 30.0, snapshot_id: int = -1,
                    client_id: str = "", rerequest_after_s: float = 0.25,
-                   first_answer_after_s: float = 3.0) -> Snapshot:
+                   first_answer_after_s: float = 3.0, channels: Optional[Channels] = None) -> Snapshot:
     """A snapshot: fresh (snapshot_id -1), the latest kept (0) or a kept one by id."""
     if fmt not in FORMATS:
         raise ValueError(f"format must be one of {sorted(FORMATS)}, got {fmt!r}")
     client_id = client_id or new_client_id()
-    reply_channel = REPLY_PREFIX + client_id
+    channels = channels or Channels()
+    reply_channel = channels.reply_channel(channels.map_reply_prefix, client_id)
     assembly, request_ids = _Assembly(), set()
 
     def on_chunk(_channel, data):
@@ -109,7 +110,7 @@ def fetch_snapshot(transport, fmt: str = "bt", timeout_s: float = 30.0, snapshot
         req.client_id = client_id
         req.reply_channel = reply_channel
         request_ids.add(req.request_id)
-        transport.publish(REQUEST_CHANNEL, req.encode())
+        transport.publish(channels.map_request, req.encode())
         assembly.last_arrival = time.monotonic()
 
     sub = transport.subscribe(reply_channel, on_chunk)
