@@ -262,7 +262,8 @@ TEST(QueryBounds, AReplyChannelLongerThanLcmAllowsIsRefusedNotAnswered) {
   }
   EXPECT_EQ(answered, 0);
   EXPECT_EQ(dropped, 1);
-  EXPECT_NE(why.find("1..63 characters"), std::string::npos) << why;
+  // Refused before decode (the reply channel's string is longer than the wire allows).
+  EXPECT_NE(why.find("string length"), std::string::npos) << why;
 }
 
 TEST(QueryBounds, AnIdleClientGivesItsSlotToANewOneAndTheTotalsStay) {
