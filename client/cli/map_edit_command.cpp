@@ -1,5 +1,6 @@
 // `octomap-rt map clear-box|reset` (next to map get/info/watch/diff): edit a running server's map (applied in order with the
-// scans; the server must run with --control-token and the request carry it).
+// scans; the server must run with --control-token and the request carry it). clear-box --to free changes known voxels
+// only unless --include-unknown.
 #include <unistd.h>
 
 #include <iostream>
@@ -20,6 +21,7 @@ struct EditArgs {
   std::string lcm_url, token, box, to = "free", ns;
   double timeout_s = 10;
   bool json = false;
+  bool include_unknown = false;
 };
 
 void run_edit(const EditArgs& a, int8_t op) {
@@ -28,7 +30,8 @@ void run_edit(const EditArgs& a, int8_t op) {
   client::QueryClient c(ort::protocol::lcm_url_or_default(a.lcm_url), "cli-" + std::to_string(::getpid()),
                         std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)),
                         protocol::namespace_from(a.ns));
-  const auto ack = c.edit(op, b, a.token);
+  const int8_t flags = a.include_unknown ? octomap_rt::map_edit_t::FLAG_INCLUDE_UNKNOWN : 0;
+  const auto ack = c.edit(op, b, a.token, flags);
   if (a.json) client::write_edit_json(std::cout, ack);
   if (ack.status != 0) {
     std::cerr << "octomap-rt map: " << client::status_name(ack.status) << ": " << ack.error << "\n";
@@ -49,10 +52,15 @@ void add_common(CLI::App* cmd, EditArgs& a) {
 
 void add_map_edit_commands(CLI::App* cmd) {
   auto clear = std::make_shared<EditArgs>();
-  auto* c = cmd->add_subcommand("clear-box", "set every voxel of a box free, or unknown");
+  auto* c = cmd->add_subcommand("clear-box",
+                                "set the known voxels of a box free, or every voxel of it unknown (the box only: "
+                                "leaves across its border are split there)");
   add_common(c, *clear);
   c->add_option("box", clear->box, "MINX,MINY,MINZ:MAXX,MAXY,MAXZ [m]")->required();
   c->add_option("--to", clear->to, "free or unknown")->check(CLI::IsMember({"free", "unknown"}))->capture_default_str();
+  c->add_flag("--include-unknown", clear->include_unknown,
+              "with --to free: mark the box's never-seen voxels free too (planners trust free space: only for "
+              "space known to be empty)");
   c->callback([clear] {
     run_edit(*clear, clear->to == "free" ? octomap_rt::map_edit_t::OP_CLEAR_TO_FREE
                                          : octomap_rt::map_edit_t::OP_CLEAR_TO_UNKNOWN);

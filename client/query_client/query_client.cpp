@@ -168,11 +168,12 @@ Grid QueryClient::grid(double z_min, double z_max, double cell_size, const Box* 
   return g;
 }
 
-octomap_rt::map_edit_ack_t QueryClient::edit(int8_t op, const Box& b, const std::string& token) {
+octomap_rt::map_edit_ack_t QueryClient::edit(int8_t op, const Box& b, const std::string& token, int8_t flags) {
   octomap_rt::map_edit_t e{};
   e.utime = now_us();
   e.request_id = next_request_++;
   e.op = op;
+  e.flags = flags;
   std::copy(b.min, b.min + 3, e.box_min);
   std::copy(b.max, b.max + 3, e.box_max);
   e.client_id = client_id_;

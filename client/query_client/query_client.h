@@ -60,8 +60,8 @@ class QueryClient {
   octomap_rt::box_reply_t boxes(const std::vector<Box>& boxes, int8_t mode, const WaitFor& w = {});
   std::vector<octomap_rt::region_chunk_t> region(const Box& box, int depth, bool include_free, const WaitFor& w = {});
   Grid grid(double z_min, double z_max, double cell_size, const Box* window, const WaitFor& w = {});
-  // op: map_edit_t.OP_*; box ignored for OP_RESET.
-  octomap_rt::map_edit_ack_t edit(int8_t op, const Box& box, const std::string& token);
+  // op: map_edit_t.OP_*; box ignored for OP_RESET; flags: map_edit_t.FLAG_*.
+  octomap_rt::map_edit_ack_t edit(int8_t op, const Box& box, const std::string& token, int8_t flags = 0);
 
   const std::string& reply_channel() const { return reply_channel_; }
 

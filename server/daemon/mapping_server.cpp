@@ -141,7 +141,8 @@ void MappingServer::start() {
       std::make_unique<ScanIntake>(*loop_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
   intake_->open();  // services subscribe before the loop starts: 1.3.1's subscribe races with handle
   map_service_->open();
-  queries_ = std::make_unique<QueryService>(cfg_.queries, map_, queue_, *loop_, server_id_, cfg_.engine.resolution);
+  queries_ =
+      std::make_unique<QueryService>(cfg_.queries, map_, queue_, *loop_, server_id_, cfg_.engine.resolution, log_);
   queries_->open();
   loop_->start();
   raw_publisher_ = std::make_unique<OctomapRawPublisher>(cfg_.octomap_raw, map_, *loop_, log_);
@@ -260,10 +261,19 @@ void MappingServer::drain_until_deadline() {
                                            std::chrono::duration<double>(std::max(0.0, cfg_.drain_timeout_s)));
   while (queue_.depth() > 0 && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   const std::vector<QueuedScan> left = queue_.take_all();
-  for (const QueuedScan& s : left) producers_.count_dropped_in_flight(s.producer, Reject::kLeftAtShutdown);
+  size_t scans_left = 0;
+  for (const QueuedScan& s : left) {
+    if (s.edit) {  // its sender is told, and no producer counts it
+      refuse_map_edit(*s.edit, EditRefusal::kNotApplied, "the server stopped before applying it (drain deadline)");
+      continue;
+    }
+    producers_.count_dropped_in_flight(s.producer, Reject::kLeftAtShutdown);
+    scans_left++;
+  }
   if (!left.empty())
-    log_.warning(text("drain deadline (", cfg_.drain_timeout_s, " s) passed: ", left.size(),
-                      " queued scans dropped (left at shutdown); saving the map as applied"));
+    log_.warning(text("drain deadline (", cfg_.drain_timeout_s, " s) passed: ", scans_left,
+                      " queued scans dropped (left at shutdown), ", left.size() - scans_left,
+                      " map edits refused; saving the map as applied"));
 }
 
 void MappingServer::set_state(int8_t state, std::string message) {

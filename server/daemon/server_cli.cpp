@@ -76,6 +76,13 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
   app.add_option("--control-token", s.queries.control_token,
                  "allow map edits (octomap-rt map clear-box/reset) from requests carrying this token; without it "
                  "every edit is refused. LCM has no authentication: the token keeps mistakes out, not attackers");
+  app.add_option("--max-edit-nodes", s.queries.edit_bounds.max_new_nodes,
+                 "a map edit that would add more nodes is refused before it starts (the map's exclusive lock "
+                 "holds mapping while an edit runs)")
+      ->capture_default_str();
+  app.add_option("--max-edit-work", s.queries.edit_bounds.max_work,
+                 "a map edit that would visit, make or free more nodes is refused before it starts")
+      ->capture_default_str();
   app.add_option("--query-queue", s.queries.per_client_queue, "queued queries per client; more get BUSY replies")
       ->capture_default_str();
   add_grid_flags(app, s.queries.grid);
@@ -356,6 +363,9 @@ ServerConfig to_server_config(const ServerFlags& f) {
   } catch (const std::invalid_argument& e) {
     throw CLI::ValidationError("upkeep", e.what());
   }
+  for (const auto& [value, name] : {std::pair{c.queries.edit_bounds.max_new_nodes, "--max-edit-nodes"},
+                                    std::pair{c.queries.edit_bounds.max_work, "--max-edit-work"}})
+    if (value < 1 || value > int64_t(1) << 40) throw CLI::ValidationError(name, "must be within 1..2^40");
   if (!std::isfinite(c.producer_idle_release_s))
     throw CLI::ValidationError("--producer-idle-release", "must be a finite number of seconds");
   for (const std::string& id : c.allowed_robots)

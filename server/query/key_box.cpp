@@ -61,6 +61,13 @@ NodeCube node_cube(const octomap::OcTreeKey& key, unsigned depth, unsigned tree_
   return c;
 }
 
+NodeCube child_cube(const NodeCube& cube, unsigned i) {
+  NodeCube c;
+  c.side = cube.side / 2;
+  for (int a = 0; a < 3; ++a) c.lo[a] = octomap::key_type(cube.lo[a] + ((i >> a) & 1) * c.side);
+  return c;
+}
+
 int64_t overlap_voxels(const NodeCube& c, const KeyBox& b) {
   int64_t n = 1;
   for (int i = 0; i < 3; ++i) {

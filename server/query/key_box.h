@@ -28,6 +28,9 @@ struct NodeCube {
   int side = 1;
 };
 NodeCube node_cube(const octomap::OcTreeKey& key, unsigned depth, unsigned tree_depth);
+// Child i of a node covering `cube`: bit 0 of i is x, bit 1 is y, bit 2 is z (OctoMap's
+// computeChildIdx order).
+NodeCube child_cube(const NodeCube& cube, unsigned i);
 
 // Finest voxels shared by a cube and a box (0 when they are disjoint).
 int64_t overlap_voxels(const NodeCube& c, const KeyBox& b);

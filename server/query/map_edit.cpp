@@ -5,15 +5,6 @@ namespace {
 
 using Node = octomap::OcTreeNode;
 
-// Child i of a node covering `cube`: bit 0 of i is x, bit 1 is y, bit 2 is z (OctoMap's
-// computeChildIdx order).
-NodeCube child_cube(const NodeCube& cube, unsigned i) {
-  NodeCube c;
-  c.side = cube.side / 2;
-  for (int a = 0; a < 3; ++a) c.lo[a] = octomap::key_type(cube.lo[a] + ((i >> a) & 1) * c.side);
-  return c;
-}
-
 // Deletes child i of `parent`, a node without children. deleteNodeChild frees only the
 // node itself, and OctoMap's node destructor requires its child array to be gone, which
 // stays allocated (all null) once a node's last child was deleted. expandNode then
@@ -74,9 +65,40 @@ void clear_free_below(octomap::OcTree& tree, Node* node, const NodeCube& cube, c
   if (tree.isNodeCollapsible(node)) tree.pruneNode(node);
 }
 
+// Every known voxel below `node` (inside the box) free: leaves get the value, inner nodes
+// the children's maximum; unknown children stay unknown.
+void set_known_free(octomap::OcTree& tree, Node* node, float value) {
+  if (!tree.nodeHasChildren(node)) {
+    node->setLogOdds(value);
+    return;
+  }
+  for (unsigned i = 0; i < 8; ++i)
+    if (tree.nodeChildExists(node, i)) set_known_free(tree, tree.getNodeChild(node, i), value);
+  node->updateOccupancyChildren();
+  if (tree.isNodeCollapsible(node)) tree.pruneNode(node);
+}
+
+// `node` (covering `cube`, overlapping the box but not inside it) exists: a pruned leaf stands
+// for 8 known children and is split; missing children are unknown space and stay so.
+void clear_known_free_below(octomap::OcTree& tree, Node* node, const NodeCube& cube, const KeyBox& box, float value) {
+  if (!tree.nodeHasChildren(node)) tree.expandNode(node);
+  for (unsigned i = 0; i < 8; ++i) {
+    if (!tree.nodeChildExists(node, i)) continue;
+    const NodeCube c = child_cube(cube, i);
+    if (overlap_voxels(c, box) == 0) continue;
+    Node* child = tree.getNodeChild(node, i);
+    if (cube_inside(c, box))
+      set_known_free(tree, child, value);
+    else
+      clear_known_free_below(tree, child, c, box, value);
+  }
+  node->updateOccupancyChildren();
+  if (tree.isNodeCollapsible(node)) tree.pruneNode(node);
+}
+
 }  // namespace
 
-void clear_box(octomap::OcTree& tree, const KeyBox& box, ClearTo to) {
+void clear_box(octomap::OcTree& tree, const KeyBox& box, ClearTo to, Unknown unknown) {
   NodeCube root;
   root.side = 1 << tree.getTreeDepth();
   const bool whole = cube_inside(root, box);
@@ -86,6 +108,14 @@ void clear_box(octomap::OcTree& tree, const KeyBox& box, ClearTo to) {
     return;
   }
   const float value = tree.getClampingThresMinLog();
+  if (unknown == Unknown::kKept) {
+    if (!tree.getRoot()) return;
+    if (whole)
+      set_known_free(tree, tree.getRoot(), value);
+    else
+      clear_known_free_below(tree, tree.getRoot(), root, box, value);
+    return;
+  }
   // OctoMap has no public way to make a root but a node update: set one voxel of the box
   // (it is overwritten below).
   if (!tree.getRoot()) tree.setNodeValue(box.min, value, /*lazy_eval=*/true);

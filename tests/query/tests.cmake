@@ -8,6 +8,7 @@ octomap_rt_add_test(query_test
           ${CMAKE_CURRENT_LIST_DIR}/box_query_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/grid_query_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/map_edit_test.cpp
+          ${CMAKE_CURRENT_LIST_DIR}/edit_cost_test.cpp
   LIBS octomap_rt_query
   TIMEOUT 600)
 

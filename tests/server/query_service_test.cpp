@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <map>
 #include <mutex>
+#include <sstream>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -190,6 +191,7 @@ TEST(QueryService, EditsNeedTheTokenAndApplyInOrderWithTheScans) {
   octomap_rt::map_edit_t e{};
   e.request_id = 1, e.client_id = "op", e.reply_channel = kReply, e.token = "wrong";
   e.op = octomap_rt::map_edit_t::OP_CLEAR_TO_FREE;
+  e.flags = octomap_rt::map_edit_t::FLAG_INCLUDE_UNKNOWN;  // the box's unknown space too
   double lo[3] = {2.5, -2, 0}, hi[3] = {3.5, 2, 1};
   std::copy(lo, lo + 3, e.box_min), std::copy(hi, hi + 3, e.box_max);
   lc.publish(ort::protocol::kMapEditChannel, &e);
@@ -214,6 +216,160 @@ TEST(QueryService, EditsNeedTheTokenAndApplyInOrderWithTheScans) {
   EXPECT_EQ(replies.wait_for<octomap_rt::map_edit_ack_t>(4).snapshot_id, 3);
   EXPECT_EQ(server.with_map([](const octomap::OcTree& t) { return t.size(); }), 0u);
   server.stop();
+}
+
+// An edit whose cost passes its bound is refused before it starts, with the reason, and the
+// map is untouched: marking the unknown space of a huge misaligned box free would build ~10^10
+// nodes under the exclusive lock. The same box on known space only is applied (the map's
+// nodes), and every edit leaves an audit line in the server's log.
+TEST(QueryService, ACostlyEditIsRefusedBeforeItStartsAndEveryEditIsAudited) {
+  lcm::LCM lc("memq://");
+  auto cfg = test_config(0.1, true);
+  cfg.queries.control_token = "s3cret";
+  std::ostringstream log;
+  daemon::MappingServer server(cfg, lc, log);
+  Replies replies(server);
+  server.start();
+  const auto s = wall_scan(0);
+  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);
+  ASSERT_TRUE(wait_until_done(server, 1));
+  const auto nodes = server.with_map([](const octomap::OcTree& t) { return t.size(); });
+  octomap_rt::map_edit_t e{};
+  e.request_id = 1, e.client_id = "op", e.reply_channel = kReply, e.token = "s3cret";
+  e.op = octomap_rt::map_edit_t::OP_CLEAR_TO_FREE;
+  e.flags = octomap_rt::map_edit_t::FLAG_INCLUDE_UNKNOWN;
+  double lo[3] = {-3000.01, -3000.01, -3000.01}, hi[3] = {3000.01, 3000.01, 3000.01};
+  std::copy(lo, lo + 3, e.box_min), std::copy(hi, hi + 3, e.box_max);
+  lc.publish(wire::kMapEditChannel, &e);
+  const auto refused = replies.wait_for<octomap_rt::map_edit_ack_t>(1);
+  EXPECT_EQ(refused.status, Reply::REPLY_REFUSED);
+  EXPECT_NE(refused.error.find("too costly"), std::string::npos) << refused.error;
+  EXPECT_EQ(server.with_map([](const octomap::OcTree& t) { return t.size(); }), nodes);
+  e.request_id = 2, e.flags = 0;  // known space only: the wall and the free space before it
+  lc.publish(wire::kMapEditChannel, &e);
+  const auto applied = replies.wait_for<octomap_rt::map_edit_ack_t>(2);
+  ASSERT_EQ(applied.status, Reply::REPLY_OK) << applied.error;
+  server.with_map([&](const octomap::OcTree& t) {
+    for (auto it = t.begin_leafs(), end = t.end_leafs(); it != end; ++it)
+      EXPECT_EQ(it->getLogOdds(), t.getClampingThresMinLog());
+    return 0;
+  });
+  server.stop();
+  const std::string text = log.str();
+  EXPECT_NE(text.find("map edit 1 from client 'op' (reply " + kReply +
+                      "): clear-box to free (unknown voxels too) [-3000.01, -3000.01, -3000.01]..[3000.01, 3000.01, "
+                      "3000.01] m: refused (REFUSED): too costly"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("map edit 2 from client 'op' (reply " + kReply + "): clear-box to free (known voxels only)"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find(": applied, map state 2"), std::string::npos) << text;
+}
+
+// An edit is never shed for its age: with a latency bound every queued scan passes, the
+// scans are dropped and counted to their producer, the edit is applied and acked, and no
+// producer counts it.
+TEST(QueryService, EditsAreNeverShedAsStale) {
+  lcm::LCM lc("memq://");
+  auto cfg = test_config(0.1, true);
+  cfg.queries.control_token = "s3cret";
+  cfg.latency_bound_s = 1e-9;  // every queued scan is stale when stage 1 takes it
+  daemon::MappingServer server(cfg, lc, std::cerr);
+  Replies replies(server);
+  server.start();
+  for (int64_t k = 0; k < 3; ++k) {
+    const auto s = wall_scan(k);
+    lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);
+  }
+  octomap_rt::map_edit_t e{};
+  e.request_id = 1, e.client_id = "op", e.reply_channel = kReply, e.token = "s3cret";
+  e.op = octomap_rt::map_edit_t::OP_RESET;
+  lc.publish(wire::kMapEditChannel, &e);
+  const auto ack = replies.wait_for<octomap_rt::map_edit_ack_t>(1);
+  EXPECT_EQ(ack.status, Reply::REPLY_OK) << ack.error;
+  ASSERT_TRUE(wait_until_done(server, 3));
+  server.stop();
+  int64_t dropped = 0;
+  for (const auto& p : server.producer_stats()) dropped += p.dropped;
+  EXPECT_EQ(dropped, 3);
+  for (const auto& c : server.query_stats())
+    if (c.client_id == "op") {
+      EXPECT_EQ(c.edits_applied, 1);
+    }
+}
+
+// Edits still queued when the drain deadline passes are refused and acked (not counted as a
+// producer's scans): for the edit client, received = applied + refused. The test holds the
+// map (stage 2 waits) so that edits are still queued when the server stops.
+TEST(QueryService, EditsLeftAtShutdownAreRefusedNotDropped) {
+  lcm::LCM lc("memq://");
+  auto cfg = test_config(0.1, true);
+  cfg.queries.control_token = "s3cret";
+  cfg.drain_timeout_s = 0;
+  daemon::MappingServer server(cfg, lc, std::cerr);
+  Replies replies(server);
+  server.start();
+  std::mutex m;
+  std::condition_variable cv;
+  bool holding = false, release = false;
+  std::thread holder([&] {
+    server.with_map([&](const octomap::OcTree&) {
+      std::unique_lock lock(m);
+      holding = true;
+      cv.notify_all();
+      cv.wait(lock, [&] { return release; });
+      return 0;
+    });
+  });
+  {
+    std::unique_lock lock(m);
+    cv.wait(lock, [&] { return holding; });
+  }
+  octomap_rt::map_edit_t e{};
+  e.client_id = "op", e.reply_channel = kReply, e.token = "s3cret";
+  e.op = octomap_rt::map_edit_t::OP_CLEAR_TO_UNKNOWN;
+  double lo[3] = {2.5, -2, 0}, hi[3] = {3.5, 2, 1};
+  std::copy(lo, lo + 3, e.box_min), std::copy(hi, hi + 3, e.box_max);
+  constexpr int kSent = 20;
+  for (int64_t k = 0; k < kSent; ++k) {
+    const auto s = wall_scan(k);
+    lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);
+    e.request_id = 100 + k;
+    lc.publish(wire::kMapEditChannel, &e);
+  }
+  auto op_stats = [&] {
+    for (const auto& c : server.query_stats())
+      if (c.client_id == "op") return c;
+    return daemon::QueryClientStats{};
+  };
+  auto scans_received = [&] {
+    int64_t n = 0;
+    for (const auto& p : server.producer_stats()) n += p.received;
+    return n;
+  };
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while ((op_stats().received < kSent || scans_received() < kSent) && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  std::thread stopper([&] { server.stop(); });
+  while (op_stats().edits_refused == 0 && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  {
+    std::lock_guard lock(m);
+    release = true;
+  }
+  cv.notify_all();
+  holder.join();
+  stopper.join();
+  int64_t scans = 0, dropped = 0;
+  for (const auto& p : server.producer_stats()) scans += p.applied + p.dropped + p.rejected, dropped += p.dropped;
+  EXPECT_EQ(scans, kSent);
+  EXPECT_GT(dropped, 0);
+  const auto op = op_stats();
+  EXPECT_EQ(op.received, kSent);
+  EXPECT_GT(op.edits_refused, 0);
+  EXPECT_EQ(op.edits_applied + op.edits_refused, op.received);
+  EXPECT_NE(op.last_error.find("stopped before applying it"), std::string::npos) << op.last_error;
 }
 
 TEST(QueryService, BadQueriesAreRefusedOrDroppedAndCounted) {

@@ -15,7 +15,19 @@ MapEditResult apply_map_edit(MapState& map, const MapEditItem& edit) {
   } else {
     const query::KeyBox box = query::key_box(tree, edit.box_min, edit.box_max);
     r.voxels = box.voxels();
-    query::clear_box(tree, box, edit.op == Msg::OP_CLEAR_TO_FREE ? query::ClearTo::kFree : query::ClearTo::kUnknown);
+    const query::ClearTo to = edit.op == Msg::OP_CLEAR_TO_FREE ? query::ClearTo::kFree : query::ClearTo::kUnknown;
+    const query::Unknown unknown = edit.include_unknown ? query::Unknown::kMarked : query::Unknown::kKept;
+    r.cost = query::estimate_clear_box(tree, box, to, unknown, edit.bounds);
+    if (r.cost.over) {
+      const bool nodes = r.cost.new_nodes > edit.bounds.max_new_nodes;
+      r.refusal = EditRefusal::kTooCostly;
+      r.error = "too costly: the edit would " +
+                (nodes ? "add more than " + std::to_string(edit.bounds.max_new_nodes) + " nodes (--max-edit-nodes)"
+                       : "take more than " + std::to_string(edit.bounds.max_work) + " node visits (--max-edit-work)") +
+                "; the map is unchanged";
+      return r;
+    }
+    query::clear_box(tree, box, to, unknown);
   }
   map.version++;
   // Deltas cannot carry an edit (a box back to unknown, a reset): mirrors resync from a snapshot.
@@ -24,6 +36,13 @@ MapEditResult apply_map_edit(MapState& map, const MapEditItem& edit) {
   r.version = map.version;
   r.map_utime = map.last_scan_utime;
   return r;
+}
+
+void refuse_map_edit(const MapEditItem& edit, EditRefusal refusal, std::string why) {
+  MapEditResult r;
+  r.refusal = refusal;
+  r.error = std::move(why);
+  if (edit.done) edit.done(r);
 }
 
 }  // namespace ort::daemon

@@ -51,6 +51,8 @@ Clock::duration ScanPipeline::longest_busy(Clock::time_point now) const {
 }
 
 bool ScanPipeline::shed_if_stale(const QueuedScan& item) {
+  // An edit is never shed for age: its sender waits for the ack, and it belongs to no producer.
+  if (item.edit) return false;
   if (max_queue_age_.count() <= 0 || Clock::now() - item.received <= max_queue_age_) return false;
   producers_.count_dropped_in_flight(item.producer, Reject::kOverLatencyBound);
   shed_++;
@@ -163,9 +165,12 @@ void ScanPipeline::apply_edit(MapEditItem& edit) {
   MapEditResult r;
   try {
     std::unique_lock lock(map_.mutex);
+    const auto locked = Clock::now();
     r = apply_map_edit(map_, edit);
+    r.locked_ms = ms_since(locked);
   } catch (const std::exception& e) {
     r.ok = false;
+    r.refusal = EditRefusal::kBadRequest;
     r.error = e.what();
   }
   map_.changed.notify_all();

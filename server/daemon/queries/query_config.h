@@ -6,6 +6,7 @@
 #include <string>
 
 #include "protocol/channels.h"
+#include "query/edit_cost.h"
 
 namespace ort::daemon {
 
@@ -25,6 +26,12 @@ struct QueryBounds {
   size_t max_reply_bytes = 16u << 20;  // a region's or grid's replies (--query-max-reply-bytes)
 };
 
+// Default edit bounds: a clear of a room's box, misaligned, even marking its unknown space,
+// stays far below them, and so does a clear of a corridor map's known space; what the bounds
+// mean in time under the lock (mapping waits meanwhile): docs/RELIABILITY.md, "Map edits".
+inline constexpr int64_t kDefaultMaxEditNewNodes = 1'000'000;
+inline constexpr int64_t kDefaultMaxEditWork = 16'000'000;
+
 struct QueryServiceConfig {
   std::string points_channel = ort::protocol::kQueryChannel;
   std::string rays_channel = ort::protocol::kQueryRaysChannel;
@@ -34,7 +41,10 @@ struct QueryServiceConfig {
   // The server's own inputs and heartbeat: a reply_channel naming one of them is refused.
   std::string scan_prefix = ort::protocol::kScanChannelPrefix;
   std::string status_channel = ort::protocol::kStatusChannel;
-  std::string control_token;          // "": every edit is refused
+  std::string control_token;  // "": every edit is refused
+  // An edit whose estimated cost passes these is refused before it starts (--max-edit-nodes,
+  // --max-edit-work): it would hold the map's exclusive lock, and mapping, that long.
+  query::EditBounds edit_bounds{kDefaultMaxEditNewNodes, kDefaultMaxEditWork};
   size_t per_client_queue = 16;       // queued queries per client; more get BUSY
   size_t max_clients = 256;           // distinct client ids tracked; the rest share "*"
   double client_idle_expiry_s = 600;  // a client idle this long gives its slot to a new one

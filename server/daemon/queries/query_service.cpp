@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "daemon/map/map_edit_item.h"
+#include "daemon/queries/edit_audit.h"
 #include "octomap_rt/map_edit_ack_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/occupancy_reply_t.hpp"
@@ -29,6 +30,17 @@ std::string lower(std::string s) {
   return s;
 }
 
+// The ack's status for what the pipeline did with an edit.
+int8_t ack_status(const MapEditResult& r) {
+  switch (r.refusal) {
+    case EditRefusal::kNone: return r.ok ? Reply::REPLY_OK : Reply::REPLY_BAD_REQUEST;
+    case EditRefusal::kBadRequest: return Reply::REPLY_BAD_REQUEST;
+    case EditRefusal::kTooCostly: return Reply::REPLY_REFUSED;
+    case EditRefusal::kNotApplied: return Reply::REPLY_NOT_READY;
+  }
+  return Reply::REPLY_BAD_REQUEST;
+}
+
 int64_t now_us() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
@@ -37,13 +49,14 @@ int64_t now_us() {
 }  // namespace
 
 QueryService::QueryService(const QueryServiceConfig& cfg, MapState& map, ScanQueue& scans, LcmLoop& loop,
-                           std::string server_id, double resolution)
+                           std::string server_id, double resolution, Log log)
     : cfg_(cfg),
       map_(map),
       scans_(scans),
       loop_(loop),
       server_id_(std::move(server_id)),
       resolution_(resolution),
+      audit_(std::move(log)),
       clients_(cfg.per_client_queue, cfg.max_clients, static_cast<int64_t>(cfg.client_idle_expiry_s * 1e6)),
       grids_(cfg.grid, cfg.bounds, map, loop, server_id_) {}
 
@@ -152,7 +165,8 @@ void QueryService::on_edit(const lcm::ReceiveBuffer& rb) {
     return;
   }
   clients_.received(msg.client_id, msg.reply_channel, now_us());
-  auto ack = [this, msg](const MapEditResult& r, int8_t status, const std::string& error) {
+  // proven: the sender showed the control token (its audit line is never rate-limited).
+  auto ack = [this, msg](const MapEditResult& r, int8_t status, const std::string& error, bool proven) {
     octomap_rt::map_edit_ack_t a;
     a.utime = now_us();
     a.request_id = msg.request_id;
@@ -165,6 +179,7 @@ void QueryService::on_edit(const lcm::ReceiveBuffer& rb) {
     a.client_id = msg.client_id;
     a.error = error;
     clients_.count(msg.client_id, status == Reply::REPLY_OK ? Count::kEditApplied : Count::kEditRefused, error);
+    audit_.record(msg, r, status, error, proven);
     loop_.publish(msg.reply_channel, a);
   };
   std::string refuse;
@@ -172,22 +187,26 @@ void QueryService::on_edit(const lcm::ReceiveBuffer& rb) {
     refuse = "map edits are off: the server was started without --control-token";
   else if (msg.token != cfg_.control_token)
     refuse = "wrong control token";
+  if (!refuse.empty()) return ack(MapEditResult{}, Reply::REPLY_REFUSED, refuse, false);
   int8_t status = Reply::REPLY_REFUSED;
-  if (refuse.empty() && msg.op != Edit::OP_CLEAR_TO_FREE && msg.op != Edit::OP_CLEAR_TO_UNKNOWN &&
-      msg.op != Edit::OP_RESET)
+  if (msg.op != Edit::OP_CLEAR_TO_FREE && msg.op != Edit::OP_CLEAR_TO_UNKNOWN && msg.op != Edit::OP_RESET)
     refuse = "unknown op " + std::to_string(msg.op), status = Reply::REPLY_BAD_REQUEST;
+  if (refuse.empty() && (msg.flags & ~Edit::FLAG_INCLUDE_UNKNOWN) != 0)
+    refuse = "unknown flags " + std::to_string(msg.flags), status = Reply::REPLY_BAD_REQUEST;
   if (refuse.empty() && msg.op != Edit::OP_RESET) {
     for (int a = 0; a < 3 && refuse.empty(); ++a)
       if (!std::isfinite(msg.box_min[a]) || !std::isfinite(msg.box_max[a]) || msg.box_min[a] > msg.box_max[a])
         refuse = "box corners must be finite with min <= max", status = Reply::REPLY_BAD_REQUEST;
   }
-  if (!refuse.empty()) return ack(MapEditResult{}, status, refuse);
+  if (!refuse.empty()) return ack(MapEditResult{}, status, refuse, true);
   auto item = std::make_shared<MapEditItem>();
   item->op = msg.op;
   std::copy(std::begin(msg.box_min), std::end(msg.box_min), item->box_min);
   std::copy(std::begin(msg.box_max), std::end(msg.box_max), item->box_max);
-  item->done = [ack](const MapEditResult& r) { ack(r, r.ok ? Reply::REPLY_OK : Reply::REPLY_BAD_REQUEST, r.error); };
-  if (!scans_.push_edit(item)) ack(MapEditResult{}, Reply::REPLY_NOT_READY, "the server is stopping");
+  item->include_unknown = (msg.flags & Edit::FLAG_INCLUDE_UNKNOWN) != 0;
+  item->bounds = cfg_.edit_bounds;
+  item->done = [ack](const MapEditResult& r) { ack(r, ack_status(r), r.error, true); };
+  if (!scans_.push_edit(item)) ack(MapEditResult{}, Reply::REPLY_NOT_READY, "the server is stopping", true);
 }
 
 bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& out) {

@@ -23,9 +23,11 @@
 #include <thread>
 #include <vector>
 
+#include "core/log.h"
 #include "daemon/intake/scan_queue.h"
 #include "daemon/map/map_state.h"
 #include "daemon/queries/grid_publisher.h"
+#include "daemon/queries/edit_audit.h"
 #include "daemon/queries/query_answers.h"
 #include "daemon/queries/query_clients.h"
 #include "daemon/queries/query_config.h"
@@ -36,8 +38,9 @@ namespace ort::daemon {
 
 class QueryService {
  public:
+  // `log` gets one audit line per map edit (who, what, box, result).
   QueryService(const QueryServiceConfig& cfg, MapState& map, ScanQueue& scans, LcmLoop& loop, std::string server_id,
-               double resolution);
+               double resolution, Log log = {});
   ~QueryService();
   // Subscribes (call before the loop starts), then start() the worker (and the grid
   // publisher); stop() joins them.
@@ -68,6 +71,7 @@ class QueryService {
   LcmLoop& loop_;
   std::string server_id_;
   double resolution_;
+  EditAudit audit_;
   QueryClients clients_;
   std::vector<LcmLoop::SubscriptionId> subs_;
   std::thread worker_;
