@@ -68,7 +68,7 @@ WireCheck check_grid_query_bytes(const uint8_t* d, size_t n) {
 }
 WireCheck check_map_edit_bytes(const uint8_t* d, size_t n) {
   return walk(d, n, kMaxInboundQueryBytes, octomap_rt::map_edit_t::getHash(),
-              {fixed(8 + 8 + 1 + 1 + 48), str(kClientId), str(kReplyChannel), str(kMaxTokenLength)});
+              {fixed(8 + 8 + 8 + 1 + 1 + 48), str(kClientId), str(kReplyChannel), fixed(32)});
 }
 
 WireCheck check_map_chunk_bytes(const uint8_t* d, size_t n) {

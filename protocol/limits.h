@@ -34,7 +34,7 @@ inline constexpr int32_t kMaxRequestedChunks = 8192;
 // Client ids: 1..63 of [A-Za-z0-9_-] (protocol/ids.h); the reply channel a client names must
 // also fit LCM's 63 characters (protocol/channels.h).
 inline constexpr size_t kMaxNameLength = 63;
-// map_edit_t.token.
+// The longest --control-token (the key of map edits' MAC; no longer on the wire).
 inline constexpr size_t kMaxTokenLength = 256;
 // Points, rays and boxes in one query message (60 KB of floats or doubles at most); clients
 // split larger requests.

@@ -12,7 +12,8 @@ repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 declare -A groups
 # Configure and build: compilers, LCM (lcm-gen), OctoMap, Vulkan + lavapipe, shaders, the libraries.
 groups[build]="cmake ninja-build g++ pkg-config liblcm-dev liblcm-bin liboctomap-dev libeigen3-dev
-  libvulkan-dev mesa-vulkan-drivers glslang-tools libjemalloc-dev libzstd-dev libgtest-dev libcli11-dev libpng-dev"
+  libvulkan-dev mesa-vulkan-drivers glslang-tools libjemalloc-dev libzstd-dev libsodium-dev libgtest-dev libcli11-dev
+  libpng-dev"
 # tools/run-demo: its network namespace (ip) and the Python planner example (client/bindings/python).
 groups[demo]="iproute2 python3 python3-numpy"
 # The tests beyond the demo's: the Python client's snapshots (zstd), the Java example and types jar,

@@ -41,7 +41,7 @@ void run_edit(const EditArgs& a, int8_t op) {
 }
 
 void add_common(CLI::App* cmd, EditArgs& a) {
-  cmd->add_option("--token", a.token, "the server's --control-token")->required();
+  cmd->add_option("--token", a.token, "the server's --control-token (signs the edit; never sent)")->required();
   cmd->add_option("--lcm-url", a.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else the host-local udpm URL)");
   add_namespace_flag(cmd, a.ns);
   cmd->add_option("--timeout", a.timeout_s, "seconds to wait for the acknowledgement")->capture_default_str();

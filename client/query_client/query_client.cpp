@@ -11,6 +11,7 @@
 #include "octomap_rt/occupancy_query_t.hpp"
 #include "octomap_rt/ray_query_t.hpp"
 #include "protocol/channels.h"
+#include "protocol/edit_mac.h"
 #include "protocol/ids.h"
 
 namespace ort::client {
@@ -176,9 +177,10 @@ octomap_rt::map_edit_ack_t QueryClient::edit(int8_t op, const Box& b, const std:
   e.flags = flags;
   std::copy(b.min, b.min + 3, e.box_min);
   std::copy(b.max, b.max + 3, e.box_max);
+  e.nonce = protocol::random_edit_nonce();
   e.client_id = client_id_;
   e.reply_channel = reply_channel_;
-  e.token = token;
+  protocol::sign_edit(e, token, channels_.map_edit);
   return exchange<octomap_rt::map_edit_ack_t>(channels_.map_edit, e, one<octomap_rt::map_edit_ack_t>).front();
 }
 

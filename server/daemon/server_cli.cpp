@@ -74,8 +74,13 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
       ->capture_default_str();
   app.add_option("--max-points", s.max_points, "largest scan accepted [points]")->capture_default_str();
   app.add_option("--control-token", s.queries.control_token,
-                 "allow map edits (octomap-rt map clear-box/reset) from requests carrying this token; without it "
-                 "every edit is refused. LCM has no authentication: the token keeps mistakes out, not attackers");
+                 "allow map edits (octomap-rt map clear-box/reset) signed with this secret (an HMAC of each edit; "
+                 "the token itself never goes on the network); at least 16 characters; without it every edit is "
+                 "refused");
+  app.add_option("--edit-window", s.queries.edit_window_s,
+                 "seconds an edit's utime may differ from the server's clock (older ones are refused as stale; "
+                 "nonces are remembered this long against replays)")
+      ->capture_default_str();
   app.add_option("--max-edit-nodes", s.queries.edit_bounds.max_new_nodes,
                  "a map edit that would add more nodes is refused before it starts (the map's exclusive lock "
                  "holds mapping while an edit runs)")
@@ -363,6 +368,12 @@ ServerConfig to_server_config(const ServerFlags& f) {
   } catch (const std::invalid_argument& e) {
     throw CLI::ValidationError("upkeep", e.what());
   }
+  if (!c.queries.control_token.empty() && c.queries.control_token.size() < 16)
+    throw CLI::ValidationError("--control-token",
+                               "must have at least 16 characters: one observed edit lets anyone test guesses of it "
+                               "offline");
+  if (!(c.queries.edit_window_s >= 1 && c.queries.edit_window_s <= 3600))
+    throw CLI::ValidationError("--edit-window", "must be a number of seconds in [1, 3600]");
   for (const auto& [value, name] : {std::pair{c.queries.edit_bounds.max_new_nodes, "--max-edit-nodes"},
                                     std::pair{c.queries.edit_bounds.max_work, "--max-edit-work"}})
     if (value < 1 || value > int64_t(1) << 40) throw CLI::ValidationError(name, "must be within 1..2^40");

@@ -34,13 +34,15 @@ def voxel_keys(points, resolution=0.1):
 
 
 class ServerTestCase(unittest.TestCase):
+    server_args = []  # more flags for the server (a test class's own)
+
     @classmethod
     def setUpClass(cls):
         cls.dir = tempfile.mkdtemp(prefix="ort-py-client-")
         cls.url = test_url(20000 + (os.getpid() * 7 + 3) % 20000)
         cls.log = open(os.path.join(cls.dir, "server.log"), "w")
         cls.server = subprocess.Popen([SERVER, "-r", "0.1", "--lcm-url", cls.url, "--backend", "cpu",
-                                       "--octomap-raw-rate", "5", "--octomap-raw-max-kib", "4096"],
+                                       "--octomap-raw-rate", "5", "--octomap-raw-max-kib", "4096"] + cls.server_args,
                                       stdout=cls.log, stderr=subprocess.STDOUT)
         cls.client = octomap_rt.MapClient(cls.url)
         cls.wait_until_listening()

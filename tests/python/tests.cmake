@@ -22,6 +22,7 @@ if(PYTHON3 AND LCM_LOGGER)
   octomap_rt_add_python_test(python_namespaces_test test_namespaces 300)
   # README's "Connect your robot": the C++ and the Python producer examples against a real server.
   octomap_rt_add_python_test(python_producers_test test_producers 300)
+  octomap_rt_add_python_test(python_edits_test test_edits 300)
 else()
   message(WARNING "octomap-rt: python3 or lcm-logger missing: the Python client tests are not registered")
 endif()

@@ -59,7 +59,7 @@ TEST(QueryStatus, CountsEachClientsQueriesAndWhyTheyWereRefused) {
     lc.publish(ort::protocol::kQueryChannel, &q);
   }
   octomap_rt::map_edit_t e{};
-  e.request_id = 50, e.client_id = "op", e.reply_channel = kReply, e.token = "x", e.op = 3;
+  e.request_id = 50, e.client_id = "op", e.reply_channel = kReply, e.op = 3;
   lc.publish(ort::protocol::kMapEditChannel, &e);
   ASSERT_EQ(replies.wait_for<octomap_rt::map_edit_ack_t>(50).status, Reply::REPLY_REFUSED);
   auto flood_done = [&] {

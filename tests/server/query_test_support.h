@@ -10,8 +10,12 @@
 
 #include <gtest/gtest.h>
 
+#include "core/clock.h"
+#include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/occupancy_query_t.hpp"
 #include "octomap_rt/occupancy_reply_t.hpp"
+#include "protocol/channels.h"
+#include "protocol/edit_mac.h"
 #include "server/scan_fixtures.h"
 
 namespace ort::test {
@@ -62,6 +66,15 @@ inline octomap_rt::occupancy_query_t point_query(int64_t id, const std::vector<f
   q.xyz = xyz;
   q.num_xyz = static_cast<int32_t>(xyz.size());
   return q;
+}
+
+inline const std::string kToken = "correct horse battery staple";
+
+// Stamps the edit now with a fresh nonce and signs it with `token` (as a client does).
+inline void sign(octomap_rt::map_edit_t& e, const std::string& token = kToken) {
+  e.utime = now_utime();
+  e.nonce = protocol::random_edit_nonce();
+  protocol::sign_edit(e, token, ort::protocol::kMapEditChannel);
 }
 
 // Scan k of robot "alpha": a wall of points at x = 3 + k (map frame), sensor at the origin.

@@ -1,4 +1,5 @@
-# client/bindings/java/: a Java program against our types jar (compiled here so it keeps up with the types).
+# client/bindings/java/: Java programs against our types jar (compiled here so they keep up with the
+# types): the status listener and a signed map edit (javax.crypto's HMAC).
 # ProtocolTable.java (channel names, limits, default URL, version) is generated from protocol/ by
 # tools/protocol-table, so the example never spells a channel name itself.
 if(TARGET octomap_rt_lcmtypes_jar)
@@ -14,7 +15,7 @@ if(TARGET octomap_rt_lcmtypes_jar)
     COMMENT "ProtocolTable.java (tools/protocol-table)"
     VERBATIM)
   add_jar(octomap_rt_java_examples
-          SOURCES ${CMAKE_CURRENT_LIST_DIR}/examples/StatusListener.java ${ORT_JAVA_TABLE}
+          SOURCES ${CMAKE_CURRENT_LIST_DIR}/examples/StatusListener.java ${CMAKE_CURRENT_LIST_DIR}/examples/MapEdit.java ${ORT_JAVA_TABLE}
           INCLUDE_JARS ${LCM_JAR} octomap_rt_lcmtypes_jar
           OUTPUT_NAME octomap_rt_java_examples)
   set(OCTOMAP_RT_JAVA_TABLE ${ORT_JAVA_TABLE} CACHE INTERNAL "generated ProtocolTable.java")

@@ -2,7 +2,7 @@
 // client: who (client id, reply channel), what (op, flags), the box as sent, and the result
 // (applied at which map state, or refused and why), so an operator can tell who changed the map.
 //
-// Edits refused before they proved the control token (edits off, wrong token or MAC) are
+// Edits refused without proof of the control token (edits off, bad MAC, replayed, stale) are
 // logged at most kUnprovenLines per kUnprovenPeriod, then one line says how many more were
 // refused: anyone on the network can send them, and the log must not grow at their rate (the
 // status counts every one of them, per client and reason).

@@ -41,7 +41,9 @@ struct QueryServiceConfig {
   // The server's own inputs and heartbeat: a reply_channel naming one of them is refused.
   std::string scan_prefix = ort::protocol::kScanChannelPrefix;
   std::string status_channel = ort::protocol::kStatusChannel;
-  std::string control_token;  // "": every edit is refused
+  std::string control_token;      // "": every edit is refused; else the key of the edits' MAC
+  double edit_window_s = 30;      // an edit's utime at most this far from the server's clock
+  size_t max_edit_nonces = 4096;  // edits admitted within the window (the replay cache's bound)
   // An edit whose estimated cost passes these is refused before it starts (--max-edit-nodes,
   // --max-edit-work): it would hold the map's exclusive lock, and mapping, that long.
   query::EditBounds edit_bounds{kDefaultMaxEditNewNodes, kDefaultMaxEditWork};

@@ -58,6 +58,7 @@ QueryService::QueryService(const QueryServiceConfig& cfg, MapState& map, ScanQue
       resolution_(resolution),
       audit_(std::move(log)),
       clients_(cfg.per_client_queue, cfg.max_clients, static_cast<int64_t>(cfg.client_idle_expiry_s * 1e6)),
+      gate_({cfg.control_token, static_cast<int64_t>(cfg.edit_window_s * 1e6), cfg.max_edit_nonces}),
       grids_(cfg.grid, cfg.bounds, map, loop, server_id_) {}
 
 QueryService::~QueryService() { stop(); }
@@ -76,8 +77,8 @@ void QueryService::open() {
   subs_.push_back(loop_.subscribe(cfg_.grid_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
     on_query<grid_query_t>(rb, protocol::check_grid_query_bytes);
   }));
-  subs_.push_back(
-      loop_.subscribe(cfg_.edit_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) { on_edit(rb); }));
+  subs_.push_back(loop_.subscribe(
+      cfg_.edit_channel, [this](const lcm::ReceiveBuffer& rb, const std::string& channel) { on_edit(rb, channel); }));
 }
 
 QueryServiceStats QueryService::service_stats() const {
@@ -154,7 +155,7 @@ void QueryService::on_query(const lcm::ReceiveBuffer& rb, protocol::WireCheck (*
   wake_.notify_one();
 }
 
-void QueryService::on_edit(const lcm::ReceiveBuffer& rb) {
+void QueryService::on_edit(const lcm::ReceiveBuffer& rb, const std::string& channel) {
   using Edit = octomap_rt::map_edit_t;
   Edit msg;
   std::string why =
@@ -182,12 +183,12 @@ void QueryService::on_edit(const lcm::ReceiveBuffer& rb) {
     audit_.record(msg, r, status, error, proven);
     loop_.publish(msg.reply_channel, a);
   };
+  const EditAdmission admission = gate_.admit(msg, channel, now_us());
+  if (!admission.admitted())
+    return ack(MapEditResult{},
+               admission.refusal == EditGateRefusal::kTooMany ? Reply::REPLY_BUSY : Reply::REPLY_REFUSED, admission.why,
+               admission.authenticated());
   std::string refuse;
-  if (cfg_.control_token.empty())
-    refuse = "map edits are off: the server was started without --control-token";
-  else if (msg.token != cfg_.control_token)
-    refuse = "wrong control token";
-  if (!refuse.empty()) return ack(MapEditResult{}, Reply::REPLY_REFUSED, refuse, false);
   int8_t status = Reply::REPLY_REFUSED;
   if (msg.op != Edit::OP_CLEAR_TO_FREE && msg.op != Edit::OP_CLEAR_TO_UNKNOWN && msg.op != Edit::OP_RESET)
     refuse = "unknown op " + std::to_string(msg.op), status = Reply::REPLY_BAD_REQUEST;

@@ -4,8 +4,9 @@
 // LCM thread (handlers on the server's LcmLoop): wire bounds before decode, decode, checks;
 // a query that names a usable client and reply channel and fails a check gets a
 // BAD_REQUEST reply saying why; one that does not is dropped; both are counted. Valid
-// queries go to their client's bounded queue (full: BUSY reply). Edits are checked against
-// --control-token and queued into the scan pipeline, so they apply in order with the scans.
+// queries go to their client's bounded queue (full: BUSY reply). Edits must carry the MAC of
+// --control-token (EditGate: also the time window and a new nonce) and are queued into the
+// scan pipeline, so they apply in order with the scans; each is acked and audited.
 //
 // Worker thread: clients in turn; a query waits (parked, up to its timeout) until the map
 // state is >= min_snapshot_id and the robot's wait_seq was applied (read-your-writes), then
@@ -26,8 +27,9 @@
 #include "core/log.h"
 #include "daemon/intake/scan_queue.h"
 #include "daemon/map/map_state.h"
-#include "daemon/queries/grid_publisher.h"
 #include "daemon/queries/edit_audit.h"
+#include "daemon/queries/edit_gate.h"
+#include "daemon/queries/grid_publisher.h"
 #include "daemon/queries/query_answers.h"
 #include "daemon/queries/query_clients.h"
 #include "daemon/queries/query_config.h"
@@ -56,7 +58,7 @@ class QueryService {
  private:
   template <class Message>
   void on_query(const lcm::ReceiveBuffer& rb, protocol::WireCheck (*check)(const uint8_t*, size_t));
-  void on_edit(const lcm::ReceiveBuffer& rb);
+  void on_edit(const lcm::ReceiveBuffer& rb, const std::string& channel);
   // "" when client_id and reply_channel are usable for a reply.
   std::string check_addressing(const std::string& client, const std::string& channel) const;
   void run();
@@ -73,6 +75,7 @@ class QueryService {
   double resolution_;
   EditAudit audit_;
   QueryClients clients_;
+  EditGate gate_;  // the LCM thread's: MAC, time window, nonces
   std::vector<LcmLoop::SubscriptionId> subs_;
   std::thread worker_;
   GridPublisher grids_;

@@ -5,7 +5,7 @@ import time
 from typing import Optional, Sequence
 
 from ._types import map_info_t, scan_t, server_status_t
-from . import queries
+from . import edits, queries
 from .bt_reader import BtMap, read_bt
 from .snapshot_fetch import Snapshot, fetch_snapshot, new_client_id
 from .transport import open_transport
@@ -112,6 +112,25 @@ class MapClient:
     def grid(self, z_min: float, z_max: float, cell_size: float = 0.0, window=None, min_snapshot_id: int = 0):
         """The 2D occupancy grid of a z band: (cells [row, column] int8, origin (x, y), cell size)."""
         return queries.grid(self.queries, z_min, z_max, cell_size, window, min_snapshot_id)
+
+    def clear_box(self, box, token: str, to: str = "free", include_unknown: bool = False):
+        """Clears the box (min x y z, max x y z) [m] on the server: to "free" (its known voxels;
+        with include_unknown its never-seen ones too) or to "unknown". `token` is the server's
+        --control-token: it signs the edit and is never sent. Returns the map_edit_ack_t (its
+        snapshot_id: from that map state on the map holds the edit); raises QueryError if refused."""
+        if to not in ("free", "unknown"):
+            raise ValueError("to must be 'free' or 'unknown'")
+        op = edits.map_edit_t.OP_CLEAR_TO_FREE if to == "free" else edits.map_edit_t.OP_CLEAR_TO_UNKNOWN
+        flags = edits.map_edit_t.FLAG_INCLUDE_UNKNOWN if include_unknown else 0
+        return self.editor(token).edit(op, [float(v) for v in box], flags)
+
+    def reset_map(self, token: str):
+        """Empties the server's map (signed with `token`, as clear_box)."""
+        return self.editor(token).edit(edits.map_edit_t.OP_RESET)
+
+    def editor(self, token: str) -> edits.MapEditor:
+        """A MapEditor on this client's transport and id (for edits one by one, or raw bytes)."""
+        return edits.MapEditor(self.transport, self.client_id, token, channels=self.channels)
 
     def publish_scan(self, points, robot_id: str, origin: Sequence[float] = (0.0, 0.0, 0.0),
                      orientation: Sequence[float] = (1.0, 0.0, 0.0, 0.0), points_in_map_frame: bool = False,
