@@ -17,9 +17,9 @@ groups[build]="cmake ninja-build g++ pkg-config liblcm-dev liblcm-bin liboctomap
 # tools/run-demo: its network namespace (ip) and the Python planner example (client/bindings/python).
 groups[demo]="iproute2 python3 python3-numpy"
 # The tests beyond the demo's: the Python client's snapshots (zstd), the Java example and types jar,
-# gnuplot for the bench's charts, bzip2 for the data sets' sources (scan.dat.bz2), octomap-tools for
+# libdynamicedt3d-dev for distance_test's DynamicEDTOctomap check, gnuplot for the bench's charts, bzip2 for the data sets' sources (scan.dat.bz2), octomap-tools for
 # graph2tree (the peak-memory benchmark measures it beside octomap-rt build: issue 25).
-groups[tests]="python3-zstandard liblcm-java default-jdk-headless bzip2 gnuplot-nox octomap-tools"
+groups[tests]="python3-zstandard liblcm-java default-jdk-headless bzip2 gnuplot-nox octomap-tools libdynamicedt3d-dev"
 # The libFuzzer targets (tests/fuzz/, run by tools/run-tests).
 groups[fuzz]="clang-14 libclang-rt-14-dev"
 # The format check of every C++ file (tools/check-format, run by tools/run-tests).
