@@ -4,7 +4,7 @@
 set(ORT_IT_DIR ${CMAKE_CURRENT_LIST_DIR})
 add_library(octomap_rt_integration_harness STATIC ${CMAKE_CURRENT_LIST_DIR}/integration_harness.cpp)
 target_include_directories(octomap_rt_integration_harness PUBLIC ${CMAKE_CURRENT_LIST_DIR})
-target_link_libraries(octomap_rt_integration_harness PUBLIC octomap_rt_lcmtypes octomap_rt_test_support GTest::gtest)
+target_link_libraries(octomap_rt_integration_harness PUBLIC octomap_rt_protocol octomap_rt_lcmtypes octomap_rt_test_support GTest::gtest)
 octomap_rt_lcm_handler_sources(octomap_rt_integration_harness ${CMAKE_CURRENT_LIST_DIR}/integration_harness.cpp)
 target_compile_definitions(octomap_rt_integration_harness PRIVATE
   OCTOMAP_RT_SERVER="$<TARGET_FILE:octomap-rt-server>" OCTOMAP_RT_CLI="$<TARGET_FILE:octomap-rt>")
