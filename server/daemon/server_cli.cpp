@@ -222,7 +222,7 @@ void add_point_filter_flags(CLI::App& app, PointFilters& f) {
 }
 
 void add_grid_flags(CLI::App& app, GridPublishConfig& g) {
-  auto* z = app.add_option_function<std::string>(
+  app.add_option_function<std::string>(
       "--grid-z",
       [&g](const std::string& v) {
         const size_t colon = v.find(':');
@@ -232,6 +232,7 @@ void add_grid_flags(CLI::App& app, GridPublishConfig& g) {
           g.z_min = std::stod(v.substr(0, colon), &used);
           if (used != colon) throw std::invalid_argument("trailing text");
           g.z_max = std::stod(v.substr(colon + 1), &used);
+          g.z_given = true;
           if (used != v.size() - colon - 1) throw std::invalid_argument("trailing text");
         } catch (const std::exception&) {
           throw CLI::ValidationError("--grid-z", "'" + v + "' is not MIN:MAX in metres (e.g. 0.1:1.5)");
@@ -242,7 +243,6 @@ void add_grid_flags(CLI::App& app, GridPublishConfig& g) {
                  std::string("publish the 2D grid of the --grid-z band (projected_map rule, grid_t rows) on ") +
                      ort::protocol::kGridChannel + " at this rate [Hz]; 0: off")
       ->check(CLI::Range(0.0, 50.0))
-      ->needs(z)
       ->capture_default_str();
   app.add_option("--grid-cell", g.cell_size,
                  "cell size of the published grid [m], a multiple of the resolution; 0: "
@@ -353,6 +353,9 @@ ServerConfig to_server_config(const ServerFlags& f) {
   if (!(c.chunk_interval_ms >= 0)) throw CLI::ValidationError("--chunk-interval-ms", "must be >= 0");
   if (const std::string bad = check_point_filters(c.point_filters); !bad.empty())
     throw CLI::ValidationError("--pointcloud-*/--sensor-*/--min-range", bad);
+  // A rate of 0 (the default, also as --print-config writes it) needs no band; a rate above 0 does.
+  if (c.queries.grid.rate_hz > 0 && !c.queries.grid.z_given)
+    throw CLI::ValidationError("--grid-rate", "requires --grid-z");
   if (c.queries.grid.rate_hz > 0) {  // the rule of grid queries (daemon/query_answers)
     octomap_rt::grid_query_t q{};
     q.z_min = c.queries.grid.z_min, q.z_max = c.queries.grid.z_max, q.cell_size = c.queries.grid.cell_size;

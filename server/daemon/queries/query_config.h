@@ -14,6 +14,7 @@ namespace ort::daemon {
 struct GridPublishConfig {
   double rate_hz = 0;           // 0: not published
   double z_min = 0, z_max = 0;  // the band [m]
+  bool z_given = false;         // --grid-z was given: a rate above 0 needs it
   double cell_size = 0;         // [m]; 0: the resolution; else a multiple of it
   std::string channel = ort::protocol::kGridChannel;
 };
