@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <regex>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -316,7 +317,21 @@ std::string parse_server_flags(CLI::App& app, int argc, const char* const* argv)
   return "";
 }
 
-std::string effective_config(const CLI::App& app) { return app.config_to_str(/*default_also=*/true, false); }
+// An option left at a default that has no text (the filters' open limits, empty strings) is left out: read
+// back, it takes the same built-in default, where `key=""` would be read as the number 0.
+std::string effective_config(const CLI::App& app) {
+  std::istringstream in(app.config_to_str(/*default_also=*/true, false));
+  std::string out, line;
+  while (std::getline(in, line)) {
+    const size_t eq = line.find('=');
+    if (eq != std::string::npos && line.compare(eq, std::string::npos, "=\"\"") == 0) {
+      const CLI::Option* given = app.get_option_no_throw("--" + line.substr(0, eq));
+      if (given == nullptr || given->count() == 0) continue;
+    }
+    out += line + "\n";
+  }
+  return out;
+}
 
 ServerConfig to_server_config(const ServerFlags& f) {
   ServerConfig c = f.server;
