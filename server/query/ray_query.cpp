@@ -44,12 +44,14 @@ RayAnswer cast_ray(const octomap::OcTree& tree, const octomap::point3d& origin, 
 uint64_t ray_walk_bound(const octomap::OcTree& tree, const octomap::point3d& direction, const RayBatchOptions& opt) {
   const uint64_t edge = 3ull << tree.getTreeDepth();  // every key of the range, on each axis
   const double norm = direction.norm();
-  if (!(opt.max_range > 0) || !(norm > 0)) return edge;
+  // An infinite or NaN direction or range (a query field, unchecked here) has no walk bound of
+  // its own: the whole key range is the bound, never a float-to-integer cast of NaN.
+  if (!(opt.max_range > 0) || !(norm > 0) || !std::isfinite(norm) || !std::isfinite(opt.max_range)) return edge;
   // The DDA steps once per voxel boundary crossed: |d|_1 / |d|_2 * range / resolution per
   // ray, plus the start voxel and one boundary per axis at each end.
   const double l1 = std::abs(direction.x()) + std::abs(direction.y()) + std::abs(direction.z());
   const double steps = l1 / norm * opt.max_range / tree.getResolution() + 4;
-  return steps >= static_cast<double>(edge) ? edge : static_cast<uint64_t>(steps);
+  return !(steps < static_cast<double>(edge)) ? edge : static_cast<uint64_t>(steps);
 }
 
 std::vector<RayAnswer> cast_rays(const octomap::OcTree& tree, std::span<const float> origins,

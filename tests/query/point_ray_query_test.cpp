@@ -2,6 +2,7 @@
 // castRay) for thousands of random queries on real maps, and a wrong rule is caught.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "query/point_query.h"
@@ -134,6 +135,24 @@ TEST(RayQuery, RefusesRaysCastRayCannotCast) {
   EXPECT_FALSE(far.hit);
   EXPECT_EQ(far.end, octomap::point3d(1e6f, 0, 0));
   EXPECT_EQ(far.end_state, VoxelState::kUnknown);
+}
+
+TEST(RayQuery, WalkBoundIsTheKeyRangeForNonFiniteFields) {
+  // A query's direction or range may be inf or NaN (the fuzzer found inf/inf = NaN cast to an
+  // integer); the bound is then the whole key range, and a finite ray's bound stays below it.
+  const octomap::OcTree& t = *query_test_maps()[0].tree;
+  const uint64_t edge = 3ull << t.getTreeDepth();
+  query::RayBatchOptions opt;
+  opt.max_range = 5;
+  EXPECT_EQ(query::ray_walk_bound(t, {INFINITY, 1, 0}, opt), edge);
+  EXPECT_EQ(query::ray_walk_bound(t, {NAN, 1, 0}, opt), edge);
+  EXPECT_EQ(query::ray_walk_bound(t, {1e30f, 1e30f, 1e30f}, opt), edge);  // the norm overflows in float
+  opt.max_range = INFINITY;
+  EXPECT_EQ(query::ray_walk_bound(t, {1, 0, 0}, opt), edge);
+  opt.max_range = NAN;
+  EXPECT_EQ(query::ray_walk_bound(t, {1, 0, 0}, opt), edge);
+  opt.max_range = 1;
+  EXPECT_LT(query::ray_walk_bound(t, {1, 0, 0}, opt), edge);
 }
 
 }  // namespace
