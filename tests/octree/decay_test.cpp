@@ -15,6 +15,7 @@
 #include "engine/map_engine.h"
 #include "octree/decay.h"
 #include "octree/octree_update.h"
+#include "real_scan_voxels.h"
 #include "scene/scan_set.h"
 #include "support/test_data.h"
 #include "tree_checks.h"
@@ -44,25 +45,6 @@ std::unique_ptr<octomap::OcTree> reference_decay(const octomap::OcTree& in, floa
 }
 
 std::unique_ptr<octomap::OcTree> copy_of(const octomap::OcTree& t) { return std::make_unique<octomap::OcTree>(t); }
-
-std::vector<VoxelList> shoot_lists(const std::string& graph, size_t max_scans) {
-  const std::string path = test::data_file(graph);
-  if (path.empty()) return {};
-  const ScanSet set = load_scan_graph(path);
-  EngineOptions opts;
-  opts.resolution = 0.1;
-  opts.backend.kind = BackendKind::kCpu;
-  MapEngine engine(opts);
-  std::vector<VoxelList> lists;
-  for (size_t i = 0; i < set.scans.size() && i < max_scans; ++i) {
-    const octomap::Pointcloud world = world_points(set.scans[i]);
-    ShotScan shot;
-    engine.shoot(sensor_origin(set.scans[i]), std::span<const octomap::point3d>(&world[0], world.size()),
-                 opts.max_range, shot);
-    lists.push_back(std::move(shot.voxels));
-  }
-  return lists;
-}
 
 TEST(Decay, FactorIsTheHalfLifeRule) {
   EXPECT_EQ(decay_factor(10, 10), 0.5f);
@@ -104,7 +86,7 @@ TEST(Decay, RealFr079MapEqualsTheRuleOnOctomapsTree) {
 // Scans and decay steps interleaved: the octree stage's batched update and decay give the
 // tree that OctoMap's updateNode loop and the rule on OctoMap's tree give, after every step.
 void check_scans_and_steps(const std::string& graph, size_t scans, unsigned region_depth) {
-  const std::vector<VoxelList> lists = shoot_lists(graph, scans);
+  const std::vector<VoxelList> lists = test::shoot_real_scans(graph, scans);
   ASSERT_FALSE(lists.empty());
   auto reference = std::make_unique<octomap::OcTree>(0.1);
   octomap::OcTree tree(0.1);

@@ -16,6 +16,7 @@
 #include "octree/octree_update.h"
 #include "octree/region_codec.h"
 #include "octree/region_residency.h"
+#include "real_scan_voxels.h"
 #include "scene/scan_set.h"
 #include "support/test_data.h"
 #include "tree_checks.h"
@@ -37,27 +38,8 @@ std::string ot_bytes(const octomap::OcTree& t) {
   return os.str();
 }
 
-std::vector<VoxelList> shoot_lists(const std::string& graph, size_t max_scans) {
-  const std::string path = test::data_file(graph);
-  if (path.empty()) return {};
-  const ScanSet set = load_scan_graph(path);
-  EngineOptions opts;
-  opts.resolution = 0.1;
-  opts.backend.kind = BackendKind::kCpu;
-  MapEngine engine(opts);
-  std::vector<VoxelList> lists;
-  for (size_t i = 0; i < set.scans.size() && i < max_scans; ++i) {
-    const octomap::Pointcloud world = world_points(set.scans[i]);
-    ShotScan shot;
-    engine.shoot(sensor_origin(set.scans[i]), std::span<const octomap::point3d>(&world[0], world.size()),
-                 opts.max_range, shot);
-    lists.push_back(std::move(shot.voxels));
-  }
-  return lists;
-}
-
 TEST(Eviction, RegionBytesRoundTripAndRefuseDamage) {
-  const std::vector<VoxelList> lists = shoot_lists("3dtk_dat/3dtk_3scans.graph", 1);
+  const std::vector<VoxelList> lists = test::shoot_real_scans("3dtk_dat/3dtk_3scans.graph", 1);
   ASSERT_FALSE(lists.empty());
   octomap::OcTree tree(0.1);
   apply_updates_sequential(tree, lists[0]);
@@ -86,7 +68,7 @@ TEST(Eviction, RegionBytesRoundTripAndRefuseDamage) {
 // Scans applied under a bound a third of the final map's memory: regions go and come back
 // all the time; at the end, everything back, the map is the map without the bound.
 void check_bounded_build(const std::string& graph, size_t scans) {
-  const std::vector<VoxelList> lists = shoot_lists(graph, scans);
+  const std::vector<VoxelList> lists = test::shoot_real_scans(graph, scans);
   ASSERT_FALSE(lists.empty());
   octomap::OcTree unbounded(0.1);
   OctreeStage stage(OctreeUpdateOptions{OctreeUpdateMode::kBatched, 2});

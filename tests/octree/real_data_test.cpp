@@ -12,31 +12,13 @@
 
 #include "engine/map_engine.h"
 #include "octree/batched/batched_update.h"
+#include "real_scan_voxels.h"
 #include "scene/scan_set.h"
 #include "support/test_data.h"
 #include "tree_checks.h"
 
 namespace ort {
 namespace {
-
-std::vector<VoxelList> shoot_lists(const std::string& graph, size_t max_scans) {
-  const std::string path = test::data_file(graph);
-  if (path.empty()) return {};
-  const ScanSet set = load_scan_graph(path);
-  EngineOptions opts;
-  opts.resolution = 0.1;
-  opts.backend.kind = BackendKind::kCpu;
-  MapEngine engine(opts);
-  std::vector<VoxelList> lists;
-  for (size_t i = 0; i < set.scans.size() && i < max_scans; ++i) {
-    const octomap::Pointcloud world = world_points(set.scans[i]);
-    ShotScan shot;
-    engine.shoot(sensor_origin(set.scans[i]), std::span<const octomap::point3d>(&world[0], world.size()),
-                 opts.max_range, shot);
-    lists.push_back(std::move(shot.voxels));
-  }
-  return lists;
-}
 
 std::string ot_bytes(const octomap::OcTree& t) {
   std::ostringstream os;
@@ -51,7 +33,7 @@ std::string bt_bytes(const octomap::OcTree& t) {
 
 void check_data_set(const std::string& graph) {
   const bool quick = test::quick_mode();
-  const std::vector<VoxelList> lists = shoot_lists(graph, quick ? 1 : 1000);
+  const std::vector<VoxelList> lists = test::shoot_real_scans(graph, quick ? 1 : 1000);
   ASSERT_FALSE(lists.empty()) << graph;
   const int passes = quick ? 2 : 3;  // the scans, then replayed: saturation and pruning
 

@@ -11,7 +11,7 @@ octomap_rt_add_test(octree_test
           ${CMAKE_CURRENT_LIST_DIR}/leaf_changes_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/full_blocks_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/worker_pool_test.cpp
-          ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp
+          ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp ${CMAKE_CURRENT_LIST_DIR}/real_scan_voxels.cpp
   TIMEOUT 900)
 
 # Regions, the subtrees at one depth that decay, clearing and eviction work on (octree/region.h),
@@ -23,12 +23,12 @@ octomap_rt_add_test(region_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/region_test.cp
 # decay steps between them, whole sweeps and sweeps in slices.
 octomap_rt_add_test(forgetting_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/decay_test.cpp ${CMAKE_CURRENT_LIST_DIR}/distance_clearing_test.cpp
-          ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp
+          ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp ${CMAKE_CURRENT_LIST_DIR}/real_scan_voxels.cpp
   TIMEOUT 300)
 
 # The memory bound's spill and restore on real scans: a map built with regions spilled and
 # brought back is, once everything is back, the map built without the bound.
-octomap_rt_add_test(eviction_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/eviction_test.cpp ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp
+octomap_rt_add_test(eviction_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/eviction_test.cpp ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp ${CMAKE_CURRENT_LIST_DIR}/real_scan_voxels.cpp
   TIMEOUT 300)
 
 set_property(TEST octree_test region_test forgetting_test eviction_test APPEND PROPERTY LABELS data)
