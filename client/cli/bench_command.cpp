@@ -13,6 +13,7 @@
 
 #include "cli/bench/bench_plot.h"
 #include "cli/bench/bench_results.h"
+#include "cli/bench/octomap_reference.h"
 #include "cli/bench/process_memory.h"
 #include "cli/commands.h"
 #include "cli/map_summary.h"
@@ -26,7 +27,7 @@ namespace ort::cli {
 namespace {
 
 using bench::BenchRow;
-using Clock = std::chrono::steady_clock;
+using Clock = SteadyClock;
 
 struct BenchArgs {
   std::vector<std::string> presets = {"fr079", "campus", "skt-corridor"};
@@ -49,90 +50,12 @@ struct BenchArgs {
   std::vector<std::string> replot;
 };
 
-// The same leaves in the same order, with the same depth and log-odds: the trees are equal
-// node for node at the leaves (pruning included). Both iterate depth first in child order.
-bool same_leaves(const octomap::OcTree& a, const octomap::OcTree& b) {
-  if (a.getNumLeafNodes() != b.getNumLeafNodes()) return false;
-  auto ia = a.begin_leafs(), ea = a.end_leafs();
-  auto ib = b.begin_leafs(), eb = b.end_leafs();
-  for (; ia != ea && ib != eb; ++ia, ++ib) {
-    if (ia.getDepth() != ib.getDepth() || ia.getKey() != ib.getKey() || ia->getLogOdds() != ib->getLogOdds())
-      return false;
-  }
-  return ia == ea && ib == eb;
-}
-
 double diff_pct(uint64_t ours, uint64_t theirs) {
   return theirs ? 100.0 * (double(ours) - double(theirs)) / double(theirs) : 0.0;
 }
 
 std::span<const octomap::point3d> as_span(const octomap::Pointcloud& pc) {
   return {pc.size() ? &pc[0] : nullptr, pc.size()};
-}
-
-struct Reference {
-  BenchRow row;
-  std::unique_ptr<octomap::OcTree> tree;
-  MapSummary summary;
-};
-
-// OctoMap itself: insertPointCloud(world points, pose translation, max range, lazy_eval =
-// false, discretize = false), scan after scan, as the parity tests build it.
-Reference run_octomap(const ScanSet& set, const BenchRow& base, const BenchArgs& a) {
-  const double res = base.resolution;
-  Reference ref;
-  BenchRow& r = ref.row;
-  r = base;
-  r.backend = "octomap";
-  r.device = "CPU (OctoMap 1.9.7 insertPointCloud, 1 thread)";
-  r.traversal = "octomap";
-  r.octree = "updateNode";
-  const size_t warm = std::min<size_t>(a.warmup, set.scans.size());
-  {  // warm-up on a throw-away tree, as for the engine runs
-    octomap::OcTree scratch(res);
-    for (size_t i = 0; i < warm; ++i)
-      scratch.insertPointCloud(world_points(set.scans[i]), sensor_origin(set.scans[i]), a.max_range, false, false);
-  }
-  std::vector<std::pair<double, double>> runs;  // (total, transform)
-  for (int rep = 0; rep < a.repeat; ++rep) {
-    auto tree = std::make_unique<octomap::OcTree>(res);
-    double transform_ms = 0;
-    const auto t0 = Clock::now();
-    for (const PosedScan& s : set.scans) {
-      const auto tt = Clock::now();
-      const octomap::Pointcloud world = world_points(s);
-      transform_ms += ms_since(tt);
-      tree->insertPointCloud(world, sensor_origin(s), a.max_range, false, false);
-    }
-    runs.push_back({ms_since(t0), transform_ms});
-    if (rep + 1 == a.repeat) ref.tree = std::move(tree);
-  }
-  std::sort(runs.begin(), runs.end());
-  r.total_ms = runs[runs.size() / 2].first;
-  r.prepare_ms = runs[runs.size() / 2].second;
-  // Ray keys + KeySets alone (computeUpdate), so that OctoMap's bar splits like Fig. 6.
-  if (!a.no_octomap_breakdown) {
-    octomap::OcTree keys_only(res);
-    for (const PosedScan& s : set.scans) {
-      const octomap::Pointcloud world = world_points(s);
-      octomap::KeySet free_cells, occupied_cells;
-      const auto t = Clock::now();
-      keys_only.computeUpdate(world, sensor_origin(s), free_cells, occupied_cells, a.max_range);
-      r.shoot_ms += ms_since(t);
-    }
-  }
-  r.octree_ms = std::max(0.0, r.total_ms - r.prepare_ms - r.shoot_ms);
-  ref.summary = summarize(*ref.tree);
-  r.free_voxels = r.octomap_free = ref.summary.finest_free;
-  r.occupied_voxels = r.octomap_occupied = ref.summary.finest_occupied;
-  r.counts_equal = r.map_identical = "reference";
-  r.tree_bytes = ref.tree->memoryUsage();
-  r.rss_bytes = current_rss_bytes();
-  r.peak_rss_bytes = peak_rss_bytes();
-  r.octomap_total_ms = r.total_ms;
-  r.speedup = 1.0;
-  r.points_per_s = r.total_ms > 0 ? r.points / (r.total_ms / 1000.0) : 0.0;
-  return ref;
 }
 
 // (back end, preparation) pairs to measure: only vulkan prepares on its device, so other
@@ -147,7 +70,8 @@ std::vector<std::pair<std::string, std::string>> backend_configs(const BenchArgs
   return out;
 }
 
-void run_engine(const ScanSet& set, const EngineOptions& opts, const BenchArgs& a, const Reference& ref, BenchRow& r) {
+void run_engine(const ScanSet& set, const EngineOptions& opts, const BenchArgs& a, const bench::OctomapReference& ref,
+                BenchRow& r) {
   MapEngine engine(opts);  // the device is in the row; the creation notes are not wanted here
   r.device = engine.backend().device_name();
   const size_t warm = std::min<size_t>(a.warmup, set.scans.size());
@@ -194,7 +118,7 @@ void run_engine(const ScanSet& set, const EngineOptions& opts, const BenchArgs& 
   r.occupied_diff_pct = diff_pct(s.finest_occupied, ref.summary.finest_occupied);
   r.counts_equal =
       (s.finest_free == ref.summary.finest_free && s.finest_occupied == ref.summary.finest_occupied) ? "yes" : "no";
-  r.map_identical = same_leaves(*tree, *ref.tree) ? "yes" : "no";
+  r.map_identical = bench::same_leaves(*tree, *ref.tree) ? "yes" : "no";
   r.tree_bytes = tree->memoryUsage();
   r.rss_bytes = current_rss_bytes();
   r.peak_rss_bytes = peak_rss_bytes();
@@ -289,7 +213,8 @@ int run_bench(const BenchArgs& a) {
       base.warmup_scans = std::min<int>(a.warmup, int(set->scans.size()));
       base.repeats = a.repeat;
       std::fprintf(stderr, "  %s @ %.2f m: OctoMap insertPointCloud ...", name.c_str(), res);
-      Reference ref = run_octomap(*set, base, a);
+      bench::OctomapReference ref =
+          bench::run_octomap(*set, base, {a.warmup, a.repeat, a.max_range, !a.no_octomap_breakdown});
       const BenchRow& oct = ref.row;
       rows.push_back(oct);
       std::fprintf(stderr, " %.2f s\n", oct.total_ms / 1000.0);
