@@ -59,21 +59,25 @@ size_t ProducerRegistry::idle_slot(Clock::time_point now) const {
   return best;
 }
 
+void add_counts(ProducerStats& into, const ProducerStats& from) {
+  into.received += from.received;
+  into.applied += from.applied;
+  into.rejected += from.rejected;
+  into.dropped += from.dropped;
+  into.missed += from.missed;
+  into.points_applied += from.points_applied;
+  into.seq_restarts += from.seq_restarts;
+  for (size_t k = 0; k < kRejectReasonCount; ++k) {
+    into.rejects[k] += from.rejects[k];
+    into.drop_reasons[k] += from.drop_reasons[k];
+  }
+  for (size_t k = 0; k < kPointDropReasonCount; ++k) into.point_drops[k] += from.point_drops[k];
+}
+
 void ProducerRegistry::release(size_t slot) {
   ProducerStats& r = producers_[special_entry(released_index_, "-", "(released: idle)")];
   ProducerStats& p = producers_[slot];
-  r.received += p.received;
-  r.applied += p.applied;
-  r.rejected += p.rejected;
-  r.dropped += p.dropped;
-  r.missed += p.missed;
-  r.points_applied += p.points_applied;
-  r.seq_restarts += p.seq_restarts;
-  for (size_t k = 0; k < kRejectReasonCount; ++k) {
-    r.rejects[k] += p.rejects[k];
-    r.drop_reasons[k] += p.drop_reasons[k];
-  }
-  for (size_t k = 0; k < kPointDropReasonCount; ++k) r.point_drops[k] += p.point_drops[k];
+  add_counts(r, p);
   r.released++;
   by_channel_.erase(p.channel);
   p = ProducerStats{};

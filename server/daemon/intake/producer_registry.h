@@ -40,6 +40,10 @@ struct ProducerStats {
   PointDropCounts point_drops{};  // points of applied scans that gave no ray, by reason (NaN no-returns, ...)
 };
 
+// The counters of `from` (received ... point drops, not the ids, in-flight or last-scan
+// fields) added to `into`: how a released slot folds into the "released" entry.
+void add_counts(ProducerStats& into, const ProducerStats& from);
+
 struct ProducerPolicy {
   size_t max_producers = 64;
   // A producer with no message for this long (and nothing in flight) gives its slot to a

@@ -27,12 +27,13 @@ octomap_rt::query_client_stats_t client_message(const QueryClientStats& c) {
   return m;
 }
 
-// The reasons counted at least once, by name, in the order of Reject; returns how many.
-int32_t add_reasons(const std::array<int64_t, kRejectReasonCount>& counted, std::vector<std::string>& names,
+// The reasons counted at least once, by name, in the order of their enum; returns how many.
+template <typename Reason, size_t N>
+int32_t add_reasons(const std::array<int64_t, N>& counted, std::vector<std::string>& names,
                     std::vector<int64_t>& counts) {
-  for (size_t k = 0; k < kRejectReasonCount; ++k) {
+  for (size_t k = 0; k < N; ++k) {
     if (counted[k] == 0) continue;
-    names.push_back(to_string(static_cast<Reject>(k)));
+    names.push_back(to_string(static_cast<Reason>(k)));
     counts.push_back(counted[k]);
   }
   return static_cast<int32_t>(names.size());
@@ -51,15 +52,10 @@ octomap_rt::robot_stats_t robot_message(const ProducerStats& p, int64_t queue_by
   r.queue_depth = static_cast<int32_t>(p.in_flight);
   r.queue_bytes = queue_bytes;
   r.last_end_to_end_ms = static_cast<float>(p.last_end_to_end_ms);
-  r.num_reject_reasons = add_reasons(p.rejects, r.reject_reason, r.reject_count);
-  r.num_drop_reasons = add_reasons(p.drop_reasons, r.drop_reason, r.drop_count);
+  r.num_reject_reasons = add_reasons<Reject>(p.rejects, r.reject_reason, r.reject_count);
+  r.num_drop_reasons = add_reasons<Reject>(p.drop_reasons, r.drop_reason, r.drop_count);
+  r.num_point_drop_reasons = add_reasons<PointDrop>(p.point_drops, r.point_drop_reason, r.point_drop_count);
   r.seq_restarts = p.seq_restarts;
-  for (size_t k = 0; k < kPointDropReasonCount; ++k) {
-    if (p.point_drops[k] == 0) continue;
-    r.point_drop_reason.push_back(to_string(static_cast<PointDrop>(k)));
-    r.point_drop_count.push_back(p.point_drops[k]);
-  }
-  r.num_point_drop_reasons = static_cast<int32_t>(r.point_drop_reason.size());
   r.robot_id = p.robot_id;
   r.channel = p.channel;
   return r;
