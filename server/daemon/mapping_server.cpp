@@ -134,6 +134,10 @@ void MappingServer::start() {
   pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, log_, cfg_.pipeline,
                                              std::chrono::duration<double>(cfg_.latency_bound_s), cfg_.point_filters);
   pipeline_->set_cost_bounds(cfg_.scan_costs);
+  pipeline_->set_shard(ShardFilter(cfg_.shard));
+  if (cfg_.shard.sharded())
+    log_.info(text("shard ", cfg_.shard.index, " of ", cfg_.shard.count, " (", protocol::to_string(cfg_.shard.rule),
+                   " rule, regions at depth ", cfg_.shard.region_depth, "): only their voxels are mapped"));
   pipeline_->start();
   upkeep_ = std::make_unique<MapUpkeep>(map_, cfg_.upkeep, log_);
   upkeep_->start();

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "daemon/queries/query_answers.h"
+#include "daemon/shard_flags.h"
 #include "protocol/channels.h"
 #include "protocol/ids.h"
 #include "protocol/lcm_url.h"
@@ -93,6 +94,7 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
       ->capture_default_str();
   add_grid_flags(app, s.queries.grid);
   add_point_filter_flags(app, s.point_filters);
+  add_shard_flags(app, f.shard);
   app.add_option("--query-max-work", s.queries.bounds.max_work,
                  "most nodes a query may visit or key steps its rays may walk; past it a ray or box query "
                  "is cut (its reply says where), a region or grid refused")
@@ -335,8 +337,11 @@ std::string effective_config(const CLI::App& app) {
 
 ServerConfig to_server_config(const ServerFlags& f) {
   ServerConfig c = f.server;
-  apply_namespace(c, protocol::namespace_from(f.ns));
+  const std::string ns = protocol::namespace_from(f.ns);
   c.engine = ort::cli::to_engine_options(f.engine);
+  c.shard = to_shard_set(f.shard, c.engine.resolution);
+  apply_namespace(c, c.shard.sharded() ? protocol::shard_namespace(ns, c.shard.index) : ns);
+  if (c.shard.sharded()) keep_shared_channels(c, f.server, ns);
   c.pipeline = !f.no_pipeline;
   // Stage 1 shoots beside stage 2's octree update: the octree stage leaves it a core (a
   // worker preempted by stage 1 stalls every join of the update), and the voxel list of a

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "daemon/server_config.h"
+#include "daemon/shard_flags.h"
 #include "engine/engine_flags.h"
 
 namespace ort::daemon {
@@ -18,6 +19,7 @@ struct ServerFlags {
   std::string ns;                  // --namespace; "": $OCTOMAP_RT_NAMESPACE, else none
   bool print_config = false;       // --print-config: the effective configuration on stdout, then exit
   uint64_t max_scan_work = EngineOptions{}.max_scan_walk_keys;
+  ShardFlags shard;  // --shard, --shard-box, --shard-region-depth
 };
 
 void add_server_flags(CLI::App& app, ServerFlags& f);

@@ -15,6 +15,7 @@
 #include "engine/map_engine.h"
 #include "protocol/channels.h"
 #include "protocol/limits.h"
+#include "protocol/shards/shard_set.h"
 
 namespace ort::daemon {
 
@@ -72,6 +73,9 @@ struct ServerConfig {
   double stuck_stage_s = 30.0;
   // The long-lived map: decay, clearing by distance (daemon/map/map_upkeep.h).
   UpkeepConfig upkeep;
+  // The regions this daemon maps when it is one shard of several (--shard, --shard-box;
+  // protocol/shards/shard_set.h); the default maps every region.
+  protocol::ShardSet shard;
 };
 
 struct ProducerPolicy;

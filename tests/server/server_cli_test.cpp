@@ -98,3 +98,44 @@ TEST(ServerCli, ThePrintedConfigurationReadsBackAsTheSameConfiguration) {
 
 }  // namespace
 }  // namespace ort::test
+
+namespace ort::test {
+namespace {
+
+// --shard i/N: the hash rule, the shard's own channels in NS_SHARD<i>, scans and status in NS;
+// --shard-box: one box per shard in metres, overlaps and gaps refused at start.
+TEST(ServerCli, AShardHearsTheNamespacesScansAndServesOnItsOwnChannels) {
+  const Parsed p = parse({"-r", "0.1", "--namespace", "lab2", "--shard", "1/3"});
+  ASSERT_EQ(p.error, "");
+  const daemon::ServerConfig& c = p.config;
+  EXPECT_EQ(c.shard.rule, protocol::ShardRule::kHash);
+  EXPECT_EQ(c.shard.index, 1u);
+  EXPECT_EQ(c.shard.count, 3u);
+  EXPECT_EQ(c.scan_channels, "lab2_OCTOMAP_RT_SCAN_.*");
+  EXPECT_EQ(c.status_channel, "lab2_OCTOMAP_RT_STATUS");
+  EXPECT_EQ(c.queries.status_channel, "lab2_OCTOMAP_RT_STATUS");
+  EXPECT_EQ(c.map_request_channel, "lab2_SHARD1_OCTOMAP_RT_MAP_REQUEST");
+  EXPECT_EQ(c.queries.points_channel, "lab2_SHARD1_OCTOMAP_RT_QUERY");
+  EXPECT_EQ(c.octomap_raw.channel, "lab2_SHARD1_OCTOMAP");
+  const std::string west = "-inf,-inf,-inf:0,inf,inf", east = "0,-inf,-inf:inf,inf,inf";
+  const Parsed boxes = parse({"-r", "0.1", "--shard", "0/2", "--shard-box", west, "--shard-box", east});
+  ASSERT_EQ(boxes.error, "");
+  EXPECT_EQ(boxes.config.shard.rule, protocol::ShardRule::kBoxes);
+  EXPECT_EQ(boxes.config.shard.boxes.size(), 2u);
+  const Parsed gap =
+      parse({"-r", "0.1", "--shard", "0/2", "--shard-box", west, "--shard-box", "7,-inf,-inf:inf,inf,inf"});
+  EXPECT_NE(gap.error.find("the boxes leave a gap"), std::string::npos) << gap.error;
+  const Parsed overlap =
+      parse({"-r", "0.1", "--shard", "0/2", "--shard-box", west, "--shard-box", "-7,-inf,-inf:inf,inf,inf"});
+  EXPECT_NE(overlap.error.find("boxes 0 and 1 overlap"), std::string::npos) << overlap.error;
+  EXPECT_NE(parse({"-r", "0.1", "--shard", "0/2", "--shard-box", west}).error.find("1 boxes for 2 shards"),
+            std::string::npos);
+  EXPECT_NE(parse({"-r", "0.1", "--shard", "3/3"}).error.find("is not i/N"), std::string::npos);
+  EXPECT_NE(parse({"-r", "0.1", "--shard", "0/2", "--shard-box", "1,2,3:0,5,6", "--shard-box", east})
+                .error.find("is not X0,Y0,Z0:X1,Y1,Z1"),
+            std::string::npos);
+  EXPECT_NE(parse({"-r", "0.1", "--shard-box", west}).error.find("needs --shard"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace ort::test

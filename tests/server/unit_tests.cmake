@@ -66,3 +66,6 @@ octomap_rt_add_test(server_point_filters_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/
 # The server's command line: --namespace, --config's unknown keys, --print-config (issue 24).
 octomap_rt_add_test(server_cli_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_cli_test.cpp
                     ${CMAKE_SOURCE_DIR}/server/daemon/server_cli.cpp LIBS octomap_rt_daemon TIMEOUT 60)
+# Issue 26: shards keep their regions' voxels; merged they are the one-daemon map (real data).
+octomap_rt_add_test(server_shard_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/shard_test.cpp ${SERVER_TEST_FIXTURES}
+                    LIBS octomap_rt_daemon octomap_rt_map_client TIMEOUT 300)

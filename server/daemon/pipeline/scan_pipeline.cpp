@@ -137,6 +137,7 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
              "");
       ok = false;
     }
+    if (ok) shard_.keep_owned(job.shot);  // a shard's cost is what it applies
     if (ok) {
       if (const Reject why = gate_.admit_voxels(job.shot.free_voxels + job.shot.occupied_voxels, detail);
           why != Reject::kNone) {
@@ -162,6 +163,10 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
 }
 
 void ScanPipeline::apply_edit(MapEditItem& edit) {
+  if (shard_.active() && edit.include_unknown)  // it would mark other shards' regions free
+    return refuse_map_edit(edit, EditRefusal::kBadRequest,
+                           "a shard does not mark unknown space free (--include-unknown): it would map other "
+                           "shards' regions");
   MapEditResult r;
   try {
     std::unique_lock lock(map_.mutex);

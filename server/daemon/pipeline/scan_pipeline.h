@@ -18,6 +18,7 @@
 #include "daemon/pipeline/filtered_shoot.h"
 #include "daemon/pipeline/pipeline_metrics.h"
 #include "daemon/pipeline/scan_cost_gate.h"
+#include "daemon/pipeline/shard_filter.h"
 #include "engine/map_engine.h"
 
 namespace ort::daemon {
@@ -49,6 +50,8 @@ class ScanPipeline {
   ~ScanPipeline();
   // What one producer's scans may cost (pipeline/scan_cost_gate.h); call before start().
   void set_cost_bounds(const ScanCostBounds& b) { gate_ = ScanCostGate(b); }
+  // A shard's regions (pipeline/shard_filter.h): stage 1 keeps only their voxels; call before start().
+  void set_shard(const ShardFilter& f) { shard_ = f; }
   void start();
   // Call after queue.close(): returns once every queued scan was applied or rejected.
   void join();
@@ -83,6 +86,7 @@ class ScanPipeline {
   bool pipelined_;
   BoundedHandoff<ShotJob> handoff_{1};
   ScanCostGate gate_{ScanCostBounds{}};
+  ShardFilter shard_;
   int64_t cost_refusals_logged_ = 0;
   LeafChanges changes_;  // stage 2's: what the scan being applied changed, for map_.observer
   std::thread stage1_, stage2_;

@@ -1,0 +1,254 @@
+// Shards (issue 26): N daemons, each keeping the voxels of its own regions. On the real 3DTK
+// scans, for 2, 3 and 4 shards: every shard's map is OctoMap's map restricted to its regions,
+// and the shards' maps merged are the one-daemon map node for node (its .bt byte for byte),
+// both from the engine's lists and through whole daemons over memq://.
+#include <sstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "daemon/pipeline/shard_filter.h"
+#include "map_client/shard_merge.h"
+#include "octree/region.h"
+#include "protocol/channels.h"
+#include "scene/scan_set.h"
+#include "server/scan_fixtures.h"
+#include "support/octomap_reference.h"
+#include "support/test_data.h"
+#include "support/tree_compare.h"
+
+namespace ort::test {
+namespace {
+
+using protocol::RegionBox;
+using protocol::ShardRule;
+using protocol::ShardSet;
+
+ShardSet hash_set(uint32_t index, uint32_t count, uint32_t depth) {
+  ShardSet s;
+  s.index = index, s.count = count, s.rule = ShardRule::kHash, s.region_depth = depth;
+  return s;
+}
+
+// OctoMap 1.9.7's deleteNodeChild frees one node, not its children or its child array: a
+// node's subtree is emptied leaf by leaf, then its empty child array freed (expandNode and
+// pruneNode), so the node is a plain leaf that deleteNodeChild may free.
+void make_leaf(octomap::OcTree& tree, octomap::OcTreeNode* node) {
+  for (unsigned j = 0; j < 8; ++j) {
+    if (!tree.nodeChildExists(node, j)) continue;
+    octomap::OcTreeNode* child = tree.getNodeChild(node, j);
+    if (tree.nodeHasChildren(child)) make_leaf(tree, child);
+    tree.deleteNodeChild(node, j);
+  }
+  tree.expandNode(node);
+  tree.pruneNode(node);
+}
+
+// Deletes every region of `node`'s subtree that other shards own (coarse leaves over several
+// shards' regions split down to the region depth first); false when nothing is left, the node
+// then a plain leaf: OctoMap's map restricted to the filter's shard.
+bool keep_owned_below(octomap::OcTree& tree, const daemon::ShardFilter& f, octomap::OcTreeNode* node,
+                      const octomap::OcTreeKey& min_key, unsigned depth) {
+  if (depth == f.set().region_depth) return f.owns(min_key);
+  if (!tree.nodeHasChildren(node)) tree.expandNode(node);
+  const uint16_t half = static_cast<uint16_t>(1u << (15 - depth));
+  for (unsigned i = 0; i < 8; ++i) {
+    if (!tree.nodeChildExists(node, i)) continue;
+    octomap::OcTreeKey k = min_key;
+    for (unsigned a = 0; a < 3; ++a)
+      if (i & (1u << a)) k[a] = static_cast<uint16_t>(k[a] + half);
+    octomap::OcTreeNode* child = tree.getNodeChild(node, i);
+    if (keep_owned_below(tree, f, child, k, depth + 1)) continue;
+    if (tree.nodeHasChildren(child)) make_leaf(tree, child);
+    tree.deleteNodeChild(node, i);
+  }
+  if (tree.nodeHasChildren(node)) return true;
+  tree.expandNode(node);
+  tree.pruneNode(node);
+  return false;
+}
+
+std::unique_ptr<octomap::OcTree> restricted(const octomap::OcTree& full, const ShardSet& set) {
+  auto t = std::make_unique<octomap::OcTree>(full);
+  if (t->getRoot() && !keep_owned_below(*t, daemon::ShardFilter(set), t->getRoot(), octomap::OcTreeKey(0, 0, 0), 0))
+    t->clear();
+  return t;
+}
+
+std::string bt_bytes(octomap::OcTree tree) {
+  std::ostringstream out;
+  tree.writeBinary(out);
+  return out.str();
+}
+
+void expect_same_map(const octomap::OcTree& a, const octomap::OcTree& b, const std::string& what) {
+  const TreeDiff d = compare_leaves(a, b);
+  EXPECT_TRUE(d.maps_equal()) << what << ": " << d.differing_voxels << " voxels, " << d.differing_logodds
+                              << " log-odds differ: " << d.first_difference;
+}
+
+// The merged map of `shards` against the one-daemon map `whole`: node for node, .bt bytes.
+void expect_merge_is_whole(const std::vector<std::unique_ptr<octomap::OcTree>>& shards, unsigned depth,
+                           const octomap::OcTree& whole, const std::string& what) {
+  std::vector<const octomap::OcTree*> views;
+  for (const auto& s : shards) views.push_back(s.get());
+  const auto merged = client::merge_shard_trees(views, depth);
+  expect_same_map(*merged, whole, what + ", merged");
+  EXPECT_EQ(compare_structure(*merged, whole), "") << what;
+  EXPECT_EQ(merged->size(), whole.size()) << what;
+  EXPECT_TRUE(bt_bytes(*merged) == bt_bytes(whole)) << what << ": the merged .bt differs";
+}
+
+TEST(ShardRule, RegionCoordinatesAreTheRegionAbstractions) {
+  for (unsigned depth : {1u, 7u, 10u, 16u}) {
+    const RegionGrid grid = region_grid(depth);
+    for (uint32_t k = 0; k < 65536; k += 4093) {
+      const octomap::OcTreeKey key(static_cast<uint16_t>(k), static_cast<uint16_t>(65535 - k),
+                                   static_cast<uint16_t>(k * 7));
+      const RegionId id = region_of(grid, key);
+      const protocol::RegionCoords r = protocol::region_coords(depth, key[0], key[1], key[2]);
+      EXPECT_EQ(r.x, id & 0xffff);
+      EXPECT_EQ(r.y, id >> 16 & 0xffff);
+      EXPECT_EQ(r.z, id >> 32 & 0xffff);
+    }
+  }
+}
+
+TEST(ShardRule, HashSpreadsRegionsOverEveryShard) {
+  for (uint32_t n : {2u, 3u, 4u, 7u}) {
+    std::vector<int> owned(n);
+    for (uint32_t x = 0; x < 32; ++x)
+      for (uint32_t y = 0; y < 32; ++y)
+        for (uint32_t z = 0; z < 8; ++z) owned[protocol::shard_of(hash_set(0, n, 10), {512 + x, 512 + y, 512 + z})]++;
+    for (uint32_t i = 0; i < n; ++i)
+      EXPECT_NEAR(owned[i], 8192.0 / n, 0.1 * 8192.0 / n) << "shard " << i << " of " << n;
+  }
+}
+
+TEST(ShardRule, BoxesMustTileTheKeySpace) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double all_min[3] = {-inf, -inf, -inf}, all_max[3] = {inf, inf, inf};
+  ShardSet s;
+  s.rule = ShardRule::kBoxes, s.count = 2, s.region_depth = 10;
+  const double west_max[3] = {0, inf, inf}, east_min[3] = {0, -inf, -inf};
+  s.boxes = {protocol::region_box_of(all_min, west_max, 0.1, 10), protocol::region_box_of(east_min, all_max, 0.1, 10)};
+  EXPECT_EQ(protocol::check_shard_set(s), "");
+  EXPECT_EQ(s.boxes[0].max[0], 512u);  // 0 m is region 512's min corner at 0.1 m, depth 10
+  EXPECT_EQ(protocol::shard_of(s, {511, 3, 900}), 0u);
+  EXPECT_EQ(protocol::shard_of(s, {512, 3, 900}), 1u);
+  const double east_of_1m[3] = {1, -inf, -inf};  // a gap from 0 to 1 m
+  s.boxes[1] = protocol::region_box_of(east_of_1m, all_max, 0.1, 10);
+  EXPECT_NE(protocol::check_shard_set(s).find("gap: region (512, 0, 0)"), std::string::npos)
+      << protocol::check_shard_set(s);
+  const double east_of_minus_7m[3] = {-7, -inf, -inf};  // an overlap: region 511 (-6.4 .. 0 m)
+  s.boxes[1] = protocol::region_box_of(east_of_minus_7m, all_max, 0.1, 10);
+  EXPECT_NE(protocol::check_shard_set(s).find("boxes 0 and 1 overlap"), std::string::npos)
+      << protocol::check_shard_set(s);
+  s.boxes.pop_back();
+  EXPECT_NE(protocol::check_shard_set(s).find("1 boxes for 2 shards"), std::string::npos);
+  uint32_t i = 0, n = 0;
+  for (const char* bad : {"", "1", "2/2", "-1/2", "0/0", "0/65", "a/b", "0/2x"})
+    EXPECT_NE(protocol::parse_shard_index(bad, i, n), "") << bad;
+  EXPECT_EQ(protocol::parse_shard_index("2/3", i, n), "");
+  EXPECT_EQ(i, 2u);
+  EXPECT_EQ(n, 3u);
+}
+
+// The engine's voxel lists of the real scans, cut per shard: every shard equals OctoMap
+// restricted to its regions; the merge equals the one-daemon map.
+TEST(Shards, RealScansShardByShardEqualOctomapAndMergeToTheWholeMap) {
+  const std::string path = data_file("3dtk_dat/3dtk_3scans.graph");
+  if (path.empty()) return;
+  const ScanSet set = load_scan_graph(path);
+  const auto cfg = test_config(0.2, false);
+  MapEngine engine(cfg.engine);
+  std::vector<ShotScan> shots(set.scans.size());
+  auto whole = engine.make_tree();
+  for (size_t k = 0; k < set.scans.size(); ++k) {
+    const octomap::Pointcloud pts = world_points(set.scans[k]);
+    std::vector<octomap::point3d> points(pts.begin(), pts.end());
+    engine.shoot(sensor_origin(set.scans[k]), points, cfg.engine.max_range, shots[k]);
+    ShotScan copy = shots[k];
+    engine.apply(copy, *whole);
+  }
+  const auto reference = octomap_reference(set, cfg.engine.resolution, cfg.engine.max_range);
+  expect_same_map(*whole, *reference, "one daemon");
+  for (const uint32_t depth : {10u, 12u}) {
+    for (uint32_t n = 2; n <= 4; ++n) {
+      std::vector<std::unique_ptr<octomap::OcTree>> shards;
+      for (uint32_t i = 0; i < n; ++i) {
+        const ShardSet s = hash_set(i, n, depth);
+        shards.push_back(engine.make_tree());
+        for (const ShotScan& shot : shots) {
+          ShotScan mine = shot;
+          daemon::ShardFilter(s).keep_owned(mine);
+          engine.apply(mine, *shards.back());
+        }
+        const std::string what =
+            "shard " + std::to_string(i) + " of " + std::to_string(n) + ", depth " + std::to_string(depth);
+        expect_same_map(*shards.back(), *restricted(*reference, s), what);
+        EXPECT_GT(shards.back()->size(), 100u) << what;  // every shard maps some of it
+      }
+      expect_merge_is_whole(shards, depth, *whole, std::to_string(n) + " shards, depth " + std::to_string(depth));
+    }
+  }
+}
+
+std::string scan_channel(const std::string& robot) {
+  std::string c = protocol::kScanChannelPrefix;
+  for (char ch : robot) c += static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  return c;
+}
+
+// Whole daemons, one producer, the same order everywhere: 2 boxes and 3 hashed shards.
+TEST(Shards, DaemonsOverMemqMergeToTheOneDaemonMap) {
+  const std::string path = data_file("3dtk_dat/3dtk_3scans.graph");
+  if (path.empty()) return;
+  const ScanSet set = load_scan_graph(path);
+  const double inf = std::numeric_limits<double>::infinity();
+  const double lo[3] = {-inf, -inf, -inf}, hi[3] = {inf, inf, inf}, cut_max[3] = {inf, 2.0, inf},
+               cut_min[3] = {-inf, 2.0, -inf};
+  std::vector<ShardSet> sets;
+  for (uint32_t i = 0; i < 2; ++i) {
+    ShardSet s;
+    s.index = i, s.count = 2, s.rule = ShardRule::kBoxes, s.region_depth = 11;
+    s.boxes = {protocol::region_box_of(lo, cut_max, 0.2, 11), protocol::region_box_of(cut_min, hi, 0.2, 11)};
+    sets.push_back(s);
+  }
+  for (uint32_t i = 0; i < 3; ++i) sets.push_back(hash_set(i, 3, 10));
+  sets.push_back(ShardSet{});  // the one daemon
+  std::vector<std::unique_ptr<lcm::LCM>> buses;
+  std::vector<std::unique_ptr<daemon::MappingServer>> servers;
+  std::ostringstream log;
+  for (const ShardSet& s : sets) {
+    auto cfg = test_config(0.2, true);
+    cfg.shard = s;
+    buses.push_back(std::make_unique<lcm::LCM>("memq://"));
+    servers.push_back(std::make_unique<daemon::MappingServer>(cfg, *buses.back(), log));
+    servers.back()->start();
+  }
+  for (size_t k = 0; k < set.scans.size(); ++k) {
+    const auto msg = scan_message(set.scans[k], "husky1", static_cast<int64_t>(k));
+    for (auto& bus : buses) bus->publish(scan_channel("husky1"), &msg);
+  }
+  std::vector<std::unique_ptr<octomap::OcTree>> maps;
+  for (auto& server : servers) {
+    ASSERT_TRUE(wait_until_done(*server, static_cast<int64_t>(set.scans.size())));
+    server->stop();
+    expect_counts_balance(server->producer_stats());
+    EXPECT_EQ(server->applied_order().size(), set.scans.size());  // every shard accounts for every scan
+    maps.push_back(server->with_map([](const octomap::OcTree& m) { return std::make_unique<octomap::OcTree>(m); }));
+  }
+  const auto reference = octomap_reference(set, 0.2, test_config(0.2, true).engine.max_range);
+  expect_same_map(*maps.back(), *reference, "one daemon");
+  for (size_t i = 0; i < sets.size() - 1; ++i)
+    expect_same_map(*maps[i], *restricted(*reference, sets[i]), "daemon shard " + std::to_string(i));
+  std::vector<std::unique_ptr<octomap::OcTree>> boxes, hashed;
+  boxes.push_back(std::move(maps[0])), boxes.push_back(std::move(maps[1]));
+  for (int i = 2; i < 5; ++i) hashed.push_back(std::move(maps[i]));
+  expect_merge_is_whole(boxes, 11, *maps.back(), "2 boxes");
+  expect_merge_is_whole(hashed, 10, *maps.back(), "3 hashed shards");
+}
+
+}  // namespace
+}  // namespace ort::test
