@@ -3,7 +3,9 @@
 // OctoMap's float arithmetic, so every ray end is the CPU's bit for bit:
 //   Pose6D::transform (quaternion products, float), drop non-finite points, cut rays longer
 //   than max range (Vector3::normalized, float), drop ends outside the key range and rays
-//   whose walk would have no length (prepare_scan.h's degenerate_ray).
+//   too short to walk (prepare_scan.h's degenerate_ray). Map-frame coordinates below
+//   kTinyCoordinate read as 0 first (the scan contract, prepare_scan.h): decided on the bits,
+//   so a GPU that flushes fp32 subnormals to 0 reads them as the CPU does.
 // Every product and sum is `precise` (no contraction, no reassociation). Where OctoMap
 // divides floats, the division is done in double and rounded to float: NVIDIA's fp32
 // division is not IEEE, double division rounded once more gives the IEEE float quotient.
@@ -11,6 +13,8 @@
 // passes skip. The key box and the counts are reduced per workgroup, then atomically.
 #version 450
 #extension GL_ARB_gpu_shader_fp64 : require
+#extension GL_GOOGLE_include_directive : require
+#include "flush_denormals.glsl"
 
 layout(local_size_x = 64) in;
 
@@ -31,7 +35,8 @@ layout(std430, binding = 2) buffer Result {
   uint nonfinite;
   uint out_of_range;
   uint cut_at_max_range;
-  uint degenerate;  // prepare_scan.h's degenerate_ray: end key != origin key at a float length of 0
+  uint degenerate;  // prepare_scan.h's degenerate_ray: end key != origin key, nearer than min_ray_length
+  uint read_as_zero;  // points with a coordinate below tiny_coordinate read as 0
 };
 
 layout(push_constant) uniform PrepareParams {
@@ -45,9 +50,11 @@ layout(push_constant) uniform PrepareParams {
   float max_range_f;    // (float)max_range, as computeUpdate scales the direction
   uint has_max_range;   // 0: no limit
   float zero;           // 0.0f, as a run-time value: the compiler may not fold 0 * x away
+  float tiny_coordinate;  // prepare_scan.h's kTinyCoordinate
+  float min_ray_length;   // prepare_scan.h's kMinRayLength
 };
 
-shared uint s_lo[3], s_hi[3], s_nonfinite, s_out_of_range, s_cut, s_degenerate;
+shared uint s_lo[3], s_hi[3], s_nonfinite, s_out_of_range, s_cut, s_degenerate, s_read_as_zero;
 
 bool finite(float f) { return (floatBitsToUint(f) & 0x7f800000u) != 0x7f800000u; }
 bool finite3(vec3 v) { return finite(v.x) && finite(v.y) && finite(v.z); }
@@ -68,6 +75,16 @@ vec3 transform(vec3 v) {
   const vec4 r = quat_mul(quat_mul(q, vec4(zero, v)), q_inv);
   precise vec3 p = r.yzw + vec3(trans_x, trans_y, trans_z);
   return p;
+}
+
+// A coordinate below tiny_coordinate in magnitude (+-0 included), decided on the bits (the order
+// of non-negative floats is their bits' order), so a subnormal the device would flush is seen.
+bool below_tiny(float f) { return (floatBitsToUint(f) & 0x7fffffffu) < floatBitsToUint(tiny_coordinate); }
+bool tiny(float f) { return below_tiny(f) && (floatBitsToUint(f) & 0x7fffffffu) != 0u; }  // and not 0
+bool tiny3(vec3 v) { return tiny(v.x) || tiny(v.y) || tiny(v.z); }
+// prepare_scan.h's read_tiny_as_zero: +0 (the same bits as the CPU's, -0 included).
+vec3 read_tiny_as_zero(vec3 v) {
+  return vec3(below_tiny(v.x) ? 0.0 : v.x, below_tiny(v.y) ? 0.0 : v.y, below_tiny(v.z) ? 0.0 : v.z);
 }
 
 // OctoMap's coordToKeyChecked: floor(resolution_factor * coordinate) in double.
@@ -95,13 +112,11 @@ bool apply_max_range(inout vec3 end, vec3 origin) {
   return true;
 }
 
-// Whether computeRayKeys' length, (float)(end - origin).norm(), is above 0 (prepare_scan.h's
-// degenerate_ray: a walk of length 0 between two keys never stops).
-bool ray_has_length(vec3 end, vec3 origin) {
+// prepare_scan.h's degenerate_ray, given that the keys differ: the end nearer than
+// min_ray_length to the origin along every axis (a difference the device flushes is below it too).
+bool too_short_to_walk(vec3 end, vec3 origin) {
   precise vec3 d = end - origin;
-  precise float norm_sq = d.x * d.x + d.y * d.y;
-  norm_sq = norm_sq + d.z * d.z;
-  return float(sqrt(double(norm_sq))) > 0.0;
+  return abs(d.x) < min_ray_length && abs(d.y) < min_ray_length && abs(d.z) < min_ray_length;
 }
 
 void main() {
@@ -115,6 +130,7 @@ void main() {
     s_out_of_range = 0u;
     s_cut = 0u;
     s_degenerate = 0u;
+    s_read_as_zero = 0u;
   }
   barrier();
 
@@ -127,13 +143,17 @@ void main() {
     if (!finite3(v) || !finite3(end)) {
       atomicAdd(s_nonfinite, 1u);
     } else {
+      // As sent or in the map frame (prepare_scan.h's tiny_as_sent_only): a subnormal the
+      // transform made, which this device may have flushed to 0 already, is counted as the CPU counts it.
+      if (tiny3(end) || tiny3(v)) atomicAdd(s_read_as_zero, 1u);
+      end = read_tiny_as_zero(end);
       const bool cut = apply_max_range(end, vec3(origin_x, origin_y, origin_z));
       if (cut) atomicAdd(s_cut, 1u);
       uvec3 origin_key;
       if (!coord_to_key_checked(end, key)) {
         atomicAdd(s_out_of_range, 1u);
       } else if (coord_to_key_checked(vec3(origin_x, origin_y, origin_z), origin_key) && key != origin_key &&
-                 !ray_has_length(end, vec3(origin_x, origin_y, origin_z))) {
+                 too_short_to_walk(end, vec3(origin_x, origin_y, origin_z))) {
         atomicAdd(s_degenerate, 1u);
       } else {
         ray = RayEnd(end.x, end.y, end.z, cut ? 0u : kRayEndOccupied);
@@ -156,5 +176,6 @@ void main() {
     if (s_out_of_range != 0u) atomicAdd(out_of_range, s_out_of_range);
     if (s_cut != 0u) atomicAdd(cut_at_max_range, s_cut);
     if (s_degenerate != 0u) atomicAdd(degenerate, s_degenerate);
+    if (s_read_as_zero != 0u) atomicAdd(read_as_zero, s_read_as_zero);
   }
 }

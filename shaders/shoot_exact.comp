@@ -7,6 +7,7 @@
 // near ties; the neighbourhood covers that, and exact_slab.glsl decides each candidate.
 #version 450
 #extension GL_GOOGLE_include_directive : require
+#include "flush_denormals.glsl"
 
 #include "ray_space.glsl"
 #include "exact_slab.glsl"

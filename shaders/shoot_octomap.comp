@@ -2,6 +2,7 @@
 // OctoMap's computeRayKeys; the end voxel occupied when the ray's end is a measured hit.
 #version 450
 #extension GL_GOOGLE_include_directive : require
+#include "flush_denormals.glsl"
 
 #include "ray_space.glsl"
 #include "octomap_ray.glsl"

@@ -25,13 +25,15 @@ struct PreparedChunk {
 
 // OctoMap's rules for one point: false when it gives no ray (counted in `report`), else its
 // ray end and end key.
-bool prepare_point(const octomap::point3d& origin, const octomap::OcTreeKey& origin_key, const octomap::point3d& p,
+bool prepare_point(const octomap::point3d& origin, const octomap::OcTreeKey& origin_key, const octomap::point3d& given,
                    double max_range, double resolution, PrepareReport& report, RayEnd& ray,
                    octomap::OcTreeKey& end_key) {
-  if (!finite(p)) {
+  if (!finite(given)) {
     ++report.nonfinite;
     return false;
   }
+  const octomap::point3d p = read_tiny_as_zero(given);  // the scan contract (prepare_scan.h)
+  if (has_tiny_coordinate(given)) ++report.read_as_zero;
   // OccupancyOcTreeBase::computeUpdate, no bounding box: a measurement within max range
   // frees its ray and occupies its end; a longer one is cut at max range, free only.
   octomap::point3d end = p;
@@ -67,8 +69,9 @@ void prepare_points(const octomap::point3d& origin, const octomap::OcTreeKey& or
 
 #if defined(__x86_64__)
 // The common case four points at a time (AVX2): no max range, all four finite, inside the
-// key range and more than 1e-18 m from the origin along some axis (so that no ray of theirs is
-// degenerate: a squared length of at least 1e-36 is a normal float). Keys by coordToKeyChecked's expression (floor(1 / resolution * coord) in double),
+// key range, no coordinate below kTinyCoordinate but 0 and farther than kMinRayLength from the
+// origin along some axis (so that no ray of theirs is degenerate). Keys by coordToKeyChecked's
+// expression (floor(1 / resolution * coord) in double),
 // the box kept in lanes; any other group of four goes to prepare_points, so the rays, their
 // order and the counts are the scalar loop's.
 __attribute__((target("avx2"))) void prepare_points_avx2(const octomap::point3d& origin,
@@ -80,7 +83,7 @@ __attribute__((target("avx2"))) void prepare_points_avx2(const octomap::point3d&
   const __m256d factor = _mm256_set1_pd(1.0 / resolution), low = _mm256_set1_pd(-32768.0),
                 high = _mm256_set1_pd(32768.0);
   const __m128i max_val = _mm_set1_epi32(32768);
-  const __m128 sign_bit = _mm_set1_ps(-0.0f), near = _mm_set1_ps(1e-18f);
+  const __m128 sign_bit = _mm_set1_ps(-0.0f), near = _mm_set1_ps(kMinRayLength), tiny = _mm_set1_ps(kTinyCoordinate);
   const __m128 o[3] = {_mm_set1_ps(origin.x()), _mm_set1_ps(origin.y()), _mm_set1_ps(origin.z())};
   __m128i lo[3], hi[3];
   for (int i = 0; i < 3; ++i) lo[i] = _mm_set1_epi32(65536), hi[i] = _mm_set1_epi32(-1);
@@ -97,12 +100,21 @@ __attribute__((target("avx2"))) void prepare_points_avx2(const octomap::point3d&
     const __m128 z = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)),
                                     _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0)), _MM_SHUFFLE(2, 0, 2, 0));
     const __m128 v[3] = {x, y, z};
+    // -0 reads as +0 (read_tiny_as_zero); lanes with a tiny nonzero coordinate go to the
+    // point-by-point rules below, which count them.
+    __m128 r[3];
+    for (int i = 0; i < 3; ++i) r[i] = _mm_and_ps(v[i], _mm_cmpneq_ps(v[i], _mm_setzero_ps()));
     __m128i key[3];
     __m256d ok = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
-    __m128 away = _mm_setzero_ps();  // lanes more than 1e-18 from the origin along some axis
-    for (int i = 0; i < 3; ++i)
+    __m128 away = _mm_setzero_ps();  // lanes farther than kMinRayLength from the origin along some axis
+    __m128 read_as_is = _mm_castsi128_ps(_mm_set1_epi32(-1));  // lanes without a tiny nonzero coordinate
+    for (int i = 0; i < 3; ++i) {
       away = _mm_or_ps(away, _mm_cmpgt_ps(_mm_andnot_ps(sign_bit, _mm_sub_ps(v[i], o[i])), near));
-    ok = _mm256_and_pd(ok, _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_castps_si128(away))));
+      const __m128 tiny_lane =
+          _mm_and_ps(_mm_cmplt_ps(_mm_andnot_ps(sign_bit, v[i]), tiny), _mm_cmpneq_ps(v[i], _mm_setzero_ps()));
+      read_as_is = _mm_andnot_ps(tiny_lane, read_as_is);
+    }
+    ok = _mm256_and_pd(ok, _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_castps_si128(_mm_and_ps(away, read_as_is)))));
     for (int i = 0; i < 3; ++i) {
       const __m256d scaled = _mm256_mul_pd(factor, _mm256_cvtps_pd(v[i]));
       // scaled >= -32768 and < 32768 (false for NaN and inf: the finiteness test too).
@@ -119,7 +131,7 @@ __attribute__((target("avx2"))) void prepare_points_avx2(const octomap::point3d&
       continue;
     }
     for (int i = 0; i < 3; ++i) lo[i] = _mm_min_epi32(lo[i], key[i]), hi[i] = _mm_max_epi32(hi[i], key[i]);
-    __m128 r0 = x, r1 = y, r2 = z, r3 = _mm_castsi128_ps(_mm_set1_epi32(kRayEndOccupied));
+    __m128 r0 = r[0], r1 = r[1], r2 = r[2], r3 = _mm_castsi128_ps(_mm_set1_epi32(kRayEndOccupied));
     _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
     float* dst = &out.ends[n].x;
     _mm_storeu_ps(dst, r0), _mm_storeu_ps(dst + 4, r1), _mm_storeu_ps(dst + 8, r2), _mm_storeu_ps(dst + 12, r3);
@@ -150,7 +162,17 @@ void prepare_chunk(const octomap::point3d& origin, const octomap::OcTreeKey& ori
 
 }  // namespace
 
-bool prepare_origin(const octomap::point3d& origin, double resolution, RayBatch& batch, PrepareReport& report) {
+uint64_t tiny_as_sent_only(std::span<const float> xyz, std::span<const octomap::point3d> world) {
+  uint64_t n = 0;
+  for (size_t i = 0; i < world.size(); ++i) {
+    const octomap::point3d sent(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    n += finite(sent) && finite(world[i]) && has_tiny_coordinate(sent) && !has_tiny_coordinate(world[i]);
+  }
+  return n;
+}
+
+bool prepare_origin(const octomap::point3d& given, double resolution, RayBatch& batch, PrepareReport& report) {
+  const octomap::point3d origin = read_tiny_as_zero(given);
   batch.origin = origin;
   batch.resolution = resolution;
   if (!finite(origin) || !coord_to_key_checked(origin, resolution, batch.origin_key)) {
@@ -167,6 +189,7 @@ RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::p
   RayBatch batch;
   report.points_in += points.size();
   if (!prepare_origin(origin, resolution, batch, report)) return batch;
+  const octomap::point3d& read_origin = batch.origin;  // the contract's reading (read_tiny_as_zero)
   // Each point is prepared on its own, so contiguous chunks on several threads, joined in
   // order, give exactly the single-threaded batch (same rays, same order).
   constexpr size_t kMinPointsPerThread = 32768;
@@ -175,7 +198,8 @@ RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::p
   std::vector<PreparedChunk> chunks(threads);
   auto run = [&](unsigned t) {
     const size_t begin = points.size() * t / threads, end = points.size() * (t + 1) / threads;
-    prepare_chunk(origin, batch.origin_key, points.subspan(begin, end - begin), max_range, resolution, simd, chunks[t]);
+    prepare_chunk(read_origin, batch.origin_key, points.subspan(begin, end - begin), max_range, resolution, simd,
+                  chunks[t]);
   };
   {
     std::vector<std::jthread> pool;
@@ -199,6 +223,7 @@ RayBatch prepare_scan(const octomap::point3d& origin, std::span<const octomap::p
     report.out_of_range += c.report.out_of_range;
     report.cut_at_max_range += c.report.cut_at_max_range;
     report.degenerate += c.report.degenerate;
+    report.read_as_zero += c.report.read_as_zero;
   }
   report.rays += batch.ends.size();
   batch.keys_hold_ends = true;

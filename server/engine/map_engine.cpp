@@ -73,6 +73,14 @@ bool inside(const KeyBox& b, const VoxelUpdate& v) {
   return v.x >= b.lo[0] && v.x <= b.hi[0] && v.y >= b.lo[1] && v.y <= b.hi[1] && v.z >= b.lo[2] && v.z <= b.hi[2];
 }
 
+// A max range the engine can honour on every back end: none (< 0) or at least kMinMaxRange
+// (below it, whether a ray is cut depends on squares a GPU may flush to 0).
+void check_max_range(double max_range) {
+  if (!(max_range < 0.0 || max_range >= kMinMaxRange))
+    throw std::invalid_argument("max range " + std::to_string(max_range) + ": below 0 (no limit) or at least " +
+                                std::to_string(kMinMaxRange) + " m");
+}
+
 void refuse(ShotScan& out, ShotRefusal why, std::string detail) {
   out.refusal = why;
   out.refusal_detail = std::move(detail);
@@ -82,6 +90,7 @@ void refuse(ShotScan& out, ShotRefusal why, std::string detail) {
 
 void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range,
                       ShotScan& out) {
+  check_max_range(max_range);
   out.reset();
   const auto t0 = SteadyClock::now();
   const RayBatch batch = prepare_scan(origin, points, max_range, opts_.resolution, out.prepare, opts_.octree.threads);
@@ -111,6 +120,7 @@ void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::p
 void MapEngine::shoot_posed_xyz(const octomap::pose6d& pose, const octomap::point3d& origin,
                                 std::span<const float> sensor_xyz, double max_range, ShotScan& out) {
   if (sensor_xyz.size() % 3) throw std::invalid_argument("scan points: x y z floats, a multiple of 3");
+  check_max_range(max_range);
   if (backend_->prepares_on_device()) {
     out.reset();
     // The device shoots what fits one window plan; a far-flung scan comes back declined and
@@ -132,6 +142,7 @@ void MapEngine::shoot_posed_xyz(const octomap::pose6d& pose, const octomap::poin
   transform_to_map_frame(sensor_xyz, world, pose, opts_.octree.threads);
   const double transform_ms = ms_since(t0);
   shoot(origin, world, max_range, out);
+  out.prepare.read_as_zero += tiny_as_sent_only(sensor_xyz, world);
   out.shoot.times.prepare_ms += transform_ms;
   out.prepare.device_declined = declined;  // said, so callers can count scans the device passed on
 }

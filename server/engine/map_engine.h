@@ -96,6 +96,7 @@ class MapEngine {
   std::unique_ptr<octomap::OcTree> make_tree() const;
 
   // Stage 1. `max_range` overrides the engine's when >= -1 is not wanted: pass opts' value.
+  // A max range that is neither < 0 (no limit) nor >= kMinMaxRange throws std::invalid_argument.
   void shoot(const octomap::point3d& origin, std::span<const octomap::point3d> points, double max_range, ShotScan& out);
   // Stage 1 for a scan in the sensor frame: `pose` takes the points into the map frame (as
   // OctoMap's Pointcloud::transform), `origin` is the sensor origin in the map frame. The

@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/prepare_scan.h"
 #include "gpu/shader_interface.h"
 #include "shaders/prepare_rays_spv.h"
 
@@ -34,13 +35,15 @@ PreparePush prepare_push(const ScanFrame& f, uint32_t point_count) {
   p.rot[3] = q.z();
   for (int i = 0; i < 3; ++i) {
     p.trans[i] = f.pose.trans()(i);
-    p.origin[i] = f.origin(i);
+    p.origin[i] = read_tiny_as_zero(f.origin(i));  // as prepare_origin reads it
   }
   p.point_count = point_count;
   p.has_max_range = f.max_range < 0.0 ? 0u : 1u;
   p.norm_sq_limit = p.has_max_range ? norm_sq_limit(f.max_range) : 0.0f;
   p.max_range_f = float(f.max_range);  // computeUpdate's (float)maxrange
   p.zero = 0.0f;
+  p.tiny_coordinate = kTinyCoordinate;
+  p.min_ray_length = kMinRayLength;
   return p;
 }
 
@@ -129,6 +132,7 @@ DevicePrepared GpuPrepare::run(const ScanFrame& frame, VkBuffer rays) {
   out.out_of_range = c.out_of_range;
   out.cut_at_max_range = c.cut_at_max_range;
   out.degenerate = c.degenerate;
+  out.read_as_zero = c.read_as_zero;
   return out;
 }
 

@@ -35,7 +35,7 @@ struct ScanFrame {
 // What came back: the key box of the kept ray ends (origin not included) and the counts.
 struct DevicePrepared {
   KeyBox end_keys;
-  uint64_t nonfinite = 0, out_of_range = 0, cut_at_max_range = 0, degenerate = 0;
+  uint64_t nonfinite = 0, out_of_range = 0, cut_at_max_range = 0, degenerate = 0, read_as_zero = 0;
 };
 
 // The largest float |p - origin|^2 whose OctoMap norm (sqrt in double) is <= max_range,

@@ -48,8 +48,10 @@ struct PreparePush {
   float max_range_f;
   uint32_t has_max_range;
   float zero;
+  float tiny_coordinate;  // prepare_scan.h's kTinyCoordinate and kMinRayLength
+  float min_ray_length;
 };
-static_assert(sizeof(PreparePush) == 72);
+static_assert(sizeof(PreparePush) == 80);
 static_assert(offsetof(PreparePush, rot) == 8 && offsetof(PreparePush, point_count) == 36 &&
               offsetof(PreparePush, point_base) == 52 && offsetof(PreparePush, zero) == 68);
 
@@ -60,9 +62,10 @@ struct PrepareCounts {
   uint32_t nonfinite;
   uint32_t out_of_range;
   uint32_t cut_at_max_range;
-  uint32_t degenerate;  // rays whose walk would have no length (prepare_scan.h's degenerate_ray)
+  uint32_t degenerate;    // prepare_scan.h's degenerate_ray
+  uint32_t read_as_zero;  // points with a coordinate read as 0 (prepare_scan.h's kTinyCoordinate)
 };
-static_assert(sizeof(PrepareCounts) == 40);
+static_assert(sizeof(PrepareCounts) == 44);
 
 // The Counters buffer; its first three words are the compact pass's VkDispatchIndirectCommand.
 struct Counters {

@@ -94,12 +94,13 @@ class VulkanBackend final : public RayBackend {
     stats.times.upload_ms += ms_since(t_stage);
     const auto t_prepare = Clock::now();
     const VkBuffer rays = space_.device_rays(points);
-    const gpu::DevicePrepared p = prepare_->run({*scan.pose, scan.origin, scan.max_range, resolution_}, rays);
+    const gpu::DevicePrepared p = prepare_->run({*scan.pose, header.origin, scan.max_range, resolution_}, rays);
     stats.times.prepare_ms += ms_since(t_prepare);
     report.nonfinite += p.nonfinite;
     report.out_of_range += p.out_of_range;
     report.cut_at_max_range += p.cut_at_max_range;
     report.degenerate += p.degenerate;
+    report.read_as_zero += p.read_as_zero;
     const uint64_t kept = points - p.nonfinite - p.out_of_range - p.degenerate;
     report.rays += kept;
     if (kept == 0) return;  // as prepare_scan: no rays, nothing shot

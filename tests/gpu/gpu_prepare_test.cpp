@@ -85,6 +85,10 @@ class GpuPrepareTest : public ::testing::Test {
     EXPECT_EQ(got.nonfinite, want_report.nonfinite) << what;
     EXPECT_EQ(got.out_of_range, want_report.out_of_range) << what;
     EXPECT_EQ(got.cut_at_max_range, want_report.cut_at_max_range) << what;
+    EXPECT_EQ(got.degenerate, want_report.degenerate) << what;
+    EXPECT_EQ(got.read_as_zero,
+              want_report.read_as_zero + tiny_as_sent_only(as_xyz(s.points), std::span<const octomap::point3d>(world)))
+        << what;
     EXPECT_EQ(rays.size(), want.ends.size()) << what;
     size_t differ = 0;
     for (size_t i = 0; i < std::min(rays.size(), want.ends.size()); ++i) {
@@ -120,10 +124,10 @@ octomap::pose6d random_pose(std::mt19937& rng) {
 }
 
 // Mostly ordinary points; some with NaN or inf coordinates, some far beyond the key range
-// or large enough to overflow |d|^2, some tiny.
+// or large enough to overflow |d|^2, some tiny (subnormals among them: read as 0 as sent).
 Points random_points(std::mt19937& rng, size_t n) {
   std::uniform_real_distribution<float> near(-40.0f, 40.0f), u(0.0f, 1.0f);
-  const float odd[] = {kNan, kInf, -kInf, 1e4f, -4e3f, 1e20f, 3e38f, -3e38f, 1e-30f, 0.0f, -0.0f};
+  const float odd[] = {kNan, kInf, -kInf, 1e4f, -4e3f, 1e20f, 3e38f, -3e38f, 1e-30f, 0.0f, -0.0f, 1e-39f, -5e-21f};
   Points pts(n);
   for (auto& p : pts) {
     p = octomap::point3d(near(rng), near(rng), near(rng));

@@ -25,16 +25,24 @@ using M = octomap_rt::scan_t;
 int64_t count(const std::array<int64_t, daemon::kRejectReasonCount>& a, Reject r) { return a[static_cast<size_t>(r)]; }
 
 // A scan from a sensor at the map's origin (on a voxel border on all three axes), identity
-// orientation: `good` points around it and points within 1e-19 m of it across a border.
-PosedScan scan_at_zero(std::vector<octomap::point3d>& good, bool with_degenerate) {
+// orientation: ordinary points around it, points with coordinates below 1e-20 m (subnormals
+// among them), which the scan contract reads as 0, and points nearer than 1e-15 m to it
+// across a border, which it skips (core/prepare_scan.h). `expected`: the points as read.
+PosedScan scan_at_zero(std::vector<octomap::point3d>& expected) {
   PosedScan s;
   s.pose = octomap::pose6d(0, 0, 0, 0, 0, 0);
-  for (int i = 0; i < 24; ++i) good.push_back({1.5f, 0.1f * float(i - 12), 0.05f * float(i % 5)});
-  for (const auto& p : good) s.points.push_back(p);
-  if (with_degenerate)
-    for (const octomap::point3d& p : {octomap::point3d(-1e-30f, 0, 0), octomap::point3d(0, -1e-25f, 1e-30f),
-                                      octomap::point3d(1e-30f, 1e-30f, -1.4e-45f)})
-      s.points.push_back(p);
+  for (int i = 0; i < 24; ++i) {
+    s.points.push_back({1.5f, 0.1f * float(i - 12), 0.05f * float(i % 5)});
+    expected.push_back(s.points.back());
+  }
+  const std::pair<octomap::point3d, octomap::point3d> tiny[] = {
+      {{-1e-30f, 0, 0}, {0, 0, 0}}, {{0, -1e-25f, 1e-30f}, {0, 0, 0}}, {{1e-30f, 0.35f, -1.4e-45f}, {0, 0.35f, 0}}};
+  for (const auto& [p, read] : tiny) {
+    s.points.push_back(p);
+    expected.push_back(read);
+  }
+  for (const octomap::point3d& p : {octomap::point3d(-1e-19f, 0, 0), octomap::point3d(3e-20f, -5e-16f, 2e-18f)})
+    s.points.push_back(p);
   return s;
 }
 
@@ -86,11 +94,11 @@ TEST_P(ScanFields, EveryDegenerateFieldIsRefusedWithItsReasonOrWalkedSafely) {
   changed([](M& m) { m.points_frame = -128; });
   // Applied: degenerate rays skipped (map frame and sensor frame), points beyond the key
   // range skipped, extreme seq and utime values.
-  std::vector<octomap::point3d> good_map, good_sensor;
-  M in_map = scan_message(scan_at_zero(good_map, true), "fields", 0);
+  std::vector<octomap::point3d> read_map, read_sensor;
+  M in_map = scan_message(scan_at_zero(read_map), "fields", 0);
   in_map.points_frame = M::POINTS_IN_MAP_FRAME;
   publish(in_map);
-  publish(scan_message(scan_at_zero(good_sensor, true), "fields", 0));
+  publish(scan_message(scan_at_zero(read_sensor), "fields", 0));
   changed([](M& m) {
     m.xyz[0] = 3e38f, m.xyz[4] = -3e38f;  // beyond the key range (in the sensor frame: rotated, still beyond)
     m.utime = std::numeric_limits<int64_t>::min();
@@ -116,6 +124,7 @@ TEST_P(ScanFields, EveryDegenerateFieldIsRefusedWithItsReasonOrWalkedSafely) {
   EXPECT_EQ(stats[0].applied, sent - 9);
   EXPECT_GE(stats[0].seq_restarts, 1);
   EXPECT_LT(stats[0].missed, 1000);
+  EXPECT_EQ(stats[0].point_drops[static_cast<size_t>(daemon::PointDrop::kDegenerateRay)], 4);  // 2 a scan
 
   // OctoMap's map of the applied scans, without the points it cannot walk (and without those
   // outside the key range, which it skips, saying so on stderr).
@@ -148,8 +157,8 @@ TEST_P(ScanFields, EveryDegenerateFieldIsRefusedWithItsReasonOrWalkedSafely) {
     exact.shoot(p.trans(), std::span<const octomap::point3d>(&inside[0], inside.size()), max_range, shot);
     exact.apply(shot, ref);
   };
-  insert(in_map, &good_map, -1);
-  insert(in_map, &good_sensor, -1);
+  insert(in_map, &read_map, -1);
+  insert(in_map, &read_sensor, -1);
   M far = small_scan("fields", 0);
   far.xyz[0] = 3e38f, far.xyz[4] = -3e38f;
   insert(far, nullptr, -1);

@@ -59,7 +59,7 @@ const char* to_string(Reject r);
 enum class PointDrop {
   kNonFinite = 0,    // NaN or infinite coordinate (a no-return), or made infinite by the pose
   kOutsideKeyRange,  // the ray's end lies outside the map's key range (OctoMap skips it too)
-  kDegenerateRay,    // within ~1e-19 m of the sensor across a voxel border: OctoMap's walk cannot take it
+  kDegenerateRay,    // nearer than kMinRayLength to the sensor across a voxel border (core/prepare_scan.h)
   // The server's point filters (daemon/pipeline/point_filters.h: octomap_server's pass-through and a min range).
   kOutsideSensorBox,  // outside --sensor-min/max-x/y/z (the points as the sensor sent them)
   kOutsideMapBox,     // outside --pointcloud-min/max-x/y/z (octomap_server's pointcloud_min_z, ...)
