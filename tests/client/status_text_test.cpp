@@ -171,6 +171,19 @@ TEST(StatusText, ShowsARobotsSeqRestarts) {
   EXPECT_NE(status_json(s).find("\"seq_restarts\":2"), std::string::npos) << status_json(s);
 }
 
+TEST(StatusText, ShowsWhyARobotsScansWereDropped) {
+  auto s = example_status();
+  s.robots[0].scans_dropped = 9;
+  s.robots[0].drop_reason = {"queue full", "over latency bound"};
+  s.robots[0].drop_count = {8, 1};
+  s.robots[0].num_drop_reasons = 2;
+  const std::string text = format_status(s, s.utime + 2'000'000);
+  EXPECT_NE(text.find("    dropped: queue full 8, over latency bound 1\n"), std::string::npos) << text;
+  EXPECT_EQ(format_status(example_status(), s.utime).find("dropped:"), std::string::npos);
+  EXPECT_NE(status_json(s).find("\"drop_reasons\":{\"queue full\":8,\"over latency bound\":1}"), std::string::npos)
+      << status_json(s);
+}
+
 TEST(StatusJson, EveryFieldAndEscapedStrings) {
   const std::string json = status_json(example_status());
   EXPECT_EQ(json.front(), '{');

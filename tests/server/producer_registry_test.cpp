@@ -28,6 +28,30 @@ TEST(ProducerRegistry, SeqGapsAreCounted) {
   EXPECT_EQ(r.snapshot()[p].seq_restarts, 0);
 }
 
+TEST(ProducerRegistry, ACopyOfTheLastScanIsRejectedNotAppliedTwice) {
+  // The same message delivered or replayed twice (same seq, same utime) used to be queued
+  // again, applied a second time and counted as a restart.
+  ProducerRegistry r("OCTOMAP_RT_SCAN_", 4);
+  const size_t p = r.producer_for("OCTOMAP_RT_SCAN_A");
+  auto admit_at = [&](int64_t seq, int64_t utime) { return r.admit(p, seq, utime, [] { return true; }); };
+  EXPECT_TRUE(admit_at(7, 1000));
+  EXPECT_FALSE(admit_at(7, 1000));
+  ProducerStats s = r.snapshot()[p];
+  EXPECT_EQ(s.received, 2);
+  EXPECT_EQ(s.rejected, 1);
+  EXPECT_EQ(s.rejects[static_cast<size_t>(Reject::kDuplicateSeq)], 1);
+  EXPECT_EQ(s.in_flight, 1);
+  EXPECT_EQ(s.seq_restarts, 0);
+  EXPECT_STREQ(to_string(Reject::kDuplicateSeq), "duplicate seq");
+  // The same seq at another time is a restarted robot: queued, counted as a restart.
+  EXPECT_TRUE(admit_at(7, 2000));
+  EXPECT_TRUE(admit_at(8, 2100));
+  s = r.snapshot()[p];
+  EXPECT_EQ(s.seq_restarts, 1);
+  EXPECT_EQ(s.rejected, 1);
+  EXPECT_EQ(s.in_flight, 3);
+}
+
 TEST(ProducerRegistry, HugeSeqJumpIsARestartNotBillionsMissed) {
   // Finding 8: one scan with seq INT64_MAX used to leave scans_missed at 9.2e18 for good
   // (and INT64_MIN after INT64_MAX overflowed: UBSan).

@@ -69,6 +69,7 @@ std::string robot_json(const octomap_rt::robot_stats_t& r) {
       .num("queue_bytes", r.queue_bytes)
       .num("last_end_to_end_ms", double(r.last_end_to_end_ms))
       .raw("reject_reasons", counts_json(r.reject_reason, r.reject_count))
+      .raw("drop_reasons", counts_json(r.drop_reason, r.drop_count))
       .raw("point_drops", counts_json(r.point_drop_reason, r.point_drop_count))
       .close();
 }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <string>
+#include <vector>
 
 namespace ort::status {
 namespace {
@@ -68,6 +70,17 @@ void serving(std::ostringstream& o, const Status& s) {
            with_commas(s.deltas_sent).c_str(), delta.c_str());
 }
 
+// One robot's counts by reason on a line of their own ("    rejected: truncated 2, ..."), none
+// when there are none.
+void reasons(std::ostringstream& o, const char* what, const std::vector<std::string>& names,
+             const std::vector<int64_t>& counts) {
+  const size_t n = std::min(names.size(), counts.size());
+  if (n == 0) return;
+  o << "    " << what << ":";
+  for (size_t i = 0; i < n; ++i) o << (i ? ", " : " ") << names[i] << " " << with_commas(counts[i]);
+  o << "\n";
+}
+
 void robots(std::ostringstream& o, const Status& s, int64_t now) {
   if (s.robots.empty()) {
     o << "\n  no robots yet (scans on OCTOMAP_RT_SCAN_<ROBOT>)\n";
@@ -84,19 +97,9 @@ void robots(std::ostringstream& o, const Status& s, int64_t now) {
     // A robot that restarted (its seq went back to 0 or jumped) is worth a line: its gaps
     // before and after are not lost scans.
     if (r.seq_restarts > 0) o << "    seq restarts: " << with_commas(r.seq_restarts) << "\n";
-    const size_t n = std::min(r.reject_reason.size(), r.reject_count.size());
-    if (n) {
-      o << "    rejected:";
-      for (size_t i = 0; i < n; ++i)
-        o << (i ? ", " : " ") << r.reject_reason[i] << " " << with_commas(r.reject_count[i]);
-      o << "\n";
-    }
-    const size_t d = std::min(r.point_drop_reason.size(), r.point_drop_count.size());
-    if (d == 0) continue;
-    o << "    points without a ray:";
-    for (size_t i = 0; i < d; ++i)
-      o << (i ? ", " : " ") << r.point_drop_reason[i] << " " << with_commas(r.point_drop_count[i]);
-    o << "\n";
+    reasons(o, "rejected", r.reject_reason, r.reject_count);
+    reasons(o, "dropped", r.drop_reason, r.drop_count);
+    reasons(o, "points without a ray", r.point_drop_reason, r.point_drop_count);
   }
 }
 

@@ -153,6 +153,11 @@ bool ProducerRegistry::admit(size_t producer, int64_t seq, int64_t utime, const 
   std::lock_guard lock(mutex_);
   ProducerStats& p = producers_[producer];
   p.received++;
+  if (p.has_seq && seq == p.last_seq && utime == p.last_utime) {
+    p.rejected++;
+    p.rejects[static_cast<size_t>(Reject::kDuplicateSeq)]++;
+    return false;
+  }
   note_seq(p, seq);
   p.last_utime = utime;
   if (!enqueue()) {

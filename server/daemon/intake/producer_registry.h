@@ -75,7 +75,9 @@ class ProducerRegistry {
   void count_rejected_arrival(size_t producer, Reject why);
   // A valid scan arrived: counts it and its seq gap, then calls `enqueue` under the
   // registry's lock; `enqueue` returns false when the queue refuses it (counted as dropped:
-  // queue full). Returns whether it was queued.
+  // queue full). A copy of the producer's previous scan (the same seq and utime: a message
+  // delivered or replayed twice) is rejected (duplicate seq), never applied twice. Returns
+  // whether it was queued.
   bool admit(size_t producer, int64_t seq, int64_t utime, const std::function<bool()>& enqueue);
 
   // A scan was applied: `points` of its points became rays, `dropped` gave none (by reason).
