@@ -51,6 +51,7 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
                              std::to_string(cfg_.max_points));
 
   load_or_create_map();  // first: a wrong map file fails before any device is opened
+  open_memory_bound();
   engine_ = std::make_unique<MapEngine>(cfg_.engine, log_);
   if (!cfg_.applied_log.empty()) map_.order.open_live_log(cfg_.applied_log);
 

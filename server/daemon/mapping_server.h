@@ -19,8 +19,10 @@
 #include "daemon/intake/producer_registry.h"
 #include "daemon/intake/scan_intake.h"
 #include "daemon/intake/scan_queue.h"
+#include "daemon/map/map_residency.h"
 #include "daemon/map/map_state.h"
 #include "daemon/map/map_upkeep.h"
+#include "daemon/persistence/region_store.h"
 #include "daemon/pipeline/pipeline_metrics.h"
 #include "daemon/pipeline/scan_pipeline.h"
 #include "daemon/queries/query_service.h"
@@ -69,6 +71,10 @@ class MappingServer {
     return f(static_cast<const octomap::OcTree&>(*map_.tree));
   }
   const std::string& lcm_url() const { return url_; }
+  // The whole map (evicted regions included: daemon/serving/map_snapshot.h), as a copy.
+  std::unique_ptr<octomap::OcTree> whole_map();
+  // The memory bound's figures (all 0 without --max-map-memory).
+  MapResidencyStats residency_stats() const { return residency_ ? residency_->stats() : MapResidencyStats{}; }
   // Decay and clearing (null before start()); tests in manual mode step it through this.
   MapUpkeep* upkeep() { return upkeep_.get(); }
   // The server's one LCM thread: services register their raw handlers on it before start().
@@ -79,6 +85,9 @@ class MappingServer {
  private:
   MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log);
   void load_or_create_map();
+  // --max-map-memory: the region store (emptied: the map file holds what a previous run
+  // evicted) and the residency, which brings a loaded map down to the bound.
+  void open_memory_bound();
   void open_map_serving();
   // The engine's warm-up scan (ServerConfig::warm_up_points), logged.
   void warm_up_engine();
@@ -97,6 +106,8 @@ class MappingServer {
   std::unique_ptr<LcmLoop> loop_;
   std::unique_ptr<MapEngine> engine_;
   MapState map_;
+  std::unique_ptr<RegionStore> region_store_;  // --max-map-memory's evicted regions
+  std::unique_ptr<MapResidency> residency_;
   ProducerRegistry producers_;
   ScanQueue queue_;
   PipelineMetrics metrics_;

@@ -8,6 +8,7 @@
 
 #include "core/clock.h"
 #include "daemon/mapping_server.h"
+#include "daemon/status/process_memory.h"
 #include "daemon/transport/kernel_udp_stats.h"
 
 namespace ort::daemon {
@@ -69,6 +70,19 @@ StatusInputs MappingServer::gather_status() {
   in.kernel_rcvbuf_errors = read_udp_rcvbuf_errors();
   in.socket_rcvbuf_drops = read_own_udp_drops();
   in.lcm_handler_errors = loop_->handler_errors();
+  if (residency_) {
+    const MapResidencyStats r = residency_->stats();
+    in.map_memory_bound = static_cast<int64_t>(r.max_bytes);
+    in.resident_regions = static_cast<int64_t>(r.resident_regions);
+    in.evicted_regions = static_cast<int64_t>(r.evicted_regions);
+    in.evicted_bytes = static_cast<int64_t>(r.evicted_bytes);
+    in.region_evictions = static_cast<int64_t>(r.evictions);
+    in.region_restores = static_cast<int64_t>(r.restores);
+    in.region_store_failures = static_cast<int64_t>(r.evict_failures + r.restore_failures);
+    // The tree's memory as the bound counts it (between walks, the status' own leaf count lags).
+    in.memory_bytes = static_cast<int64_t>(r.resident_bytes);
+  }
+  in.rss_bytes = resident_set_bytes();
   in.map_saves = saves_;
   if (map_service_) {
     const MapServiceStats ms = map_service_->stats();

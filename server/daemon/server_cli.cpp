@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "daemon/long_lived_flags.h"
 #include "daemon/queries/query_answers.h"
 #include "daemon/shard_flags.h"
 #include "protocol/channels.h"
@@ -147,26 +148,7 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
       ->capture_default_str();
   app.add_option("--stuck-stage", s.stuck_stage_s, "DEGRADED when a pipeline stage is on one scan longer than this [s]")
       ->capture_default_str();
-  app.add_option("--decay-half-life", s.upkeep.decay_half_life_s,
-                 "decay [s]: every voxel's log-odds halves toward 0 (unknown) in this long of the daemon's clock; "
-                 "0: no decay")
-      ->capture_default_str();
-  app.add_option("--decay-step", s.upkeep.decay_step_s, "seconds between decay steps; 0: half-life / 16")
-      ->capture_default_str();
-  app.add_option("--decay-delete-below", s.upkeep.decay_delete_below,
-                 "a voxel whose |log-odds| decays below this is deleted (0.1: p within 0.475..0.525)")
-      ->capture_default_str();
-  app.add_option("--clear-radius", s.upkeep.clear_radius_m,
-                 "clearing by distance [m]: everything farther than this from every robot seen within --clear-recent "
-                 "is deleted; 0: off")
-      ->capture_default_str();
-  app.add_option("--clear-recent", s.upkeep.clear_recent_s,
-                 "robots whose scan was applied within this many seconds count for --clear-radius")
-      ->capture_default_str();
-  app.add_option("--clear-period", s.upkeep.clear_period_s, "seconds between clearing passes")->capture_default_str();
-  app.add_option("--region-depth", s.upkeep.region_depth,
-                 "octree depth of the regions decay and clearing work on (10: 64 voxels a side)")
-      ->capture_default_str();
+  add_long_lived_flags(app, s);
   app.add_option("--max-scan-work", f.max_scan_work,
                  "most ray-walk steps one scan may cost (summed over its windows); a scan above it is rejected "
                  "as 'too much work'; 0: no limit")
@@ -386,11 +368,7 @@ ServerConfig to_server_config(const ServerFlags& f) {
        {std::pair{c.latency_bound_s, "--latency-bound"}, std::pair{c.drain_timeout_s, "--drain-timeout"},
         std::pair{c.stuck_stage_s, "--stuck-stage"}})
     if (!(value >= 0 && value <= 1e6)) throw CLI::ValidationError(name, "must be a number of seconds in [0, 1e6]");
-  try {
-    validate_upkeep(c.upkeep);
-  } catch (const std::invalid_argument& e) {
-    throw CLI::ValidationError("upkeep", e.what());
-  }
+  check_long_lived_flags(c);
   if (!c.queries.control_token.empty() && c.queries.control_token.size() < 16)
     throw CLI::ValidationError("--control-token",
                                "must have at least 16 characters: one observed edit lets anyone test guesses of it "

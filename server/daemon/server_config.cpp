@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <string>
 
 #include "daemon/intake/producer_registry.h"
 
@@ -12,6 +13,20 @@ uint64_t automatic_queue_budget() {
   const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
   const uint64_t phys = pages > 0 && page > 0 ? uint64_t(pages) * uint64_t(page) : (4ull << 30);
   return std::clamp<uint64_t>(phys / 64, 64ull << 20, 1ull << 30);
+}
+
+std::string memory_bound_problem(const ServerConfig& c) {
+  constexpr uint64_t kMin = uint64_t(1) << 20, kMax = uint64_t(1) << 50;
+  if (c.max_map_memory == 0) return "";
+  if (c.max_map_memory < kMin || c.max_map_memory > kMax)
+    return "must be 0 (no bound) or a number of bytes in [1 MiB, 2^50]";
+  if (c.region_store_max_bytes < kMin || c.region_store_max_bytes > kMax)
+    return "--region-store-max must be a number of bytes in [1 MiB, 2^50]";
+  if (c.map_path.empty()) return "needs --map: evicted regions are kept in FILE.ot.regions/ beside the map file";
+  if (c.queries.grid.rate_hz > 0)
+    return "cannot go with --grid-rate: its whole-map grid would bring every evicted region back each period "
+           "(ask for windowed grids instead)";
+  return "";
 }
 
 ProducerPolicy producer_policy(const ServerConfig& c) {

@@ -76,7 +76,16 @@ struct ServerConfig {
   // The regions this daemon maps when it is one shard of several (--shard, --shard-box;
   // protocol/shards/shard_set.h); the default maps every region.
   protocol::ShardSet shard;
+  // The memory bound (daemon/map/map_residency.h): past this many bytes of tree, the least
+  // recently touched regions (--region-depth) go to FILE.ot.regions/; 0: no bound.
+  uint64_t max_map_memory = 0;
+  uint64_t region_store_max_bytes = uint64_t(1) << 40;  // the store's own bound on disk
 };
+
+// "" when the memory bound's flags fit together; else why not (a bound or a store bound
+// below 1 MiB or past 2^50 bytes, no --map for the store to live beside, a --grid-rate whose
+// whole-map grid would bring every spilled region back each period).
+std::string memory_bound_problem(const ServerConfig& c);
 
 struct ProducerPolicy;
 // The producer admission policy (slots, idle release, allow-list) of `c`.

@@ -51,6 +51,8 @@ class DecaySweep {
   DecaySweep(const octomap::OcTree& tree, const RegionGrid& grid, const DecayRule& rule);
   // RegionSweep::run_slice with the decay: true when the step is done.
   bool run_slice(octomap::OcTree& tree, uint64_t node_budget);
+  // The sweep under it (a memory bound's hooks: RegionSweep::set_spill).
+  RegionSweep& regions() { return sweep_; }
   bool done() const { return sweep_.done(); }
   DecayStats stats() const;
   uint64_t nodes_deleted() const { return stats().nodes_deleted; }

@@ -24,6 +24,8 @@ class DistanceClearingSweep {
   DistanceClearingSweep(const octomap::OcTree& tree, const RegionGrid& grid, std::vector<octomap::point3d> centres,
                         double radius);
   bool run_slice(octomap::OcTree& tree, uint64_t node_budget);
+  // The sweep under it (a memory bound's hooks: RegionSweep::set_spill).
+  RegionSweep& regions() { return sweep_; }
   bool done() const { return centres_.empty() || sweep_.done(); }
   uint64_t nodes_deleted() const { return deleted_ + sweep_.nodes_deleted(); }
   uint64_t nodes_visited() const { return sweep_.nodes_visited(); }

@@ -53,9 +53,24 @@ void RegionResidency::touch_voxels(octomap::OcTree& tree, std::span<const VoxelU
   touch(tree, ids);
 }
 
-size_t RegionResidency::enforce(octomap::OcTree& tree) {
-  uint64_t bytes = tree.memoryUsage();
-  if (bytes <= max_bytes_) return 0;
+namespace {
+
+// Inner nodes of an encoded region (octree/region_codec.h: 5 bytes a node, the last its
+// child bits): each had a child array, freed with the nodes below the stand-in.
+uint64_t inner_nodes(const std::vector<uint8_t>& encoded) {
+  constexpr size_t kHeader = 36, kNode = 5;
+  uint64_t n = 0;
+  for (size_t at = kHeader; at + kNode <= encoded.size(); at += kNode) n += encoded[at + 4] != 0;
+  return n;
+}
+
+}  // namespace
+
+size_t RegionResidency::enforce(octomap::OcTree& tree) { return enforce(tree, tree.memoryUsage(), max_bytes_).regions; }
+
+EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, uint64_t target) {
+  EnforceResult result;
+  if (bytes <= target) return result;
   struct Candidate {
     uint64_t touched;
     RegionId id;
@@ -69,27 +84,65 @@ size_t RegionResidency::enforce(octomap::OcTree& tree) {
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
     return a.touched != b.touched ? a.touched < b.touched : a.id < b.id;
   });
-  const uint64_t per_node = tree.size() ? bytes / tree.size() : 1;
-  size_t n = 0;
+  result.listed = candidates.size();
   for (const Candidate& c : candidates) {
-    if (bytes <= max_bytes_) break;
+    if (bytes <= target) break;
     const std::vector<uint8_t> encoded = encode_region(tree, grid_, c.id);
     spill_.put(c.id, encoded);  // durable before the nodes go
     const uint64_t freed = strip_region(tree, grid_, c.id);
+    const uint64_t freed_bytes =
+        freed * tree.memoryUsageNode() + inner_nodes(encoded) * 8 * sizeof(octomap::OcTreeNode*);
     spilled_[c.id] = encoded.size();
     stats_.evicted_bytes += encoded.size();
     stats_.evictions++;
-    bytes -= std::min(bytes, freed * per_node);
-    ++n;
+    bytes -= std::min(bytes, freed_bytes);
+    result.bytes_freed += freed_bytes;
+    result.regions++;
   }
-  return n;
+  return result;
 }
 
-void RegionResidency::restore_all(octomap::OcTree& tree) {
+std::vector<RegionId> RegionResidency::spilled_in(const octomap::OcTreeKey& lo, const octomap::OcTreeKey& hi) const {
+  std::vector<RegionId> out;
+  if (spilled_.empty()) return out;
+  const unsigned s = grid_.shift();
+  uint64_t cells = 1;
+  for (unsigned a = 0; a < 3; ++a) cells *= uint64_t((hi[a] >> s) - (lo[a] >> s) + 1);
+  if (cells <= spilled_.size()) {  // few regions in the box: look each up
+    for (unsigned z = lo[2] >> s; z <= unsigned(hi[2] >> s); ++z)
+      for (unsigned y = lo[1] >> s; y <= unsigned(hi[1] >> s); ++y)
+        for (unsigned x = lo[0] >> s; x <= unsigned(hi[0] >> s); ++x) {
+          const octomap::OcTreeKey k(uint16_t(x << s), uint16_t(y << s), uint16_t(z << s));
+          const RegionId id = region_of(grid_, k);
+          if (spilled_.count(id)) out.push_back(id);
+        }
+  } else {  // a large box: test each spilled region
+    for (const auto& [id, b] : spilled_) {
+      const octomap::OcTreeKey k = region_min_key(grid_, id);
+      bool meets = true;
+      for (unsigned a = 0; a < 3; ++a) meets = meets && (k[a] >> s) >= (lo[a] >> s) && (k[a] >> s) <= (hi[a] >> s);
+      if (meets) out.push_back(id);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<RegionId> RegionResidency::spilled_ids() const {
   std::vector<RegionId> ids;
   for (const auto& [id, b] : spilled_) ids.push_back(id);
   std::sort(ids.begin(), ids.end());
-  for (RegionId id : ids) restore(tree, id);
+  return ids;
+}
+
+void RegionResidency::forget_all() {
+  for (RegionId id : spilled_ids()) spill_.erase(id);
+  spilled_.clear();
+  stats_.evicted_bytes = 0;
+}
+
+void RegionResidency::restore_all(octomap::OcTree& tree) {
+  for (RegionId id : spilled_ids()) restore(tree, id);
 }
 
 ResidencyStats RegionResidency::stats() const {

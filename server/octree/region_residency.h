@@ -37,6 +37,14 @@ struct ResidencyStats {
   uint64_t evicted_regions = 0, evicted_bytes = 0;  // now
 };
 
+// What one enforce() did: the regions spilled and the tree memory they freed, counted as
+// OctoMap's memoryUsage() counts it (a node each, a child array of 8 pointers per inner node).
+struct EnforceResult {
+  size_t regions = 0;
+  size_t listed = 0;  // regions holding a subtree before the call (0 when nothing was spilled)
+  uint64_t bytes_freed = 0;
+};
+
 class RegionResidency {
  public:
   RegionResidency(const RegionGrid& grid, RegionSpill& spill, uint64_t max_bytes);
@@ -49,6 +57,18 @@ class RegionResidency {
   // Spills the least recently touched regions until the tree's memory (OctoMap's
   // memoryUsage()) is within the bound. Returns the regions spilled.
   size_t enforce(octomap::OcTree& tree);
+  // The same from a known memory figure `bytes_now` down to `target` (a caller that keeps its
+  // own count: memoryUsage() walks the whole tree). A put() that throws leaves that region in
+  // the tree and ends the call with the exception (nothing was lost).
+  EnforceResult enforce(octomap::OcTree& tree, uint64_t bytes_now, uint64_t target);
+  // Brings one spilled region back without counting it as touched (a sweep visiting every
+  // region must not make the whole map "recent"). No-op when it is not spilled.
+  void bring_back(octomap::OcTree& tree, RegionId id) { restore(tree, id); }
+  // The spilled regions whose cubes meet the key box [lo, hi] (inclusive).
+  std::vector<RegionId> spilled_in(const octomap::OcTreeKey& lo, const octomap::OcTreeKey& hi) const;
+  std::vector<RegionId> spilled_ids() const;
+  // The tree no longer holds any spilled region (a reset): drops them from the spill.
+  void forget_all();
   // Brings every spilled region back (a whole-map save or snapshot without the bound).
   void restore_all(octomap::OcTree& tree);
   bool spilled(RegionId id) const { return spilled_.count(id) != 0; }

@@ -5,13 +5,20 @@
 namespace ort {
 namespace {
 
-// The nodes above the region depth, post-order: inner values, then OctoMap's prune.
-void settle_top(octomap::OcTree& tree, octomap::OcTreeNode* node, unsigned depth, unsigned region_depth) {
-  if (depth >= region_depth || !tree.nodeHasChildren(node)) return;
-  for (unsigned i = 0; i < 8; ++i)
-    if (tree.nodeChildExists(node, i)) settle_top(tree, tree.getNodeChild(node, i), depth + 1, region_depth);
+// The nodes above the region depth, post-order: inner values, then OctoMap's prune (never
+// of a node whose children include a stand-in: region_sweep.h).
+void settle_top(octomap::OcTree& tree, octomap::OcTreeNode* node, const octomap::OcTreeKey& min_key, unsigned depth,
+                const RegionGrid& grid, const SweepSpill& spill) {
+  if (depth >= grid.depth || !tree.nodeHasChildren(node)) return;
+  bool stand_in = false;
+  for (unsigned i = 0; i < 8; ++i) {
+    if (!tree.nodeChildExists(node, i)) continue;
+    const octomap::OcTreeKey k = detail::child_min_key(min_key, depth, i);
+    settle_top(tree, tree.getNodeChild(node, i), k, depth + 1, grid, spill);
+    if (depth + 1 == grid.depth && spill.spilled && spill.spilled(region_of(grid, k))) stand_in = true;
+  }
   node->updateOccupancyChildren();
-  if (depth > 0) tree.pruneNode(node);  // OctoMap's prune() never prunes the root
+  if (depth > 0 && !stand_in) tree.pruneNode(node);  // OctoMap's prune() never prunes the root
 }
 
 unsigned child_index_at(const octomap::OcTreeKey& key, unsigned depth) {
@@ -56,6 +63,7 @@ RegionSweep::RegionSweep(const octomap::OcTree& tree, const RegionGrid& grid) : 
 }
 
 void RegionSweep::visit_unit(octomap::OcTree& tree, const Unit& unit, const RegionVisit& visit) {
+  if (unit.depth == grid_.depth && spill_.bring_back) spill_.bring_back(tree, region_of(grid_, unit.min_key));
   octomap::OcTreeNode* root = tree.getRoot();
   if (root == nullptr) return;
   octomap::OcTreeNode* path[17];
@@ -97,7 +105,7 @@ bool RegionSweep::run_slice(octomap::OcTree& tree, uint64_t node_budget, const R
     visit_unit(tree, units_[next_++], visit);
   } while (visited_ - start < node_budget);
   if (next_ < units_.size()) return false;
-  if (octomap::OcTreeNode* root = tree.getRoot()) settle_top(tree, root, 0, grid_.depth);
+  if (octomap::OcTreeNode* root = tree.getRoot()) settle_top(tree, root, octomap::OcTreeKey(0, 0, 0), 0, grid_, spill_);
   finished_ = true;
   return true;
 }

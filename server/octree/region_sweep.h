@@ -42,9 +42,18 @@ void free_empty_child_array(octomap::OcTreeNode* node);
 // The min-corner key of child `i` of a node at `depth` whose min corner is `min_key`.
 octomap::OcTreeKey child_min_key(const octomap::OcTreeKey& min_key, unsigned depth, unsigned i);
 
+// With a memory bound (octree/region_residency.h) some regions are stand-ins for subtrees on
+// disk: a sweep brings each back before it visits it, and its closing prune leaves alone every
+// node with a stand-in below it (the same map without the bound has a subtree there).
+struct SweepSpill {
+  std::function<void(octomap::OcTree&, RegionId)> bring_back;
+  std::function<bool(RegionId)> spilled;
+};
+
 class RegionSweep {
  public:
   RegionSweep(const octomap::OcTree& tree, const RegionGrid& grid);
+  void set_spill(SweepSpill spill) { spill_ = std::move(spill); }
 
   // Visits listed regions until `node_budget` nodes were visited (at least one region) or
   // none is left; then, once, prunes the nodes above the region depth. True when done.
@@ -63,6 +72,7 @@ class RegionSweep {
   void visit_unit(octomap::OcTree& tree, const Unit& unit, const RegionVisit& visit);
 
   RegionGrid grid_;
+  SweepSpill spill_;
   std::vector<Unit> units_;
   size_t next_ = 0;
   bool finished_ = false;

@@ -47,6 +47,10 @@ octomap_rt_add_test(server_delta_changes_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/
 # The long-lived map's upkeep in the daemon: decay steps and clearing passes between scans.
 octomap_rt_add_test(map_upkeep_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_upkeep_test.cpp ${SERVER_TEST_FIXTURES}
                     LIBS octomap_rt_daemon TIMEOUT 120)
+# The memory bound in the daemon: real scans past --max-map-memory, saves, restarts, kill -9.
+octomap_rt_add_test(memory_bound_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/memory_bound_test.cpp ${SERVER_TEST_FIXTURES}
+                    LIBS octomap_rt_daemon TIMEOUT 300)
+octomap_rt_lcm_handler_sources(memory_bound_test ${CMAKE_CURRENT_LIST_DIR}/memory_bound_test.cpp)
 # Issue 21: every numeric field of scan_t at its degenerate values, on every back end.
 octomap_rt_add_test(server_scan_fields_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/scan_fields_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)

@@ -246,18 +246,21 @@ LoadReport run_load_test(const LoadTestConfig& cfg) {
   if (!cfg.series_path.empty()) {
     series = std::jthread([&] {
       std::ofstream out(cfg.series_path);
-      out << "t_s,rss_mib,peak_rss_mib,map_memory_mib,map_nodes,e2e_p99_ms,scans_applied\n";
+      out << "t_s,rss_mib,peak_rss_mib,map_memory_mib,map_nodes,e2e_p99_ms,scans_applied,octree_p99_ms,"
+             "bound_mib,evicted_mib,evicted_regions,region_evictions,region_restores\n";
       int64_t last_seq = -1;
       while (!series_stop) {
         std::this_thread::sleep_for(std::chrono::milliseconds(250));
         const octomap_rt::server_status_t st = status.latest();
         if (st.seq == last_seq) continue;
         last_seq = st.seq;
-        char line[256];
-        std::snprintf(line, sizeof line, "%.2f,%.1f,%.1f,%.2f,%lld,%.2f,%lld\n",
+        char line[384];
+        std::snprintf(line, sizeof line, "%.2f,%.1f,%.1f,%.2f,%lld,%.2f,%lld,%.2f,%.2f,%.2f,%lld,%lld,%lld\n",
                       std::chrono::duration<double>(Clock::now() - t0).count(), rss_mib(server), peak_rss_mib(server),
                       double(st.memory_bytes) / 1048576.0, (long long)st.num_nodes, double(st.end_to_end_ms_p99),
-                      (long long)st.scans_applied);
+                      (long long)st.scans_applied, double(st.octree_ms_p99), double(st.map_memory_bound) / 1048576.0,
+                      double(st.evicted_bytes) / 1048576.0, (long long)st.evicted_regions,
+                      (long long)st.region_evictions, (long long)st.region_restores);
         out << line << std::flush;
       }
     });

@@ -57,6 +57,12 @@ void queue_and_kernel(std::ostringstream& o, const Status& s) {
   if (s.lcm_handler_errors > 0)
     o << "  LCM       " << with_commas(s.lcm_handler_errors)
       << " messages whose handler failed (see the server's log)\n";
+  if (s.map_memory_bound > 0)
+    o << "  memory    bound " << bytes_text(s.map_memory_bound) << ": " << bytes_text(s.memory_bytes) << " resident in "
+      << with_commas(s.resident_regions) << " regions, " << with_commas(s.evicted_regions) << " regions evicted ("
+      << bytes_text(s.evicted_bytes) << " in the store); " << with_commas(s.region_evictions) << " evictions, "
+      << with_commas(s.region_restores) << " restores, " << with_commas(s.region_store_failures)
+      << " refused by the store; RSS " << (s.rss_bytes < 0 ? std::string("unknown") : bytes_text(s.rss_bytes)) << "\n";
 }
 
 // The map service (snapshots, chunks) and the delta stream: what mirrors and map clients got.

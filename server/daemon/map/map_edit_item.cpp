@@ -1,5 +1,6 @@
 #include "daemon/map/map_edit_item.h"
 
+#include "daemon/map/map_residency.h"
 #include "daemon/map/map_state.h"
 #include "octomap_rt/map_edit_t.hpp"
 #include "query/map_edit.h"
@@ -12,8 +13,11 @@ MapEditResult apply_map_edit(MapState& map, const MapEditItem& edit) {
   octomap::OcTree& tree = *map.tree;
   if (edit.op == Msg::OP_RESET) {
     query::reset_map(tree);
+    if (map.residency) map.residency->forget_all();
   } else {
     const query::KeyBox box = query::key_box(tree, edit.box_min, edit.box_max);
+    // The box's spilled regions come back before the estimate reads them.
+    if (map.residency) map.residency->touch_boxes(tree, std::span<const query::KeyBox>(&box, 1));
     r.voxels = box.voxels();
     const query::ClearTo to = edit.op == Msg::OP_CLEAR_TO_FREE ? query::ClearTo::kFree : query::ClearTo::kUnknown;
     const query::Unknown unknown = edit.include_unknown ? query::Unknown::kMarked : query::Unknown::kKept;
@@ -28,6 +32,7 @@ MapEditResult apply_map_edit(MapState& map, const MapEditItem& edit) {
       return r;
     }
     query::clear_box(tree, box, to, unknown);
+    if (map.residency) map.residency->enforce(tree);
   }
   map.version++;
   // Deltas cannot carry an edit (a box back to unknown, a reset): mirrors resync from a snapshot.

@@ -33,6 +33,8 @@ class MapChangeObserver {
   virtual void replaced(const octomap::OcTree& tree, uint64_t version) = 0;
 };
 
+class MapResidency;
+
 struct MapState {
   // Writers (stage 2, edits) lock it exclusively; queries read under a shared lock.
   std::shared_mutex mutex;
@@ -47,6 +49,9 @@ struct MapState {
   int64_t last_scan_utime = 0;            // utime of the newest applied scan
   octomap::point3d last_scan_origin;      // its sensor origin (where a clipped grid is centred)
   MapChangeObserver* observer = nullptr;  // set before the pipeline starts
+  // The memory bound (daemon/map/map_residency.h); null without --max-map-memory. Set before
+  // the pipeline starts; whoever reads or changes voxels touches their regions through it.
+  MapResidency* residency = nullptr;
   // Where each robot's newest applied scan was taken from and when it was applied (the
   // daemon's steady clock): clearing by distance keeps what is near the robots seen lately
   // (daemon/map/map_upkeep.h). At most kMaxRobotsSeen entries (the stalest goes first).

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/map/map_residency.h"
 #include "octree/decay.h"
 #include "octree/distance_clearing.h"
 
@@ -66,11 +67,23 @@ template <class Sweep>
 void MapUpkeep::run_sweep(Sweep& sweep, uint64_t& deleted_counter) {
   bool done = false;
   uint64_t deleted_before = 0;
+  // With a memory bound, spilled regions come back as the sweep reaches them and the bound
+  // holds after every slice (daemon/map/map_residency.h).
+  if (map_.residency) sweep.regions().set_spill(map_.residency->sweep_hooks());
   while (!done) {
     const auto t0 = SteadyClock::now();
     {
       std::unique_lock lock(map_.mutex);
-      done = sweep.run_slice(*map_.tree, cfg_.slice_nodes);
+      try {
+        done = sweep.run_slice(*map_.tree, cfg_.slice_nodes);
+      } catch (const std::exception& e) {  // the region store could not give a region back
+        log_.error(
+            text("a sweep stopped before its end (the regions it reached are swept, the rest wait for "
+                 "the next): ",
+                 e.what()));
+        done = true;
+      }
+      if (map_.residency) map_.residency->enforce(*map_.tree);
       count_slice_change();
       // Deltas cannot carry the sweep: mirrors resync once it is whole.
       if (done && map_.observer) map_.observer->replaced(*map_.tree, map_.version);

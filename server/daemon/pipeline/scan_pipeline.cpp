@@ -6,6 +6,7 @@
 
 #include "core/clock.h"
 #include "daemon/intake/scan_to_map.h"
+#include "daemon/map/map_residency.h"
 
 namespace ort::daemon {
 namespace {
@@ -215,6 +216,9 @@ void ScanPipeline::apply(ShotJob& job) {
   try {
     std::lock_guard lock(map_.mutex);
     const auto locked = Clock::now();
+    // Spilled regions the scan updates come back first (daemon/map/map_residency.h).
+    if (std::string why; map_.residency && !map_.residency->touch_scan(*map_.tree, job.shot.voxels, why))
+      throw std::runtime_error(why);
     const auto nodes_before = static_cast<int64_t>(map_.tree->size());
     engine_.apply(job.shot, *map_.tree, map_.observer ? &changes_ : nullptr);
     new_nodes = static_cast<int64_t>(map_.tree->size()) - nodes_before;
@@ -231,6 +235,7 @@ void ScanPipeline::apply(ShotJob& job) {
     const std::string robot = lower_case(job.robot_id);
     map_.applied_seq[robot] = job.seq;
     note_robot_seen(map_, robot, job.origin);
+    if (map_.residency) map_.residency->enforce(*map_.tree);
     parts = {ms_between(t0, locked), ms_between(locked, updated), ms_between(updated, Clock::now())};
   } catch (const std::exception& e) {
     set_busy(1, false);

@@ -6,7 +6,9 @@
 #include <cmath>
 
 #include "daemon/map/map_edit_item.h"
+#include "daemon/map/map_residency.h"
 #include "daemon/queries/edit_audit.h"
+#include "daemon/queries/query_footprint.h"
 #include "octomap_rt/map_edit_ack_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/occupancy_reply_t.hpp"
@@ -232,6 +234,12 @@ bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& o
     out.push_back(error_reply(q.msg, Reply::REPLY_NOT_READY, why, stamp, server_id_));
     return true;
   }
+  // A query meeting an evicted region waits for the exclusive turn that brings it back.
+  if (map_.residency && !exclusive_turn_ &&
+      map_.residency->any_spilled_in(query_footprint(*map_.tree, map_.residency->grid(), q.msg))) {
+    to_restore_.push_back(std::move(q));
+    return true;
+  }
   // Its own bounds, checked inside the walk: work, time under the lock, the server stopping.
   query::WorkBudget budget;
   budget.max_work = cfg_.bounds.max_work;
@@ -304,8 +312,30 @@ void QueryService::run() {
         }
       }
     }
+    if (!to_restore_.empty()) answer_restoring(parked, out);
     for (const EncodedReplies& r : out) publish(r);
   }
+}
+
+// The queries that meet evicted regions: under the exclusive lock, their regions come back,
+// they are answered, and the bound holds again (daemon/map/map_residency.h).
+void QueryService::answer_restoring(std::vector<PendingQuery>& parked, std::vector<EncodedReplies>& out) {
+  std::unique_lock lock(map_.mutex);
+  exclusive_turn_ = true;
+  for (PendingQuery& q : to_restore_) {
+    try {
+      map_.residency->touch_boxes(*map_.tree, query_footprint(*map_.tree, map_.residency->grid(), q.msg));
+    } catch (const std::exception& e) {  // the store could not give a region back
+      const QueryHeader h = header_of(q.msg);
+      clients_.count(h.client_id, Count::kBusy, e.what());
+      out.push_back(error_reply(q.msg, Reply::REPLY_BUSY, std::string("busy: ") + e.what(), {}, server_id_));
+      continue;
+    }
+    if (!answer_locked(q, out) && parked.size() < kMaxParked) parked.push_back(std::move(q));
+  }
+  to_restore_.clear();
+  exclusive_turn_ = false;
+  map_.residency->enforce(*map_.tree);
 }
 
 }  // namespace ort::daemon

@@ -65,6 +65,7 @@ class QueryService {
   // Under the map lock (shared): true when answered or refused for good, its replies added to
   // `out` (published after the lock is released); false: not ready yet, within its deadline.
   bool answer_locked(PendingQuery& q, std::vector<EncodedReplies>& out);
+  void answer_restoring(std::vector<PendingQuery>& parked, std::vector<EncodedReplies>& out);
   void publish(const EncodedReplies& r);
 
   QueryServiceConfig cfg_;
@@ -78,6 +79,10 @@ class QueryService {
   EditGate gate_;  // the LCM thread's: MAC, time window, nonces
   std::vector<LcmLoop::SubscriptionId> subs_;
   std::thread worker_;
+  // Queries of this turn that meet evicted regions, and whether the exclusive turn that
+  // answers them is on (the worker's own state).
+  std::vector<PendingQuery> to_restore_;
+  bool exclusive_turn_ = false;
   GridPublisher grids_;
   std::mutex wake_mutex_;
   std::condition_variable wake_;

@@ -4,6 +4,7 @@
 #include <mutex>
 
 #include "core/clock.h"
+#include "daemon/map/map_residency.h"
 
 namespace ort::daemon {
 namespace {
@@ -12,6 +13,8 @@ namespace {
 MapCopy copy_locked(const MapState& map, std::chrono::steady_clock::time_point t0) {
   MapCopy c;
   c.tree = std::make_unique<octomap::OcTree>(*map.tree);
+  // With a memory bound the copy is the whole map: its stand-ins get their regions back.
+  if (map.residency) map.residency->fill_copy(*c.tree);
   c.version = map.version;
   c.scans = map.order.size();
   c.last_scan_utime = map.last_scan_utime;

@@ -160,6 +160,15 @@ void print_run_summary(std::ostream& out, const RunSummaryInputs& in) {
       << " in this network namespace (all programs; -1: unknown)\n";
   if (s.lcm_handler_errors > 0)
     out << "  LCM handler errors: " << s.lcm_handler_errors << " messages (each logged as it happened)\n";
+  if (s.map_memory_bound > 0) {
+    std::snprintf(line, sizeof line,
+                  "  memory bound: %.1f MiB; %lld regions evicted (%.1f MiB in the store), %lld evictions, %lld "
+                  "restores, %lld refused by the store; RSS %.1f MiB\n",
+                  s.map_memory_bound / 1048576.0, (long long)s.evicted_regions, s.evicted_bytes / 1048576.0,
+                  (long long)s.region_evictions, (long long)s.region_restores, (long long)s.region_store_failures,
+                  s.rss_bytes / 1048576.0);
+    out << line;
+  }
   print_serving(out, in);
   print_files(out, in);
 }

@@ -130,6 +130,14 @@ octomap_rt::server_status_t make_status(const StatusInputs& in) {
   s.kernel_rcvbuf_errors = in.kernel_rcvbuf_errors;
   s.socket_rcvbuf_drops = in.socket_rcvbuf_drops;
   s.lcm_handler_errors = in.lcm_handler_errors;
+  s.map_memory_bound = in.map_memory_bound;
+  s.resident_regions = in.resident_regions;
+  s.evicted_regions = in.evicted_regions;
+  s.evicted_bytes = in.evicted_bytes;
+  s.region_evictions = in.region_evictions;
+  s.region_restores = in.region_restores;
+  s.region_store_failures = in.region_store_failures;
+  s.rss_bytes = in.rss_bytes;
   s.map_saves = in.map_saves;
   s.last_save_utime = in.last_save_utime;
   s.latest_snapshot_id = in.latest_snapshot_id;

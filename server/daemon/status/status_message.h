@@ -26,6 +26,9 @@ struct StatusInputs {
   int64_t queue_bytes = 0, queue_budget_bytes = 0;
   int64_t kernel_rcvbuf_errors = -1, socket_rcvbuf_drops = -1;
   int64_t lcm_handler_errors = 0;  // LcmLoop::handler_errors()
+  // The memory bound (daemon/map/map_residency.h) and the process's RSS.
+  int64_t map_memory_bound = 0, resident_regions = 0, evicted_regions = 0, evicted_bytes = 0;
+  int64_t region_evictions = 0, region_restores = 0, region_store_failures = 0, rss_bytes = -1;
   int64_t map_saves = 0, last_save_utime = 0;
   int64_t map_version = 0, latest_snapshot_id = 0, requests_served = 0, requests_rejected = 0;
   int64_t snapshots_taken = 0, chunks_sent = 0, deltas_sent = 0, last_delta_seq = -1;

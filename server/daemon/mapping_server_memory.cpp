@@ -1,0 +1,34 @@
+// The server's memory bound (--max-map-memory): daemon/map/map_residency.h.
+#include <stdexcept>
+
+#include "daemon/mapping_server.h"
+#include "daemon/serving/map_snapshot.h"
+
+namespace ort::daemon {
+
+void MappingServer::open_memory_bound() {
+  if (cfg_.max_map_memory == 0) return;
+  if (const std::string bad = memory_bound_problem(cfg_); !bad.empty())
+    throw std::invalid_argument("--max-map-memory " + bad);
+  const std::string dir = region_store_dir(cfg_.map_path);
+  region_store_ = std::make_unique<RegionStore>(dir, cfg_.region_store_max_bytes);
+  // Every save is the whole map (its copy gets the evicted regions back), so what a previous
+  // run left here is in the map file as of its last save, or newer than it (evicted after
+  // it, lost with that run's unsaved scans): the map file is the map of record.
+  const std::vector<RegionId> left = region_store_->ids();
+  for (RegionId id : left) region_store_->erase(id);
+  if (!left.empty())
+    log_.info(text("removed ", left.size(), " regions a previous run left in ", dir,
+                   " (the map file holds the map as it was saved)"));
+  residency_ = std::make_unique<MapResidency>(map_, region_grid(cfg_.upkeep.region_depth), *region_store_,
+                                              cfg_.max_map_memory, log_);
+  map_.residency = residency_.get();
+  residency_->enforce(*map_.tree);  // a loaded map larger than the bound goes down to it now
+  const MapResidencyStats s = residency_->stats();
+  log_.info(text("map memory bound ", cfg_.max_map_memory, " bytes: ", s.resident_bytes, " resident, ",
+                 s.evicted_regions, " regions (", s.evicted_bytes, " bytes) evicted to ", dir));
+}
+
+std::unique_ptr<octomap::OcTree> MappingServer::whole_map() { return copy_map(map_).tree; }
+
+}  // namespace ort::daemon
