@@ -11,6 +11,7 @@
 
 #include "daemon/long_lived_flags.h"
 #include "daemon/queries/query_answers.h"
+#include "daemon/scan_cost_flags.h"
 #include "daemon/shard_flags.h"
 #include "protocol/channels.h"
 #include "protocol/ids.h"
@@ -153,25 +154,7 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                  "most ray-walk steps one scan may cost (summed over its windows); a scan above it is rejected "
                  "as 'too much work'; 0: no limit")
       ->capture_default_str();
-  app.add_option("--max-origin-jump", s.scan_costs.max_origin_jump_m,
-                 "farthest a robot's scan origin may be from its last scan's [m] (plus --max-robot-speed for each "
-                 "second since); farther: rejected as 'origin jump'; 0: unchecked")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e7));
-  app.add_option("--max-robot-speed", s.scan_costs.max_speed_mps, "see --max-origin-jump [m/s]")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e6));
-  app.add_option("--max-scan-voxels", s.scan_costs.max_scan_voxels,
-                 "most voxels one scan may update; more: rejected as 'too many voxels'; 0: no limit")
-      ->capture_default_str();
-  app.add_option("--max-new-nodes-per-s", s.scan_costs.max_new_nodes_per_s,
-                 "new octree nodes a second one robot may add, on average (allowance up to --new-node-burst); "
-                 "past it its scans are rejected as 'new-node rate' until the allowance refills; 0: no limit")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e12));
-  app.add_option("--new-node-burst", s.scan_costs.new_node_burst, "see --max-new-nodes-per-s")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e13));
+  add_scan_cost_flags(app, s.scan_costs);
   app.add_option("--max-producers", s.max_producers,
                  "most scan channels served at once; more are rejected (too many producers) unless an idle "
                  "one can be let go (--producer-idle-release)")

@@ -97,6 +97,36 @@ TEST(ScanCosts, RepeatedFarReachingScansStopAtTheRobotsNewNodeAllowance) {
   expect_counts_balance(server.producer_stats());
 }
 
+TEST(ScanCosts, ManyRobotsEachWithinItsAllowanceStopAtTheMapsAllowance) {
+  // Robot ids are free to make: each new one came with a fresh allowance of its own, so many
+  // of them grew the map without a bound. The map's allowance bounds them together.
+  lcm::LCM lc("memq://");
+  auto cfg = test_config(0.1, true);
+  cfg.scan_costs.max_new_nodes_per_s = 0;  // no bound per robot
+  cfg.scan_costs.max_map_new_nodes_per_s = 1000;
+  cfg.scan_costs.map_new_node_burst = 1;
+  daemon::MappingServer server(cfg, lc, std::cerr);
+  server.start();
+  for (int64_t k = 0; k < 4; ++k) {  // ~300 K new nodes each, from four robots
+    const std::string robot = "ROBOT" + std::to_string(k);
+    auto s = reaching_scan(k, {1, 2, 0.5f}, 300, 100);
+    s.robot_id = robot;
+    lc.publish("OCTOMAP_RT_SCAN_" + robot, &s);
+    ASSERT_TRUE(wait_until_done(server, k + 1, std::chrono::seconds(120)));
+  }
+  // The first overdraws the map's allowance (a scan is applied whole or not at all); the other
+  // robots' scans are refused though each robot is within its own (unbounded) allowance.
+  int64_t applied_scans = 0, refused = 0;
+  for (const auto& p : server.producer_stats()) {
+    applied_scans += p.applied;
+    refused += p.rejects[static_cast<size_t>(Reject::kMapNewNodeRate)];
+  }
+  EXPECT_EQ(applied_scans, 1);
+  EXPECT_EQ(refused, 3);
+  server.stop();
+  expect_counts_balance(server.producer_stats());
+}
+
 TEST(ScanCosts, AScanOverTheVoxelBoundIsRefusedWhole) {
   lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);

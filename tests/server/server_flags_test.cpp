@@ -56,6 +56,11 @@ TEST(ServerFlags, AbsurdNumbersForTheWalkAndTheSensorModelAreRefusedAtStart) {
       {"-r 0.1 --sensor-max-x nan", "--sensor"},
       {"-r 0.1 --min-range -1", "--min-range"},
       {"-r 0.1 --occupancy-min-z 3 --occupancy-max-z 1", "--occupancy-min-z"},
+      // Issue 21's cost bounds over time: NaN or negative rates and allowances.
+      {"-r 0.1 --max-new-nodes-per-s nan", "--max-new-nodes-per-s"},
+      {"-r 0.1 --max-map-new-nodes-per-s -1", "--max-map-new-nodes-per-s"},
+      {"-r 0.1 --map-new-node-burst nan", "--map-new-node-burst"},
+      {"-r 0.1 --max-origin-jump -5", "--max-origin-jump"},
   };
   for (const auto& c : cases) {
     const ServerRun r = run_server(c.flags);

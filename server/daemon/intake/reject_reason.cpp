@@ -32,6 +32,7 @@ const char* to_string(Reject r) {
     case Reject::kTooManyVoxels: return "too many voxels";
     case Reject::kOriginJump: return "origin jump";
     case Reject::kNewNodeRate: return "new-node rate";
+    case Reject::kMapNewNodeRate: return "map new-node rate";
     case Reject::kDuplicateSeq: return "duplicate seq";
     case Reject::kQueueFull: return "queue full";
     case Reject::kOverLatencyBound: return "over latency bound";

@@ -41,6 +41,7 @@ enum class Reject {
   kTooManyVoxels,     // the shot scan updates more voxels than --max-scan-voxels
   kOriginJump,        // the origin is farther from the robot's last scan than it could have moved
   kNewNodeRate,       // the robot's new nodes passed --max-new-nodes-per-s (its allowance is spent)
+  kMapNewNodeRate,    // all robots' new nodes passed --max-map-new-nodes-per-s (the map's allowance is spent)
   kDuplicateSeq,      // the seq and utime of the robot's previous scan again: a copy, not applied twice
   // Why a valid scan was dropped (counted as dropped, not rejected).
   kQueueFull,         // the producer's queue budget was full on arrival

@@ -4,32 +4,52 @@
 #include <cmath>
 
 namespace ort::daemon {
+namespace {
+
+// Full at first sight, then refilled at `rate` a second up to `burst`.
+void refill(double& tokens, SteadyClock::time_point& refilled, SteadyClock::time_point now, double rate, double burst) {
+  if (refilled == SteadyClock::time_point{}) {
+    tokens = burst;
+    refilled = now;
+    return;
+  }
+  const double s = std::chrono::duration<double>(now - refilled).count();
+  if (s <= 0) return;
+  tokens = std::min(burst, tokens + s * rate);
+  refilled = now;
+}
+
+std::string over(double tokens, double rate, const char* whose, const char* flag) {
+  return std::string(whose) + " new nodes passed " + std::to_string(static_cast<int64_t>(rate)) + " a second (" + flag +
+         "); " + std::to_string(static_cast<int64_t>(-tokens)) + " over the allowance";
+}
+
+}  // namespace
 
 ScanCostGate::Track& ScanCostGate::track(size_t producer, SteadyClock::time_point now) {
   if (tracks_.size() <= producer) tracks_.resize(producer + 1);
   Track& t = tracks_[producer];
-  if (t.refilled == SteadyClock::time_point{}) {
-    t.tokens = bounds_.new_node_burst;
-    t.refilled = now;
-  }
+  if (t.nodes.refilled == SteadyClock::time_point{})
+    refill(t.nodes.tokens, t.nodes.refilled, now, bounds_.max_new_nodes_per_s, bounds_.new_node_burst);
   return t;
 }
 
-void ScanCostGate::refill(Track& t, SteadyClock::time_point now) const {
-  const double s = std::chrono::duration<double>(now - t.refilled).count();
-  if (s <= 0) return;
-  t.tokens = std::min(bounds_.new_node_burst, t.tokens + s * bounds_.max_new_nodes_per_s);
-  t.refilled = now;
-}
-
-Reject ScanCostGate::allowance_locked(Track& t, SteadyClock::time_point now, std::string& detail) const {
-  if (bounds_.max_new_nodes_per_s <= 0) return Reject::kNone;
-  refill(t, now);
-  if (t.tokens >= 0) return Reject::kNone;
-  detail = "the robot's new nodes passed " + std::to_string(static_cast<int64_t>(bounds_.max_new_nodes_per_s)) +
-           " a second (--max-new-nodes-per-s); " + std::to_string(static_cast<int64_t>(-t.tokens)) +
-           " over its allowance";
-  return Reject::kNewNodeRate;
+Reject ScanCostGate::allowance_locked(Track& t, SteadyClock::time_point now, std::string& detail) {
+  if (bounds_.max_new_nodes_per_s > 0) {
+    refill(t.nodes.tokens, t.nodes.refilled, now, bounds_.max_new_nodes_per_s, bounds_.new_node_burst);
+    if (t.nodes.tokens < 0) {
+      detail = over(t.nodes.tokens, bounds_.max_new_nodes_per_s, "the robot's", "--max-new-nodes-per-s");
+      return Reject::kNewNodeRate;
+    }
+  }
+  if (bounds_.max_map_new_nodes_per_s > 0) {
+    refill(map_.tokens, map_.refilled, now, bounds_.max_map_new_nodes_per_s, bounds_.map_new_node_burst);
+    if (map_.tokens < 0) {
+      detail = over(map_.tokens, bounds_.max_map_new_nodes_per_s, "all robots'", "--max-map-new-nodes-per-s");
+      return Reject::kMapNewNodeRate;
+    }
+  }
+  return Reject::kNone;
 }
 
 Reject ScanCostGate::admit_allowance(size_t producer, SteadyClock::time_point now, std::string& detail) {
@@ -66,11 +86,17 @@ Reject ScanCostGate::admit_voxels(uint64_t voxels, std::string& detail) const {
 }
 
 void ScanCostGate::applied(size_t producer, int64_t new_nodes, SteadyClock::time_point now) {
-  if (bounds_.max_new_nodes_per_s <= 0 || new_nodes <= 0) return;
+  if (new_nodes <= 0) return;
   std::lock_guard lock(mutex_);
-  Track& t = track(producer, now);
-  refill(t, now);
-  t.tokens -= static_cast<double>(new_nodes);
+  if (bounds_.max_new_nodes_per_s > 0) {
+    Track& t = track(producer, now);
+    refill(t.nodes.tokens, t.nodes.refilled, now, bounds_.max_new_nodes_per_s, bounds_.new_node_burst);
+    t.nodes.tokens -= static_cast<double>(new_nodes);
+  }
+  if (bounds_.max_map_new_nodes_per_s > 0) {
+    refill(map_.tokens, map_.refilled, now, bounds_.max_map_new_nodes_per_s, bounds_.map_new_node_burst);
+    map_.tokens -= static_cast<double>(new_nodes);
+  }
 }
 
 }  // namespace ort::daemon

@@ -6,7 +6,10 @@
 //  - it would update more voxels than max_scan_voxels (a campus LiDAR scan updates ~8 M);
 //  - the producer's new-node allowance is spent: each applied scan's new nodes are taken
 //    from a bucket refilled at max_new_nodes_per_s up to new_node_burst, and while the
-//    bucket is below zero the producer's scans are refused.
+//    bucket is below zero the producer's scans are refused;
+//  - the map's new-node allowance is spent: the same bucket for all producers together
+//    (max_map_new_nodes_per_s, map_new_node_burst), so that many robot ids, each within its
+//    own allowance, cannot grow the map without a bound either.
 // Refusals are counted per producer with their reason (ProducerRegistry); the status shows
 // them. Stage 1 asks (admit_origin, admit_voxels), stage 2 reports what it applied.
 #pragma once
@@ -24,11 +27,13 @@
 namespace ort::daemon {
 
 struct ScanCostBounds {
-  double max_origin_jump_m = 100;          // <= 0: origins unchecked
-  double max_speed_mps = 50;               // added to the jump for each second since the last scan
-  uint64_t max_scan_voxels = 64'000'000;   // 0: no limit
-  double max_new_nodes_per_s = 4'000'000;  // <= 0: no limit
-  double new_node_burst = 32'000'000;      // a campus LiDAR scan's ~8 M new voxels fit
+  double max_origin_jump_m = 100;               // <= 0: origins unchecked
+  double max_speed_mps = 50;                    // added to the jump for each second since the last scan
+  uint64_t max_scan_voxels = 64'000'000;        // 0: no limit
+  double max_new_nodes_per_s = 4'000'000;       // <= 0: no limit
+  double new_node_burst = 32'000'000;           // a campus LiDAR scan's ~8 M new voxels fit
+  double max_map_new_nodes_per_s = 16'000'000;  // all producers together; <= 0: no limit
+  double map_new_node_burst = 128'000'000;
   // The map's utime follows its newest scan's, but never more than this ahead of the
   // daemon's clock (a scan stamped years ahead would pin it there).
   double max_future_s = 60;
@@ -40,40 +45,47 @@ class ScanCostGate {
   ScanCostGate& operator=(ScanCostGate&& o) noexcept {
     bounds_ = o.bounds_;
     tracks_ = std::move(o.tracks_);
+    map_ = o.map_;
     return *this;
   }
 
   // kNone, or why the producer's scan with this origin is refused (kOriginJump: too far from
-  // the robot's last scan; kNewNodeRate: its allowance is spent). `detail` says by how much.
+  // the robot's last scan; kNewNodeRate: its allowance is spent; kMapNewNodeRate: the map's
+  // is). `detail` says by how much.
   Reject admit_origin(size_t producer, const octomap::point3d& origin, SteadyClock::time_point now,
                       std::string& detail);
-  // kNone, or kNewNodeRate when the producer's allowance is spent (asked again by stage 2
-  // right before it applies: stage 1 may have admitted the scan while the one before was
-  // being applied).
+  // kNone, or kNewNodeRate / kMapNewNodeRate when the producer's or the map's allowance is
+  // spent (asked again by stage 2 right before it applies: stage 1 may have admitted the scan
+  // while the one before was being applied).
   Reject admit_allowance(size_t producer, SteadyClock::time_point now, std::string& detail);
   // kNone, or kTooManyVoxels when the shot scan updates more voxels than the bound.
   Reject admit_voxels(uint64_t voxels, std::string& detail) const;
-  // Stage 2 applied the producer's scan: its new nodes are taken from the allowance.
+  // Stage 2 applied the producer's scan: its new nodes are taken from its allowance and the map's.
   void applied(size_t producer, int64_t new_nodes, SteadyClock::time_point now);
 
   const ScanCostBounds& bounds() const { return bounds_; }
   int64_t max_future_us() const { return static_cast<int64_t>(bounds_.max_future_s * 1e6); }
 
  private:
+  // New nodes allowed: refilled at `rate` a second up to `burst`; spent while below zero.
+  struct Allowance {
+    double tokens = 0;
+    SteadyClock::time_point refilled;
+  };
   struct Track {
     bool seen = false;
     octomap::point3d origin;
     SteadyClock::time_point at;
-    double tokens = 0;
-    SteadyClock::time_point refilled;
+    Allowance nodes;
   };
   Track& track(size_t producer, SteadyClock::time_point now);  // under mutex_
-  void refill(Track& t, SteadyClock::time_point now) const;
-  Reject allowance_locked(Track& t, SteadyClock::time_point now, std::string& detail) const;
+  // Both allowances refilled to `now`; kNone, or which one is spent (and `detail`).
+  Reject allowance_locked(Track& t, SteadyClock::time_point now, std::string& detail);
 
   ScanCostBounds bounds_;
   std::mutex mutex_;
   std::vector<Track> tracks_;  // by producer index
+  Allowance map_;              // all producers'
 };
 
 }  // namespace ort::daemon

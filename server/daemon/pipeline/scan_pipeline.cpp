@@ -206,10 +206,11 @@ void ScanPipeline::apply(ShotJob& job) {
   const auto t0 = Clock::now();
   job.waits.handoff_ms = ms_between(job.shot_at, t0);
   set_busy(1, true);
-  if (std::string detail; gate_.admit_allowance(job.producer, t0, detail) != Reject::kNone) {
+  std::string detail;
+  if (const Reject why = gate_.admit_allowance(job.producer, t0, detail); why != Reject::kNone) {
     set_busy(1, false);
     metrics_.overlap().end(1, token);
-    return refuse_cost(job.producer, Reject::kNewNodeRate, detail);
+    return refuse_cost(job.producer, why, detail);
   }
   Stage2Parts parts;
   int64_t new_nodes = 0;

@@ -1,0 +1,55 @@
+#include "daemon/scan_cost_flags.h"
+
+#include <cstdlib>
+#include <string>
+
+namespace ort::daemon {
+namespace {
+
+// CLI::Range lets NaN through (every comparison with it is false), and a NaN rate or
+// allowance turned its bound off: refill() made the tokens NaN, never below zero.
+CLI::Validator number_in(double lo, double hi) {
+  const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || !(v >= lo && v <= hi)) return "must be a number in " + range;
+        return {};
+      },
+      "NUMBER in " + range);
+}
+
+}  // namespace
+
+void add_scan_cost_flags(CLI::App& app, ScanCostBounds& c) {
+  app.add_option("--max-origin-jump", c.max_origin_jump_m,
+                 "farthest a robot's scan origin may be from its last scan's [m] (plus --max-robot-speed for each "
+                 "second since); farther: rejected as 'origin jump'; 0: unchecked")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e7));
+  app.add_option("--max-robot-speed", c.max_speed_mps, "see --max-origin-jump [m/s]")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e6));
+  app.add_option("--max-scan-voxels", c.max_scan_voxels,
+                 "most voxels one scan may update; more: rejected as 'too many voxels'; 0: no limit")
+      ->capture_default_str();
+  app.add_option("--max-new-nodes-per-s", c.max_new_nodes_per_s,
+                 "new octree nodes a second one robot may add, on average (allowance up to --new-node-burst); "
+                 "past it its scans are rejected as 'new-node rate' until the allowance refills; 0: no limit")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e12));
+  app.add_option("--new-node-burst", c.new_node_burst, "see --max-new-nodes-per-s")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e13));
+  app.add_option("--max-map-new-nodes-per-s", c.max_map_new_nodes_per_s,
+                 "new octree nodes a second all robots together may add, on average (allowance up to "
+                 "--map-new-node-burst); past it scans are rejected as 'map new-node rate'; 0: no limit")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e12));
+  app.add_option("--map-new-node-burst", c.map_new_node_burst, "see --max-map-new-nodes-per-s")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e13));
+}
+
+}  // namespace ort::daemon
