@@ -4,9 +4,11 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/commands.h"
+#include "cli/octomap_chatter.h"
 #include "protocol/version.h"
 
 int main(int argc, char** argv) {
+  const ort::cli::OctomapChatterFilter quiet(std::cerr);  // OctoMap's "Reading octree ..." lines
   CLI::App app{"octomap-rt: GPU-accelerated OctoMap building, and the client of octomap-rt-server"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("octomap-rt ") + OCTOMAP_RT_VERSION + " (protocol version " +

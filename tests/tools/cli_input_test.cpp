@@ -14,6 +14,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <octomap/OcTree.h>
 
 #include "scene/scan_set.h"
 #include "support/test_data.h"
@@ -147,6 +148,25 @@ TEST(CliInput, EveryPointOutsideTheKeyRangeIsSaidOutLoud) {
   const CliRun r = run("build " + graph + " -r 0.0001 --backend cpu -q -o " + dir() + "/empty.bt");
   EXPECT_EQ(r.exit, 0) << r.output;
   EXPECT_NE(r.output.find("the map is empty; is the resolution right?"), std::string::npos) << r.output;
+}
+
+TEST(CliInput, OctomapsReadProgressLinesDoNotReachTheUser) {
+  // OctoMap writes "Reading binary octree type OcTree" (and for .ot "Reading octree type
+  // OcTree", "Done (N nodes)") to stderr on every tree it reads; octomap-rt drops those
+  // lines and nothing else.
+  octomap::OcTree tree(0.1);
+  tree.updateNode(octomap::point3d(1, 1, 1), true);
+  const std::string bt = dir() + "/one.bt", ot = dir() + "/one.ot";
+  ASSERT_TRUE(tree.writeBinary(bt));
+  ASSERT_TRUE(tree.write(ot));
+  const CliRun same = run("map diff " + bt + " " + ot);
+  EXPECT_EQ(same.exit, 0) << same.output;
+  EXPECT_FALSE(same.output.empty());
+  for (const char* chatter : {"Reading binary octree type", "Reading octree type", "Done ("})
+    EXPECT_EQ(same.output.find(chatter), std::string::npos) << same.output;
+  const CliRun missing = run("map diff " + bt + " " + dir() + "/none.bt");
+  EXPECT_NE(missing.exit, 0);
+  EXPECT_NE(missing.output.find("none.bt"), std::string::npos) << missing.output;  // errors still pass
 }
 
 }  // namespace
