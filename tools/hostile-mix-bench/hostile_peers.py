@@ -5,10 +5,12 @@ send what the review found expensive (issue 21):
   - box queries of 1000 whole-map boxes;
   - floods of fresh-snapshot requests from 40 client ids;
   - far scans: 100 points 1 km from a sensor that jumps 3 km each scan, on 4 robot channels.
-Prints what it sent, one `key value` a line."""
+--kinds picks some of them (rays, boxes, fresh, far; default all). Prints what it sent, one
+`key value` a line, when the time is up or on SIGTERM."""
 import argparse
 import math
 import random
+import signal
 import time
 
 from octomap_rt import (box_query_t, map_request_t, ray_query_t, scan_t)
@@ -65,23 +67,29 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lcm-url", required=True)
     ap.add_argument("--duration", type=float, default=30)
+    ap.add_argument("--kinds", default="rays,boxes,fresh,far")
     a = ap.parse_args()
+    kinds = set(a.kinds.split(","))
+    stop = []
+    signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
     t = open_transport(a.lcm_url)
     sent = {"ray_queries": 0, "box_queries": 0, "fresh_requests": 0, "far_scans": 0}
     rays, boxes = ray_query(0), box_query(0)
     end, i, seq = time.monotonic() + a.duration, 0, 0
-    while time.monotonic() < end:
+    while time.monotonic() < end and not stop:
         i += 1
         rays.request_id = boxes.request_id = i
-        t.publish("OCTOMAP_RT_QUERY_RAYS", rays.encode())
-        t.publish("OCTOMAP_RT_QUERY_BOXES", boxes.encode())
-        sent["ray_queries"] += 1
-        sent["box_queries"] += 1
-        if i % 2 == 0:
+        if "rays" in kinds:
+            t.publish("OCTOMAP_RT_QUERY_RAYS", rays.encode())
+            sent["ray_queries"] += 1
+        if "boxes" in kinds:
+            t.publish("OCTOMAP_RT_QUERY_BOXES", boxes.encode())
+            sent["box_queries"] += 1
+        if i % 2 == 0 and "fresh" in kinds:
             for c in range(40):
                 t.publish("OCTOMAP_RT_MAP_REQUEST", fresh_request(i * 100 + c, "hostile-%d" % c).encode())
                 sent["fresh_requests"] += 1
-        if i % 4 == 0:
+        if i % 4 == 0 and "far" in kinds:
             for r in range(4):
                 robot = "evil%d" % r
                 t.publish("OCTOMAP_RT_SCAN_" + robot.upper(), far_scan(seq, robot).encode())
@@ -90,7 +98,7 @@ def main():
         t.handle(0.0)
         time.sleep(0.05)
     for k, v in sent.items():
-        print(k, v)
+        print(k, v, flush=True)
 
 
 if __name__ == "__main__":
