@@ -26,10 +26,10 @@ namespace ort::protocol {
 // constants; tests/protocol checks them against real encodings.
 inline constexpr size_t kScanNumXyzOffset = 85;  // scan_t.num_xyz
 inline constexpr size_t kScanXyzOffset = 89;     // scan_t.xyz[0]
-inline constexpr size_t kChunkDataSizeOffset = 86;
-inline constexpr size_t kDeltaDataSizeOffset = 74;
+inline constexpr size_t kChunkDataSizeOffset = 94;
+inline constexpr size_t kDeltaDataSizeOffset = 82;
 inline constexpr size_t kRequestNumIndicesOffset = 33;
-inline constexpr size_t kInfoNumProducersOffset = 202;
+inline constexpr size_t kInfoNumProducersOffset = 210;
 // Where protocol_version sits in map_info_t and server_status_t, in every version
 // (protocol/version.h).
 inline constexpr size_t kVersionOffset = 8;

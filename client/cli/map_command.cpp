@@ -60,17 +60,17 @@ void run_info(const MapArgs& a) {
   if (!m)
     throw std::runtime_error("no map_info_t within " + std::to_string(a.timeout_s) + " s (is the server running?)");
   if (a.json) {
-    std::cout << "{\"server_id\": \"" << m->server_id << "\", \"map_version\": " << m->map_version
-              << ", \"snapshot_id\": " << m->snapshot_id << ", \"num_scans\": " << m->num_scans
-              << ", \"delta_seq\": " << m->delta_seq << ", \"resolution\": " << m->resolution
-              << ", \"uncompressed_size\": " << m->uncompressed_size << ", \"total_size\": " << m->total_size
-              << ", \"num_chunks\": " << m->num_chunks << ", \"bbox_min\": [" << m->bbox_min[0] << ", "
-              << m->bbox_min[1] << ", " << m->bbox_min[2] << "], \"bbox_max\": [" << m->bbox_max[0] << ", "
-              << m->bbox_max[1] << ", " << m->bbox_max[2] << "]}\n";
+    std::cout << "{\"server_id\": \"" << m->server_id << "\", \"map_epoch\": " << m->map_epoch
+              << ", \"map_version\": " << m->map_version << ", \"snapshot_id\": " << m->snapshot_id
+              << ", \"num_scans\": " << m->num_scans << ", \"delta_seq\": " << m->delta_seq
+              << ", \"resolution\": " << m->resolution << ", \"uncompressed_size\": " << m->uncompressed_size
+              << ", \"total_size\": " << m->total_size << ", \"num_chunks\": " << m->num_chunks << ", \"bbox_min\": ["
+              << m->bbox_min[0] << ", " << m->bbox_min[1] << ", " << m->bbox_min[2] << "], \"bbox_max\": ["
+              << m->bbox_max[0] << ", " << m->bbox_max[1] << ", " << m->bbox_max[2] << "]}\n";
     return;
   }
-  std::printf("server %s: map version %lld, resolution %g m, last delta seq %lld\n", m->server_id.c_str(),
-              (long long)m->map_version, m->resolution, (long long)m->delta_seq);
+  std::printf("server %s: map version %lld of epoch %llx, resolution %g m, last delta seq %lld\n", m->server_id.c_str(),
+              (long long)m->map_version, (unsigned long long)m->map_epoch, m->resolution, (long long)m->delta_seq);
   std::printf("latest snapshot %lld (%lld scans): %lld bytes raw, %lld compressed (%s), %d chunks\n",
               (long long)m->snapshot_id, (long long)m->num_scans, (long long)m->uncompressed_size,
               (long long)m->total_size, m->format == Chunk::FORMAT_OCTOMAP_BINARY ? ".bt" : ".ot", m->num_chunks);

@@ -258,6 +258,7 @@ FetchedSnapshot MapClient::fetch_snapshot(int8_t format, double timeout_s, const
     throw FetchError(FetchError::kCorrupt, "snapshot has another size than announced");
   out.snapshot_id = as.snapshot_id();
   out.num_scans = as.num_scans();
+  out.map_epoch = as.map_epoch();
   out.format = as.format();
   out.compressed_size = as.total_size();
   out.num_chunks = as.num_chunks();

@@ -57,6 +57,7 @@ struct ClientOptions {
 
 struct FetchedSnapshot {
   int64_t snapshot_id = 0, num_scans = 0;
+  int64_t map_epoch = 0;  // the history snapshot_id counts in
   int8_t format = 0;
   std::string bytes;  // decompressed: the .bt or .ot file's content
   int64_t compressed_size = 0;

@@ -21,7 +21,7 @@ void MapMirror::on_delta(const Delta& d) {
     buffered_.push_back(d);
     return;
   }
-  process(d);
+  process(d, /*buffered=*/false);
 }
 
 // The server publishes a delta before any map_info_t naming its delta_seq, from one socket,
@@ -32,7 +32,13 @@ void MapMirror::on_info(const octomap_rt::map_info_t& info) {
   info_seen_ = true;
   latest_info_seq_ = info.delta_seq;
   if (info.delta_seq < highest_seq_ || baseline) highest_seq_ = info.delta_seq;  // or the server started again
-  if (syncing_ || !tree_ || need_sync_ || info.delta_seq <= highest_seq_) return;
+  if (syncing_ || !tree_ || need_sync_) return;
+  if (info.map_epoch != epoch_) {  // the map's history forked since the snapshot
+    stats_.epoch_changes++;
+    gap();
+    return;
+  }
+  if (info.delta_seq <= highest_seq_) return;
   highest_seq_ = info.delta_seq;  // counted once
   gap();
 }
@@ -53,7 +59,9 @@ void MapMirror::sync() {
   tree_ = s.tree();
   highest_seq_ = std::max(highest_seq_, sent_before);
   version_ = s.snapshot_id;
+  epoch_ = s.map_epoch;
   started_ = false;
+  set_open_ = false;
   last_seq_ = -1;
   need_sync_ = false;
   syncing_ = false;
@@ -63,7 +71,7 @@ void MapMirror::sync() {
   std::sort(pending.begin(), pending.end(), [](const Delta& a, const Delta& b) { return a.delta_seq < b.delta_seq; });
   for (const Delta& d : pending) {
     if (need_sync_) break;
-    process(d);
+    process(d, /*buffered=*/true);
   }
 }
 
@@ -81,8 +89,17 @@ void MapMirror::gap() {
   if (opts_.resync) need_sync_ = true;
 }
 
-void MapMirror::process(const Delta& d) {
+void MapMirror::process(const Delta& d, bool buffered) {
   if (need_sync_) return;
+  if (d.map_epoch != epoch_) {
+    if (buffered) {  // sent before the snapshot's history began: not part of it
+      stats_.deltas_skipped++;
+      return;
+    }
+    stats_.epoch_changes++;
+    gap();
+    return;
+  }
   if (!started_) {
     if (d.to_version <= version_) {  // already in the snapshot
       stats_.deltas_skipped++;
@@ -97,8 +114,13 @@ void MapMirror::process(const Delta& d) {
     }
     started_ = true;
   } else if (d.delta_seq != last_seq_ + 1) {
-    gap();
-    if (opts_.resync) return;
+    // A server restarted from its clean save numbers its deltas from 0 again; a set that starts
+    // at the mirror's complete version continues the chain whatever its delta_seq.
+    const bool chains = !set_open_ && d.part_index == 0 && d.from_version == version_;
+    if (!chains) {
+      gap();
+      if (opts_.resync) return;
+    }
   }
   apply(d);
 }
@@ -123,6 +145,7 @@ void MapMirror::apply(const Delta& d) {
   last_seq_ = d.delta_seq;
   const bool complete = d.part_index == d.num_parts - 1;
   if (complete) version_ = std::max(version_, d.to_version);
+  set_open_ = !complete;
   stats_.deltas_applied++;
   stats_.voxels_applied += static_cast<int64_t>(changes.size());
   const int64_t bytes = d.getEncodedSize();

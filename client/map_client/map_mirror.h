@@ -5,6 +5,13 @@
 // last delta (no later one shows the gap) is found by map_info_t (1 Hz), which names the last
 // delta_seq sent: one never received is a gap too.
 //
+// Map state ids compare only within one epoch (docs/PROTOCOL.md "Ids"): a delta or map_info_t
+// of another epoch than the mirror's snapshot (a reset, a server that lost changes in a crash,
+// another map file) makes it resync. A server restarted cleanly keeps epoch and id and starts
+// its delta_seq again: a change set that starts exactly at the mirror's complete version is
+// applied on (the version chain shows nothing was missed), so such a mirror goes on without a
+// snapshot.
+//
 // In class mode (the server's default) the mirror's voxels have the right class (free /
 // occupied / unknown), with the clamping bound as log-odds; in exact mode (server flag
 // --delta-exact) they have the server's log-odds.
@@ -38,6 +45,7 @@ struct MirrorOptions {
 struct MirrorStats {
   int64_t snapshots = 0, deltas_applied = 0, deltas_skipped = 0, gaps = 0, bad_deltas = 0, delta_bytes = 0;
   int64_t voxels_applied = 0;
+  int64_t epoch_changes = 0;  // deltas or infos of another epoch seen (each a gap too)
 };
 
 class MapMirror {
@@ -50,12 +58,13 @@ class MapMirror {
 
   const octomap::OcTree& tree() const { return *tree_; }
   int64_t version() const { return version_; }  // map state id the mirror is at
+  int64_t epoch() const { return epoch_; }      // and its epoch
   const MirrorStats& stats() const { return stats_; }
 
  private:
   void on_delta(const octomap_rt::map_delta_t& d);
   void on_info(const octomap_rt::map_info_t& info);
-  void process(const octomap_rt::map_delta_t& d);
+  void process(const octomap_rt::map_delta_t& d, bool buffered);
   void apply(const octomap_rt::map_delta_t& d);
   void gap();
 
@@ -63,6 +72,8 @@ class MapMirror {
   MirrorOptions opts_;
   std::unique_ptr<octomap::OcTree> tree_;
   int64_t version_ = -1;
+  int64_t epoch_ = 0;
+  bool set_open_ = false;         // a change set's first parts applied, not yet its last
   int64_t last_seq_ = -1;         // last delta applied or skipped as contained
   int64_t highest_seq_ = -1;      // highest delta_seq received, or known to be in the snapshot
   int64_t latest_info_seq_ = -1;  // delta_seq of the latest map_info_t

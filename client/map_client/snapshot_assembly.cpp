@@ -22,6 +22,7 @@ std::string SnapshotAssembly::add(const octomap_rt::map_chunk_t& c) {
     hash_ = c.blob_hash;
     uncompressed_size_ = c.uncompressed_size;
     num_scans_ = c.num_scans;
+    map_epoch_ = c.map_epoch;
     num_chunks_ = c.num_chunks;
     chunk_size_ = c.chunk_size;
     format_ = c.format;
@@ -29,8 +30,8 @@ std::string SnapshotAssembly::add(const octomap_rt::map_chunk_t& c) {
     parts_.assign(static_cast<size_t>(num_chunks_), {});
     have_.assign(static_cast<size_t>(num_chunks_), false);
   }
-  if (c.snapshot_id != snapshot_id_ || c.total_size != total_size_ || c.blob_hash != hash_ ||
-      c.num_chunks != num_chunks_ || c.chunk_size != chunk_size_ || c.format != format_ ||
+  if (c.snapshot_id != snapshot_id_ || c.map_epoch != map_epoch_ || c.total_size != total_size_ ||
+      c.blob_hash != hash_ || c.num_chunks != num_chunks_ || c.chunk_size != chunk_size_ || c.format != format_ ||
       c.compression != compression_)
     return "chunk of another snapshot";
   if (c.chunk_index < 0 || c.chunk_index >= num_chunks_) return "chunk index out of range";

@@ -28,12 +28,14 @@ class SnapshotAssembly {
   int64_t received_bytes() const { return received_bytes_; }
   int64_t uncompressed_size() const { return uncompressed_size_; }
   int64_t num_scans() const { return num_scans_; }
+  int64_t map_epoch() const { return map_epoch_; }
   int8_t format() const { return format_; }
   int8_t compression() const { return compression_; }
 
  private:
   bool started_ = false;
-  int64_t snapshot_id_ = 0, total_size_ = 0, hash_ = 0, uncompressed_size_ = 0, num_scans_ = 0, received_bytes_ = 0;
+  int64_t snapshot_id_ = 0, total_size_ = 0, hash_ = 0, uncompressed_size_ = 0, num_scans_ = 0, received_bytes_ = 0,
+          map_epoch_ = 0;
   int32_t num_chunks_ = 0, chunk_size_ = 0, received_ = 0;
   int8_t format_ = 0, compression_ = 0;
   std::vector<std::string> parts_;

@@ -4,12 +4,9 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <optional>
 
 #include "core/clock.h"
-#include "daemon/persistence/map_store.h"
-#include "daemon/serving/map_snapshot.h"
 #include "daemon/status/run_summary.h"
 #include "daemon/transport/server_lcm_url.h"
 #include "engine/engine_warm_up.h"
@@ -50,8 +47,23 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
                              " MiB per producer cannot hold one scan of --max-points " +
                              std::to_string(cfg_.max_points));
 
-  load_or_create_map();  // first: a wrong map file fails before any device is opened
+  // First: a wrong or busy map file fails before any device is opened.
+  if (!cfg_.map_path.empty()) map_lock_ = MapFileLock(cfg_.map_path, map_lock_holder(server_id_, host_));
+  if (cfg_.resolution_from_file) take_resolution_from_file();
+  load_or_create_map();
   open_memory_bound();
+  // The upkeep's slices are not replayable steps yet, and the read replica would hold the
+  // whole map past a memory bound: with decay, clearing or --max-map-memory, readers read the
+  // map of record (as with --no-read-replica).
+  if (cfg_.read_replica && (cfg_.upkeep.decay_on() || cfg_.upkeep.clearing_on() || cfg_.max_map_memory > 0))
+    log_.info("decay, clearing or a memory bound on: whole-map readers copy the map under its lock (no read replica)");
+  else if (cfg_.read_replica) {
+    OctreeUpdateOptions o = cfg_.engine.octree;
+    // A quarter of the cores: it runs beside the octree stage, which keeps the rest.
+    o.threads = std::max(1u, std::thread::hardware_concurrency() / 4);
+    replica_ = std::make_unique<MapReplica>(map_, o, cfg_.replica_pending_bytes);
+    map_.replica = replica_.get();
+  }
   engine_ = std::make_unique<MapEngine>(cfg_.engine, log_);
   if (!cfg_.applied_log.empty()) map_.order.open_live_log(cfg_.applied_log);
 
@@ -74,59 +86,12 @@ MappingServer::~MappingServer() {
   }
 }
 
-// A map that is not complete is never loaded (and so never overwritten by a smaller one):
-// the server refuses to start, or with --move-corrupt-map-aside keeps it under another name
-// and starts anew.
-std::unique_ptr<octomap::OcTree> MappingServer::load_checked_map() {
-  try {
-    return load_map(cfg_.map_path, cfg_.engine.resolution);
-  } catch (const MapStoreError& e) {
-    if (e.kind() != MapStoreError::Kind::kCorrupt) throw;
-    if (!cfg_.move_corrupt_map_aside)
-      throw MapStoreError(e.kind(), std::string(e.what()) +
-                                        "; the file is left as it is (start with --move-corrupt-map-aside to keep it "
-                                        "under another name and start a new map)");
-    const std::string aside = move_map_aside(cfg_.map_path);
-    if (std::filesystem::exists(cfg_.map_path + ".order"))
-      std::filesystem::rename(cfg_.map_path + ".order", aside + ".order");
-    log_.warning(text(e.what(), "; moved it to ", aside, " and starting a new map"));
-    return nullptr;
-  }
-}
-
-void MappingServer::load_or_create_map() {
-  const double res = cfg_.engine.resolution;
-  if (!cfg_.map_path.empty()) check_map_directory_writable(cfg_.map_path);
-  std::unique_ptr<octomap::OcTree> loaded;
-  if (!cfg_.map_path.empty() && std::filesystem::exists(cfg_.map_path)) loaded = load_checked_map();
-  if (loaded) {
-    map_.tree = std::move(loaded);
-    apply_sensor_model(*map_.tree, cfg_.engine.sensor);
-    std::vector<AppliedEntry> previous;
-    const std::string order_path = cfg_.map_path + ".order";
-    if (std::filesystem::exists(order_path)) {
-      AppliedOrderFile f = read_applied_order(order_path);
-      if (f.map_bytes >= 0 && static_cast<uint64_t>(f.map_bytes) != std::filesystem::file_size(cfg_.map_path))
-        log_.warning(text(order_path,
-                          " does not belong to this map file (the server stopped between writing the two); its ",
-                          f.entries.size(), " entries are kept but may not match the map"));
-      previous = std::move(f.entries);
-    }
-    map_.order.restore(std::move(previous));
-    map_.version = map_.order.size();
-    saved_version_ = map_.version;
-    log_.info(text("loaded map ", cfg_.map_path, " (", map_.tree->size(), " nodes, ", map_.order.size(),
-                   " scans applied before)"));
-  } else {
-    map_.tree = std::make_unique<octomap::OcTree>(res);
-    apply_sensor_model(*map_.tree, cfg_.engine.sensor);
-    if (!cfg_.map_path.empty()) log_.info(text("new map, will be saved to ", cfg_.map_path));
-  }
-}
-
 void MappingServer::start() {
   if (started_) return;
   started_ = true;
+  // From now until the last save of an orderly stop the identity says "unclean": a crash of
+  // this run forks the history at the next start.
+  if (loaded_identity_) write_identity(*loaded_identity_);
   ScanLimits limits;
   limits.max_points = cfg_.max_points;
   limits.resolution = cfg_.engine.resolution;
@@ -191,7 +156,7 @@ void MappingServer::open_map_serving() {
     deltas_ = std::make_unique<DeltaPublisher>(
         *loop_, d, [this] { return map_service_ ? map_service_->stats().latest_snapshot_id : -1; }, log_);
     map_.observer = deltas_.get();
-    deltas_->start(map_.version);
+    deltas_->start(map_.version, map_.epoch);
   }
   MapServiceConfig m;
   m.request_channel = cfg_.map_request_channel;
@@ -237,7 +202,7 @@ bool MappingServer::stop() {
     // Nothing may throw before the threads below are joined: a failed final save is
     // reported (log, summary, status, exit status), not thrown.
     try {
-      save(true);
+      save_map(/*force=*/true, /*clean=*/true);
     } catch (const std::exception& e) {
       final_save_error_ = e.what();
       log_.error(text("the final save failed (the previous map file is intact): ", e.what()));
@@ -255,6 +220,7 @@ bool MappingServer::stop() {
   map_service_->stop();
   if (queries_) queries_->stop();
   loop_->stop();
+  if (replica_) replica_->stop();
   return final_save_error_.empty();
 }
 
@@ -289,28 +255,6 @@ void MappingServer::set_state(int8_t state, std::string message) {
     state_changed_ = true;
   }
   wake_.notify_all();
-}
-
-void MappingServer::save(bool force) {
-  if (cfg_.map_path.empty()) return;
-  std::lock_guard save_lock(save_mutex_);
-  const auto t0 = std::chrono::steady_clock::now();
-  // Copy under the map lock (a state between two whole scans); serialize and write outside it.
-  std::optional<MapCopy> copy =
-      force ? std::optional<MapCopy>(copy_map(map_)) : copy_map_if_changed(map_, saved_version_);
-  if (!copy) return;
-  const std::string bytes = serialize_map(*copy->tree);
-  copy->tree.reset();
-  const std::vector<AppliedEntry> order = map_.order.entries(copy->scans);
-  // Map first: if we die between the two renames the order file is the older one, which
-  // the next start detects by its map_bytes line.
-  write_file_atomically(cfg_.map_path, bytes);
-  write_file_atomically(cfg_.map_path + ".order", format_applied_order(order, bytes.size()));
-  saved_version_ = copy->version;
-  saves_++;
-  last_save_utime_ = now_utime();
-  max_save_lock_ms_ = std::max(max_save_lock_ms_, copy->lock_ms);
-  last_save_ms_ = ms_since(t0);
 }
 
 void MappingServer::run_save_loop() {

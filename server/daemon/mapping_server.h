@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <thread>
@@ -19,9 +20,13 @@
 #include "daemon/intake/producer_registry.h"
 #include "daemon/intake/scan_intake.h"
 #include "daemon/intake/scan_queue.h"
+#include "daemon/map/map_replica.h"
 #include "daemon/map/map_residency.h"
 #include "daemon/map/map_state.h"
 #include "daemon/map/map_upkeep.h"
+#include "daemon/persistence/map_file_lock.h"
+#include "daemon/persistence/map_identity_file.h"
+#include "daemon/persistence/map_store.h"
 #include "daemon/persistence/region_store.h"
 #include "daemon/pipeline/pipeline_metrics.h"
 #include "daemon/pipeline/scan_pipeline.h"
@@ -63,12 +68,36 @@ class MappingServer {
   std::vector<QueryClientStats> query_stats() const {
     return queries_ ? queries_->stats() : std::vector<QueryClientStats>{};
   }
-  std::vector<AppliedEntry> applied_order() const { return map_.order.entries(); }
+  // The applied order as the order file beside the map has it (synced first); without --map
+  // the newest AppliedOrder::kRecent entries of this run.
+  std::vector<AppliedEntry> applied_order() {
+    if (cfg_.map_path.empty()) return map_.order.recent();
+    map_.order.sync();
+    return read_applied_order(cfg_.map_path + ".order").entries;
+  }
   // Runs f(const OcTree&) under the map lock: a state between two whole scans.
   template <class F>
   auto with_map(F&& f) {
     std::shared_lock lock(map_.mutex);
     return f(static_cast<const octomap::OcTree&>(*map_.tree));
+  }
+  // Runs f(const OcTree&) on what whole-map readers read (the read replica, caught up with
+  // the map as it is now; the map itself without one), under that map's lock.
+  template <class F>
+  auto with_readable_map(F&& f) {
+    MapState& m = readable_map(map_);
+    std::shared_lock lock(m.mutex);
+    return f(static_cast<const octomap::OcTree&>(*m.tree));
+  }
+  // Holds the read replica's lock (shared) until `release` is set, as a slow whole-map
+  // reader would (tests: the octree stage goes on meanwhile). No-op without a replica.
+  void hold_replica_until(const std::atomic<bool>& release) {
+    if (!replica_) return;
+    std::shared_lock lock(replica_->state().mutex);
+    while (!release) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  std::optional<ReplicaStats> replica_stats() const {
+    return replica_ ? std::optional<ReplicaStats>(replica_->stats()) : std::nullopt;
   }
   const std::string& lcm_url() const { return url_; }
   // The whole map (evicted regions included: daemon/serving/map_snapshot.h), as a copy.
@@ -88,11 +117,15 @@ class MappingServer {
   // --max-map-memory: the region store (emptied: the map file holds what a previous run
   // evicted) and the residency, which brings a loaded map down to the bound.
   void open_memory_bound();
+  void take_resolution_from_file();  // cfg_.resolution_from_file
   void open_map_serving();
   // The engine's warm-up scan (ServerConfig::warm_up_points), logged.
   void warm_up_engine();
   void drain_until_deadline();
-  std::unique_ptr<octomap::OcTree> load_checked_map();  // nullptr: moved aside, start anew
+  LoadedMapFile load_checked_map();       // tree nullptr: moved aside, start anew
+  void save_map(bool force, bool clean);  // clean: the last save of an orderly stop
+  std::string absolute_map_path() const;
+  void write_identity(const MapIdentityRecord& r);
   void set_state(int8_t state, std::string message);
   StatusInputs gather_status();
   void publish_status();
@@ -103,11 +136,14 @@ class MappingServer {
   ServerConfig cfg_;
   Log log_;
   std::string url_;
+  MapFileLock map_lock_;                              // held from start to the end of the final save
+  std::optional<MapIdentityRecord> loaded_identity_;  // the loaded map's, marked unclean
   std::unique_ptr<LcmLoop> loop_;
   std::unique_ptr<MapEngine> engine_;
   MapState map_;
   std::unique_ptr<RegionStore> region_store_;  // --max-map-memory's evicted regions
   std::unique_ptr<MapResidency> residency_;
+  std::unique_ptr<MapReplica> replica_;  // what whole-map readers read (cfg_.read_replica)
   ProducerRegistry producers_;
   ScanQueue queue_;
   PipelineMetrics metrics_;
@@ -131,7 +167,7 @@ class MappingServer {
   int64_t status_seq_ = 0;
   // The last map figures read under the map lock (atomic: read without it when the lock is busy).
   std::atomic<size_t> cached_leaves_{0};
-  std::atomic<int64_t> cached_nodes_{0}, cached_memory_{0}, cached_version_{0};
+  std::atomic<int64_t> cached_nodes_{0}, cached_memory_{0}, cached_version_{0}, cached_epoch_{0};
   std::chrono::steady_clock::time_point leaves_time_;
   std::atomic<int64_t> leaves_version_{-1};    // map version of cached_leaves_
   std::atomic<bool> pipeline_drained_{false};  // set by stop() once the pipeline is joined

@@ -39,13 +39,27 @@ StatusInputs MappingServer::gather_status() {
     // OctoMap's formula.
     // The status never waits long for the map lock: a stage stuck while holding it must
     // still be reported (DEGRADED), so after ~100 ms the last figures are used again.
+    // With the read replica the leaves are counted there (the octree stage never waits for
+    // the walk), whenever the map changed and at most once a second.
+    if (map_.replica) {
+      MapState& r = map_.replica->state();
+      std::shared_lock rl(r.mutex, std::defer_lock);
+      for (int i = 0; i < 100 && !rl.try_lock(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      const auto now = std::chrono::steady_clock::now();
+      if (rl.owns_lock() && static_cast<int64_t>(r.version) != leaves_version_ &&
+          (leaves_version_ < 0 || pipeline_drained_ || now - leaves_time_ >= std::chrono::seconds(1))) {
+        cached_leaves_ = r.tree->getNumLeafNodes();
+        leaves_time_ = now;
+        leaves_version_ = static_cast<int64_t>(r.version);
+      }
+    }
     std::shared_lock lock(map_.mutex, std::defer_lock);
     for (int i = 0; i < 100 && !lock.try_lock(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     if (lock.owns_lock()) {
       const octomap::OcTree& t = *map_.tree;
       const auto now = std::chrono::steady_clock::now();
       const int64_t version = static_cast<int64_t>(map_.version);
-      if (version != leaves_version_ &&
+      if (!map_.replica && version != leaves_version_ &&
           (t.size() <= kLeafWalkEveryStatus || pipeline_drained_ || now - leaves_time_ > std::chrono::seconds(10))) {
         cached_leaves_ = t.getNumLeafNodes();
         leaves_time_ = now;
@@ -54,10 +68,12 @@ StatusInputs MappingServer::gather_status() {
       const size_t leaves = std::min(cached_leaves_.load(), t.size());
       cached_nodes_ = static_cast<int64_t>(t.size());
       cached_version_ = static_cast<int64_t>(map_.version);
+      cached_epoch_ = static_cast<int64_t>(map_.epoch);
       cached_memory_ = static_cast<int64_t>(sizeof(octomap::OcTree) + t.memoryUsageNode() * t.size() +
                                             (t.size() - leaves) * sizeof(octomap::OcTreeNode* [8]));
     }
     in.map_version = cached_version_;
+    in.map_epoch = cached_epoch_;
     in.num_nodes = cached_nodes_;
     in.num_leaf_nodes =
         static_cast<int64_t>(std::min<size_t>(cached_leaves_.load(), static_cast<size_t>(cached_nodes_.load())));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <regex>
 #include <sstream>
@@ -25,18 +26,9 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
   app.allow_config_extras(CLI::config_extras_mode::error);
   app.add_flag("--print-config", f.print_config,
                "print the effective configuration (every key of --config with its value) and exit");
-  ort::cli::add_engine_flags(app, f.engine, /*require_resolution=*/true);
+  ort::cli::add_engine_flags(app, f.engine, /*require_resolution=*/false);
   ServerConfig& s = f.server;
-  app.add_option("--map", s.map_path,
-                 "map file (.ot, with log-odds): loaded at start if it exists, saved every --save-interval "
-                 "seconds and at exit (atomically); the applied scan order goes to FILE.order");
-  app.add_flag("--move-corrupt-map-aside", s.move_corrupt_map_aside,
-               "when --map exists but is not a complete .ot file: rename it to FILE.corrupt-<UTC time> and start a "
-               "new map (default: refuse to start)");
-  app.add_option("--save-interval", s.save_interval_s, "seconds between periodic saves; 0: only at exit")
-      ->capture_default_str();
-  app.add_option("--applied-log", s.applied_log,
-                 "also append each applied scan's (robot, seq) to this file as it happens");
+  add_map_file_flags(app, f);
   app.add_option("--lcm-url", s.lcm_url,
                  std::string("LCM URL (default: $LCM_DEFAULT_URL, else ") + ort::protocol::kDefaultLcmUrl +
                      "); udpm URLs get recv_buf_size=min(--recv-buf-size, net.core.rmem_max) unless they set it");
@@ -66,6 +58,10 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                  "size cap of one octomap.raw_t [KiB]; a larger map is sent depth-limited, or not at all (said in "
                  "the status); default: 90 % of net.core.rmem_default");
   app.add_flag("--no-pipeline", f.no_pipeline, "run the GPU and CPU stages on one thread, one scan after another");
+  app.add_flag("--no-read-replica", f.no_read_replica,
+               "whole-map readers (snapshots, saves, the OCTOMAP viewer map, status counts) copy the map under its "
+               "lock instead of reading the read replica (which costs one more tree in memory and a second octree "
+               "update per scan on another thread, and never holds mapping up)");
   app.add_option(
          "--warm-up-points", s.warm_up_points,
          "points of the synthetic scan shot and applied to a scratch tree at start-up, so the first scans "
@@ -167,57 +163,6 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                  "Not authentication: LCM has none (see docs/RELIABILITY.md)");
 }
 
-void add_point_filter_flags(CLI::App& app, PointFilters& f) {
-  // Each flag also answers to octomap_server's parameter name, so that a --config file may use
-  // its keys (pointcloud_min_z = 0.1); README, "Connect your robot", has the table.
-  const char* axes[] = {"x", "y", "z"};
-  for (int i = 0; i < 3; ++i) {
-    const std::string a = axes[i];
-    app.add_option(
-        "--pointcloud-min-" + a + ",--pointcloud_min_" + a, f.map_frame.min[i],
-        "drop points whose map-frame " + a + " is below this [m] (octomap_server's pointcloud_min_" + a + ")");
-    app.add_option(
-        "--pointcloud-max-" + a + ",--pointcloud_max_" + a, f.map_frame.max[i],
-        "drop points whose map-frame " + a + " is above this [m] (octomap_server's pointcloud_max_" + a + ")");
-    app.add_option("--sensor-min-" + a, f.sensor_frame.min[i],
-                   "drop points whose " + a + " in the sensor frame is below this [m]");
-    app.add_option("--sensor-max-" + a, f.sensor_frame.max[i],
-                   "drop points whose " + a + " in the sensor frame is above this [m]");
-  }
-  app.add_option("--min-range,--min_range", f.min_range,
-                 "drop points nearer the sensor than this [m] (no ray at all); 0: none")
-      ->capture_default_str();
-}
-
-void add_grid_flags(CLI::App& app, GridPublishConfig& g) {
-  app.add_option_function<std::string>(
-      "--grid-z",
-      [&g](const std::string& v) {
-        const size_t colon = v.find(':');
-        try {
-          size_t used = 0;
-          if (colon == std::string::npos) throw std::invalid_argument("no colon");
-          g.z_min = std::stod(v.substr(0, colon), &used);
-          if (used != colon) throw std::invalid_argument("trailing text");
-          g.z_max = std::stod(v.substr(colon + 1), &used);
-          g.z_given = true;
-          if (used != v.size() - colon - 1) throw std::invalid_argument("trailing text");
-        } catch (const std::exception&) {
-          throw CLI::ValidationError("--grid-z", "'" + v + "' is not MIN:MAX in metres (e.g. 0.1:1.5)");
-        }
-      },
-      "z band of the published grid, MIN:MAX [m]");
-  app.add_option("--grid-rate", g.rate_hz,
-                 std::string("publish the 2D grid of the --grid-z band (projected_map rule, grid_t rows) on ") +
-                     ort::protocol::kGridChannel + " at this rate [Hz]; 0: off")
-      ->check(CLI::Range(0.0, 50.0))
-      ->capture_default_str();
-  app.add_option("--grid-cell", g.cell_size,
-                 "cell size of the published grid [m], a multiple of the resolution; 0: "
-                 "the resolution")
-      ->capture_default_str();
-}
-
 // Every channel of `c` (today's names, or the ones given by flag) as NS_ + the name, each checked
 // against LCM's 63 characters: a server that could not publish or hear one does not start.
 void apply_namespace(ServerConfig& c, const std::string& ns) {
@@ -304,10 +249,14 @@ ServerConfig to_server_config(const ServerFlags& f) {
   ServerConfig c = f.server;
   const std::string ns = protocol::namespace_from(f.ns);
   c.engine = ort::cli::to_engine_options(f.engine);
+  c.resolution_from_file = f.resolution && f.resolution->count() == 0;
+  if (c.resolution_from_file && !f.shard.boxes.empty())
+    throw CLI::ValidationError("--shard-box", "needs -r: the boxes are cut into regions at the map's resolution");
   c.shard = to_shard_set(f.shard, c.engine.resolution);
   apply_namespace(c, c.shard.sharded() ? protocol::shard_namespace(ns, c.shard.index) : ns);
   if (c.shard.sharded()) keep_shared_channels(c, f.server, ns);
   c.pipeline = !f.no_pipeline;
+  c.read_replica = !f.no_read_replica;
   // Stage 1 shoots beside stage 2's octree update: the octree stage leaves it a core (a
   // worker preempted by stage 1 stalls every join of the update), and the voxel list of a
   // scan, small here, comes straight into host memory (one fence wait less a scan).
@@ -372,7 +321,15 @@ ServerConfig to_server_config(const ServerFlags& f) {
     throw CLI::ValidationError("--scan-channels", std::string("not a regular expression: ") + e.what());
   }
   if (!c.map_path.empty() && (c.map_path.size() < 4 || c.map_path.compare(c.map_path.size() - 3, 3, ".ot") != 0))
-    throw CLI::ValidationError("--map", "must name an .ot file (OctoMap's full format keeps the log-odds)");
+    throw CLI::ValidationError("--map",
+                               "must name an .ot file (OctoMap's full format keeps the log-odds; a .bt map "
+                               "can be the --prior of a new --map)");
+  auto ends_with = [](const std::string& s, const char* e) {
+    const size_t n = std::strlen(e);
+    return s.size() >= n && s.compare(s.size() - n, n, e) == 0;
+  };
+  if (!c.prior_path.empty() && !ends_with(c.prior_path, ".bt") && !ends_with(c.prior_path, ".ot"))
+    throw CLI::ValidationError("--prior", "must name a .bt or .ot file");
   return c;
 }
 

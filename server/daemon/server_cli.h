@@ -14,15 +14,20 @@ struct ServerFlags {
   ort::cli::EngineFlags engine;
   ServerConfig server;
   bool no_pipeline = false;
+  bool no_read_replica = false;
   double queue_mib = 0;
   double octomap_raw_max_kib = 0;  // 0: automatic
   std::string ns;                  // --namespace; "": $OCTOMAP_RT_NAMESPACE, else none
   bool print_config = false;       // --print-config: the effective configuration on stdout, then exit
   uint64_t max_scan_work = EngineOptions{}.max_scan_walk_keys;
-  ShardFlags shard;  // --shard, --shard-box, --shard-region-depth
+  ShardFlags shard;                         // --shard, --shard-box, --shard-region-depth
+  const CLI::Option* resolution = nullptr;  // -r: given, or taken from the map file
 };
 
 void add_server_flags(CLI::App& app, ServerFlags& f);
+// -r's default from the map file, --map, --prior, --move-corrupt-map-aside, --save-interval,
+// --applied-log (after the engine's flags).
+void add_map_file_flags(CLI::App& app, ServerFlags& f);
 // --pointcloud-min/max-x/y/z (map frame), --sensor-min/max-x/y/z, --min-range.
 void add_point_filter_flags(CLI::App& app, PointFilters& f);
 // --grid-rate, --grid-z MIN:MAX, --grid-cell (the grid published on OCTOMAP_RT_GRID).

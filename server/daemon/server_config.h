@@ -29,7 +29,12 @@ struct ServerConfig {
   std::string scan_channels =
       (std::string(ort::protocol::kScanChannelPrefix) + ".*");  // regex; its literal prefix + robot id
   std::string status_channel = ort::protocol::kStatusChannel;
-  std::string map_path;                 // .ot; "": no persistence
+  std::string map_path;  // .ot; "": no persistence
+  // A map to start from when map_path does not exist yet (or without map_path): .bt or .ot
+  // (octomap_server's map file). "": none. A new history (docs/PROTOCOL.md "Ids").
+  std::string prior_path;
+  // -r was not given: map at the resolution of map_path (when it exists), else of prior_path.
+  bool resolution_from_file = false;
   bool move_corrupt_map_aside = false;  // corrupt map: keep it as FILE.corrupt-<time>, start anew
   std::string applied_log;              // live applied-order log; "": none
   double save_interval_s = 30;          // <= 0: save only at exit
@@ -80,6 +85,12 @@ struct ServerConfig {
   // recently touched regions (--region-depth) go to FILE.ot.regions/; 0: no bound.
   uint64_t max_map_memory = 0;
   uint64_t region_store_max_bytes = uint64_t(1) << 40;  // the store's own bound on disk
+  // Whole-map readers (snapshots, saves, the viewer publisher, status counts) read a replica
+  // of the map fed by stage 2 (daemon/map/map_replica.h), so they never hold the octree stage
+  // up; it costs one more tree in memory and a second octree update per scan on another
+  // thread. false: they copy the map of record under its lock.
+  bool read_replica = true;
+  uint64_t replica_pending_bytes = 256ull << 20;  // changes the replica may lag behind by
 };
 
 // "" when the memory bound's flags fit together; else why not (a bound or a store bound

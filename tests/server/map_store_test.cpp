@@ -103,12 +103,49 @@ TEST(MapStore, SaveIsAtomicUnderSigkill) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(AppliedOrder, FormatParsesBack) {
-  std::vector<daemon::AppliedEntry> e = {{"husky1", 0, 100}, {"husky2", 0, 150}, {"husky1", 1, 200}};
-  std::istringstream in(daemon::format_applied_order(e, 12345));
-  const auto f = daemon::parse_applied_order(in);
+// The order file is appended to, cut back to the entries a saved map holds, and an older
+// server's v1 file (rewritten whole at every save) is taken over.
+TEST(AppliedOrder, AppendedCutBackAndAnOldFileTakenOver) {
+  const auto dir = temp_dir("applied-order");
+  const std::string path = dir + "/map.ot.order";
+  const std::vector<daemon::AppliedEntry> e = {{"husky1", 0, 100}, {"husky2", 0, 150}, {"husky1", 1, 200}};
+  {
+    daemon::AppliedOrder order;
+    EXPECT_EQ(order.open_file(path, std::nullopt), 0u);
+    for (const auto& x : e) order.append(x);
+    order.sync();
+    EXPECT_EQ(daemon::read_applied_order(path).entries, e);
+    order.append({"husky2", 1, 250});
+  }  // unsynced lines are written when the order is closed
+  EXPECT_EQ(daemon::read_applied_order(path).entries.size(), 4u);
+  {
+    daemon::AppliedOrder order;  // a map saved after 2 scans: the later lines are cut off
+    EXPECT_EQ(order.open_file(path, 2), 2u);
+    order.append({"husky3", 0, 300});
+    order.sync();
+    const auto f = daemon::read_applied_order(path);
+    ASSERT_EQ(f.entries.size(), 3u);
+    EXPECT_EQ(f.entries[1], e[1]);
+    EXPECT_EQ(f.entries[2].robot_id, "husky3");
+  }
+  {
+    std::ofstream v1(path, std::ios::trunc);
+    v1 << "# octomap-rt applied order v1\n# columns: index robot_id seq utime\n# scans 2\n# map_bytes 12345\n"
+       << "0 husky1 0 100\n1 husky2 0 150\n";
+  }
+  {
+    daemon::AppliedOrder order;
+    EXPECT_EQ(order.open_file(path, std::nullopt), 2u);
+    order.append(e[2]);
+    order.sync();
+  }
+  const auto f = daemon::read_applied_order(path);
   EXPECT_EQ(f.entries, e);
-  EXPECT_EQ(f.map_bytes, 12345);
+  EXPECT_EQ(f.map_bytes, -1) << "rewritten as v2";
+  std::filesystem::remove_all(dir);
+}
+
+TEST(AppliedOrder, BadFilesAreRefused) {
   std::istringstream bad("# octomap-rt applied order v1\n0 a 1 2\n2 b 1 2\n");
   EXPECT_THROW(daemon::parse_applied_order(bad), std::runtime_error);
   std::istringstream short_file("# scans 3\n0 a 1 2\n");

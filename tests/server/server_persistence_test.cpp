@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "daemon/persistence/map_identity_file.h"
 #include "daemon/persistence/map_store.h"
 #include "scene/synthetic_scene.h"
 #include "server/scan_fixtures.h"
@@ -39,7 +40,10 @@ TEST(ServerPersistence, SaveOnStopRestartLoadsAndExtends) {
   ASSERT_TRUE(std::filesystem::exists(cfg.map_path));
   const auto first = daemon::read_applied_order(cfg.map_path + ".order");
   EXPECT_EQ(first.entries.size(), 3u);
-  EXPECT_EQ(first.map_bytes, static_cast<int64_t>(std::filesystem::file_size(cfg.map_path)));
+  const auto identity = daemon::read_map_identity(cfg.map_path);
+  ASSERT_TRUE(identity.has_value());
+  EXPECT_EQ(identity->map_bytes, std::filesystem::file_size(cfg.map_path));
+  EXPECT_EQ(identity->order_entries, 3u);
 
   // Another resolution: refused with a clear message, the file untouched.
   {
@@ -89,14 +93,15 @@ TEST(ServerPersistence, PeriodicSavesHappenWhileServing) {
   server.start();
   feed(server, lc, set, 0, 2);
   // A periodic save (no stop yet) captures the map after both scans: the map changes only
-  // between whole scans, and the order file says how many it holds.
+  // between whole scans, and the map's identity (written after the map) says how many of the
+  // order file's scans it holds.
   size_t saved_scans = 0;
   for (int i = 0; i < 250 && saved_scans < 2; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    if (std::filesystem::exists(cfg.map_path + ".order"))
-      saved_scans = daemon::read_applied_order(cfg.map_path + ".order").entries.size();
+    if (const auto id = daemon::read_map_identity(cfg.map_path)) saved_scans = id->order_entries;
   }
   EXPECT_EQ(saved_scans, 2u);
+  EXPECT_GE(daemon::read_applied_order(cfg.map_path + ".order").entries.size(), 2u);
   EXPECT_NO_THROW(daemon::load_map(cfg.map_path, 0.1));
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   const int64_t saves = server.status().map_saves;

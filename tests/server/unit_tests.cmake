@@ -13,6 +13,8 @@ octomap_rt_lcm_handler_sources(server_memq_test ${CMAKE_CURRENT_LIST_DIR}/server
                                ${CMAKE_CURRENT_LIST_DIR}/map_request_bounds_test.cpp)
 octomap_rt_add_test(server_persistence_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_store_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/server_persistence_test.cpp ${CMAKE_CURRENT_LIST_DIR}/map_file_integrity_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/map_identity_test.cpp ${CMAKE_CURRENT_LIST_DIR}/map_replica_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/prior_map_test.cpp
                     ${SERVER_TEST_FIXTURES}
                     LIBS octomap_rt_daemon TIMEOUT 300)
 octomap_rt_add_test(lcm_loop_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/lcm_loop_test.cpp LIBS octomap_rt_daemon TIMEOUT 120)
@@ -69,7 +71,8 @@ octomap_rt_add_test(server_point_filters_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
 # The server's command line: --namespace, --config's unknown keys, --print-config (issue 24).
 octomap_rt_add_test(server_cli_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_cli_test.cpp
-                    ${CMAKE_SOURCE_DIR}/server/daemon/server_cli.cpp LIBS octomap_rt_daemon TIMEOUT 60)
+                    ${CMAKE_SOURCE_DIR}/server/daemon/server_cli.cpp ${CMAKE_SOURCE_DIR}/server/daemon/server_flag_groups.cpp
+                    LIBS octomap_rt_daemon TIMEOUT 60)
 # Issue 26: shards keep their regions' voxels; merged they are the one-daemon map (real data).
 octomap_rt_add_test(server_shard_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/shard_test.cpp ${SERVER_TEST_FIXTURES}
                     LIBS octomap_rt_daemon octomap_rt_map_client TIMEOUT 300)

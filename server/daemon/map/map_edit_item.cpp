@@ -1,5 +1,6 @@
 #include "daemon/map/map_edit_item.h"
 
+#include "daemon/map/map_identity.h"
 #include "daemon/map/map_residency.h"
 #include "daemon/map/map_state.h"
 #include "octomap_rt/map_edit_t.hpp"
@@ -12,7 +13,9 @@ MapEditResult apply_map_edit(MapState& map, const MapEditItem& edit) {
   MapEditResult r;
   octomap::OcTree& tree = *map.tree;
   if (edit.op == Msg::OP_RESET) {
-    query::reset_map(tree);
+    // An empty map is not the same history at a later id.
+    apply_map_step(
+        map, [](octomap::OcTree& t) { query::reset_map(t); }, /*forks_history=*/true);
     if (map.residency) map.residency->forget_all();
   } else {
     const query::KeyBox box = query::key_box(tree, edit.box_min, edit.box_max);
@@ -31,14 +34,14 @@ MapEditResult apply_map_edit(MapState& map, const MapEditItem& edit) {
                 "; the map is unchanged";
       return r;
     }
-    query::clear_box(tree, box, to, unknown);
+    apply_map_step(map, [box, to, unknown](octomap::OcTree& t) { query::clear_box(t, box, to, unknown); });
     if (map.residency) map.residency->enforce(tree);
   }
-  map.version++;
   // Deltas cannot carry an edit (a box back to unknown, a reset): mirrors resync from a snapshot.
-  if (map.observer) map.observer->replaced(tree, map.version);
+  if (map.observer) map.observer->replaced(tree, map.version, map.epoch);
   r.ok = true;
   r.version = map.version;
+  r.epoch = map.epoch;
   r.map_utime = map.last_scan_utime;
   return r;
 }

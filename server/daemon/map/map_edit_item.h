@@ -24,6 +24,7 @@ struct MapEditResult {
   EditRefusal refusal = EditRefusal::kNone;
   std::string error;
   uint64_t version = 0;  // map state id right after the edit
+  uint64_t epoch = 0;    // and its epoch (a reset starts a new one)
   int64_t map_utime = 0;
   int64_t voxels = 0;    // finest voxels of the box
   query::EditCost cost;  // as estimated before the edit (a clear)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "daemon/map/map_identity.h"
 #include "daemon/map/map_state.h"
 #include "octree/region_codec.h"
 
@@ -18,9 +19,9 @@ MapResidency::MapResidency(MapState& map, const RegionGrid& grid, RegionSpill& s
   stats_.max_bytes = max_bytes;
 }
 
-// The one place eviction and restore are counted as a change of the map (its state id):
-// the map's contents are the same, its tree is not.
-void MapResidency::count_residency_change() { map_.version++; }
+// The one place eviction and restore are counted as a change of the map (its state id,
+// through daemon/map/map_identity.h): the map's contents are the same, its tree is not.
+void MapResidency::count_residency_change() { count_map_change(map_); }
 
 uint64_t MapResidency::estimate(const octomap::OcTree& tree) const {
   if (bytes_per_node_ <= 0) return tree.memoryUsage();

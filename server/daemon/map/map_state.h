@@ -3,6 +3,7 @@
 // scans. Stage 2 holds the lock for one scan's octree update at a time.
 #pragma once
 
+#include <cctype>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -30,22 +31,33 @@ class MapChangeObserver {
   virtual void applied(LeafChanges& changes, const octomap::OcTree& tree, uint64_t version) = 0;
   // The map changed in a way not described by a voxel list (an edit, a reload): deltas
   // cannot carry it, so the observer makes clients resync. Also under the map lock.
-  virtual void replaced(const octomap::OcTree& tree, uint64_t version) = 0;
+  // `epoch`: the map's epoch now (a reset starts a new one).
+  virtual void replaced(const octomap::OcTree& tree, uint64_t version, uint64_t epoch) = 0;
 };
 
+class MapReplica;
 class MapResidency;
+
+// The key of a robot in the map's tables: its id in lower case (ids are case-insensitive).
+inline std::string robot_key(std::string id) {
+  for (char& c : id) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return id;
+}
 
 struct MapState {
   // Writers (stage 2, edits) lock it exclusively; queries read under a shared lock.
   std::shared_mutex mutex;
   std::unique_ptr<octomap::OcTree> tree;
   AppliedOrder order;
-  // The map state id: how many scans the map contains by its applied order, over the map's
-  // whole life (a loaded map starts at its order file's count; +1 per applied scan, under
-  // the lock). Two reads with the same version saw the same map. Snapshot ids and the map
-  // state a query was answered on are this number. A map edit (daemon/map_edit_item.h)
-  // also adds 1: the id changes whenever the map does.
+  // The map's identity (daemon/map/map_identity.h): `version` is the map state id, +1 for
+  // every change (scan, edit, reset, loaded prior), under the lock, through
+  // count_map_change/fork_map_history only; `epoch` names the history the id counts in and
+  // changes when that history forks. Both are persisted with the map (a clean restart goes
+  // on from them). Two reads with the same epoch and version saw the same map. Snapshot ids
+  // and the map state a query was answered on are `version`.
   uint64_t version = 0;
+  uint64_t epoch = 0;
+  uint64_t scans = 0;                     // applied scans over the map's life (the applied order's length)
   int64_t last_scan_utime = 0;            // utime of the newest applied scan
   octomap::point3d last_scan_origin;      // its sensor origin (where a clipped grid is centred)
   MapChangeObserver* observer = nullptr;  // set before the pipeline starts
@@ -61,8 +73,18 @@ struct MapState {
   };
   static constexpr size_t kMaxRobotsSeen = 256;
   std::map<std::string, RobotSeen> robots_seen;
-  // Newest applied seq per robot (lower-case id), for queries that wait for their own scan.
-  std::map<std::string, int64_t> applied_seq;
+  // The read replica whole-map readers read (daemon/map/map_replica.h); null: they read this
+  // map. Set before the pipeline starts; stage 2 feeds it every change.
+  MapReplica* replica = nullptr;
+  // Each robot's newest applied scan, by lower-case id: its seq (queries that wait for their
+  // own scan), its id as sent and how many scans the map had applied with it (snapshots list
+  // the producers with the most recent scans first).
+  struct NewestScan {
+    std::string robot_id;
+    int64_t seq = -1;
+    uint64_t scans = 0;
+  };
+  std::map<std::string, NewestScan> newest_scan;
   // Notified (without the lock held) after every applied scan or edit.
   std::condition_variable_any changed;
 };

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/map/map_identity.h"
 #include "daemon/map/map_residency.h"
 #include "octree/decay.h"
 #include "octree/distance_clearing.h"
@@ -61,7 +62,7 @@ UpkeepStats MapUpkeep::stats() const {
   return stats_;
 }
 
-void MapUpkeep::count_slice_change() { map_.version++; }
+void MapUpkeep::count_slice_change() { count_map_change(map_); }
 
 template <class Sweep>
 void MapUpkeep::run_sweep(Sweep& sweep, uint64_t& deleted_counter) {
@@ -86,7 +87,7 @@ void MapUpkeep::run_sweep(Sweep& sweep, uint64_t& deleted_counter) {
       if (map_.residency) map_.residency->enforce(*map_.tree);
       count_slice_change();
       // Deltas cannot carry the sweep: mirrors resync once it is whole.
-      if (done && map_.observer) map_.observer->replaced(*map_.tree, map_.version);
+      if (done && map_.observer) map_.observer->replaced(*map_.tree, map_.version, map_.epoch);
     }
     map_.changed.notify_all();
     const double ms = ms_since(t0);

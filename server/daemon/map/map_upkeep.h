@@ -69,8 +69,8 @@ class MapUpkeep {
   void run_clear_sweep();
   template <class Sweep>
   void run_sweep(Sweep& sweep, uint64_t& deleted_counter);
-  // The one place a slice's change of the map is counted (the map state id; issue 23's
-  // epoch/state counting replaces the body when it lands).
+  // The one place a slice's change of the map is counted (map_identity.h). Its change is not
+  // replayed on a read replica: the server runs without one while upkeep is on.
   void count_slice_change();
 
   MapState& map_;

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "core/file_checks/octree_file_check.h"
+#include "daemon/persistence/map_identity_file.h"
 
 namespace ort::daemon {
 namespace {
@@ -64,6 +65,27 @@ void sync_directory(const std::string& dir) {
   if (d.fd < 0 || ::fsync(d.fd) != 0) throw sys_error(Kind::kSync, "cannot fsync directory", dir);
 }
 
+std::string read_whole(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw sys_error(Kind::kOpen, "cannot open map", path);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw sys_error(Kind::kRead, "cannot read map", path);
+  return bytes;
+}
+
+// The header prints the resolution as text (6 significant digits), so allow for that
+// rounding, and then use the requested value bit for bit.
+void require_resolution(octomap::OcTree& tree, double resolution, const std::string& path, const char* flag) {
+  const double file_res = tree.getResolution();
+  if (std::abs(file_res - resolution) > 1e-6 * resolution) {
+    std::ostringstream msg;
+    msg << "map '" << path << "' has resolution " << file_res << " m but the server was started with -r " << resolution
+        << "; start with -r " << file_res << " (or without -r: the file's), or use another " << flag << " file";
+    throw MapStoreError(Kind::kWrongResolution, msg.str());
+  }
+  if (file_res != resolution) tree.setResolution(resolution);
+}
+
 std::string utc_stamp() {
   const std::time_t t = std::time(nullptr);
   std::tm tm{};
@@ -87,6 +109,7 @@ const char* to_string(MapStoreError::Kind kind) {
     case Kind::kRename: return "rename failed";
     case Kind::kNotWritable: return "map directory not writable";
     case Kind::kSerialize: return "cannot serialize";
+    case Kind::kLocked: return "map in use";
   }
   return "unknown";
 }
@@ -98,10 +121,11 @@ std::string serialize_map(const octomap::OcTree& tree) {
 }
 
 std::unique_ptr<octomap::OcTree> load_map(const std::string& path, double resolution) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw sys_error(Kind::kOpen, "cannot open map", path);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw sys_error(Kind::kRead, "cannot read map", path);
+  return load_map_file(path, resolution).tree;
+}
+
+LoadedMapFile load_map_file(const std::string& path, double resolution) {
+  const std::string bytes = read_whole(path);
   const OctreeFileCheck check = check_octree_file(bytes, /*inner_is_max=*/true);
   if (!check.ok) {
     const bool other_tree = !check.tree_type.empty() && check.tree_type != "OcTree";
@@ -109,24 +133,59 @@ std::unique_ptr<octomap::OcTree> load_map(const std::string& path, double resolu
     throw MapStoreError(kind, "map '" + path + "' is not a complete OctoMap .ot file: " + check.error);
   }
   if (check.format != OctreeFileFormat::kFull)
-    throw MapStoreError(Kind::kWrongType, "map '" + path + "' is a .bt file (no log-odds); the server keeps .ot maps");
+    throw MapStoreError(Kind::kWrongType, "map '" + path +
+                                              "' is a .bt file (no log-odds); the map of record is kept as .ot: "
+                                              "start from it with --prior and save to another --map");
   std::unique_ptr<octomap::OcTree> tree;
   try {
     tree = read_octree_file_bytes(bytes, "map '" + path + "'", /*inner_is_max=*/true);
   } catch (const std::runtime_error& e) {
     throw MapStoreError(Kind::kCorrupt, e.what());
   }
-  const double file_res = tree->getResolution();
-  // The .ot header prints the resolution as text (6 significant digits), so allow for that
-  // rounding, and then use the requested value bit for bit.
-  if (std::abs(file_res - resolution) > 1e-6 * resolution) {
-    std::ostringstream msg;
-    msg << "map '" << path << "' has resolution " << file_res << " m but the server was started with -r " << resolution
-        << "; start with -r " << file_res << " or use another --map file";
-    throw MapStoreError(Kind::kWrongResolution, msg.str());
+  require_resolution(*tree, resolution, path, "--map");
+  return LoadedMapFile{std::move(tree), bytes.size(), map_file_hash(bytes)};
+}
+
+std::unique_ptr<octomap::OcTree> load_prior_map(const std::string& path, double resolution, const SensorModel& sensor) {
+  const std::string bytes = read_whole(path);
+  const OctreeFileCheck check = check_octree_file(bytes);
+  if (!check.ok) {
+    const bool other_tree = !check.tree_type.empty() && check.tree_type != "OcTree";
+    throw MapStoreError(other_tree ? Kind::kWrongType : Kind::kCorrupt,
+                        "prior map '" + path + "' is not a complete OctoMap OcTree file (.bt or .ot): " + check.error);
   }
-  if (file_res != resolution) tree->setResolution(resolution);
+  std::unique_ptr<octomap::OcTree> tree;
+  try {
+    tree = read_octree_file_bytes(bytes, "prior map '" + path + "'");
+  } catch (const std::runtime_error& e) {
+    throw MapStoreError(Kind::kCorrupt, e.what());
+  }
+  require_resolution(*tree, resolution, path, "--prior");
+  if (check.format == OctreeFileFormat::kBinary) {
+    // readBinary gave every node OctoMap's default clamping bounds: move them to this sensor
+    // model's (a monotonic map, so inner nodes stay their children's maximum).
+    const float occupied = octomap::logodds(sensor.clamping_max), free = octomap::logodds(sensor.clamping_min);
+    for (auto it = tree->begin_tree(), end = tree->end_tree(); it != end; ++it)
+      it->setLogOdds(tree->isNodeOccupied(*it) ? occupied : free);
+  }
+  apply_sensor_model(*tree, sensor);
   return tree;
+}
+
+double map_file_resolution(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw sys_error(Kind::kOpen, "cannot open map", path);
+  std::string line;
+  for (int i = 0; i < 64 && std::getline(in, line); ++i) {
+    if (line == "data") break;
+    if (line.rfind("res ", 0) == 0) {
+      std::istringstream v(line.substr(4));
+      double res = 0;
+      if (v >> res && std::isfinite(res) && res > 0) return res;
+      break;
+    }
+  }
+  throw MapStoreError(Kind::kCorrupt, "'" + path + "' has no resolution in an OctoMap header");
 }
 
 std::string move_map_aside(const std::string& path) {

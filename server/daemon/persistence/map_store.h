@@ -8,12 +8,15 @@
 // FILE.tmp (a full disk stays no fuller than before).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 
 #include <octomap/OcTree.h>
+
+#include "core/sensor_model.h"
 
 namespace ort::daemon {
 
@@ -32,6 +35,7 @@ class MapStoreError : public std::runtime_error {
     kRename,           // the atomic rename failed
     kNotWritable,      // the start-up probe could not write and sync in the map's directory
     kSerialize,        // OctoMap could not serialize the map
+    kLocked,           // another daemon holds the map file (daemon/persistence/map_file_lock.h)
   };
   MapStoreError(Kind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
   Kind kind() const { return kind_; }
@@ -49,6 +53,23 @@ std::string serialize_map(const octomap::OcTree& tree);
 // last byte, node count against the header) and only then lets OctoMap read it. Throws
 // MapStoreError: kOpen/kRead, kCorrupt, kWrongType, kWrongResolution (naming both values).
 std::unique_ptr<octomap::OcTree> load_map(const std::string& path, double resolution);
+
+// load_map with what the map's identity needs of the file: its size and FNV-1a 64 hash.
+struct LoadedMapFile {
+  std::unique_ptr<octomap::OcTree> tree;
+  uint64_t bytes = 0, hash = 0;
+};
+LoadedMapFile load_map_file(const std::string& path, double resolution);
+
+// A prior map to start a new map from (octomap_server's map file at start): .ot (log-odds
+// kept) or .bt (maximum likelihood: each node at `sensor`'s clamping maximum if occupied,
+// minimum if free, as OctoMap's readBinary would give with that sensor model), checked whole
+// before OctoMap reads it. Throws MapStoreError like load_map (kWrongResolution: not `resolution`).
+std::unique_ptr<octomap::OcTree> load_prior_map(const std::string& path, double resolution, const SensorModel& sensor);
+
+// The resolution in an OctoMap file's header (.ot or .bt), read without loading the tree:
+// what the server maps at when started without -r. Throws MapStoreError (kOpen, kCorrupt).
+double map_file_resolution(const std::string& path);
 
 // Renames `path` to `path`.corrupt-<UTC time> so a new map can start without losing it;
 // returns the new name. Throws MapStoreError(kRename).

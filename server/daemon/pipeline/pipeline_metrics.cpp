@@ -13,6 +13,8 @@ void PipelineMetrics::record(const AppliedTiming& t) {
   decode_.add(t.waits.decode_ms);
   queue_wait_.add(t.waits.queue_ms);
   handoff_wait_.add(t.waits.handoff_ms);
+  lock_wait_.add(t.stage2.lock_wait_ms);
+  lock_wait_max_ = std::max(lock_wait_max_, t.stage2.lock_wait_ms);
   stage1_total_.add(t.stage1);
   slowest_.add(t);
   scans_++;
@@ -40,6 +42,8 @@ MetricsSnapshot PipelineMetrics::snapshot() {
   s.decode = both(decode_);
   s.queue_wait = both(queue_wait_);
   s.handoff_wait = both(handoff_wait_);
+  s.lock_wait = both(lock_wait_);
+  s.lock_wait_max = lock_wait_max_;
   s.stage1_total = stage1_total_;
   s.slowest = slowest_.slowest();
   while (!recent_.empty() && std::chrono::duration<double>(now - recent_.front().first).count() > kRateWindowS)

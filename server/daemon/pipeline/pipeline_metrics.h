@@ -28,8 +28,12 @@ struct MetricsSnapshot {
   double shoot_total_ms = 0, octree_total_ms = 0;
   OverlapTotals overlap;
   Percentiles decode, queue_wait, handoff_wait;  // ScanWaits over the latency window
-  StageTimes stage1_total;                       // the engine's parts of stage 1, summed over every scan
-  std::vector<SlowScan> slowest;                 // the run's slowest scans end to end, slowest first
+  // Stage 2's wait for the map lock (readers holding it: snapshot copies, saves, status
+  // counts, queries): over the window, and the longest since start.
+  Percentiles lock_wait;
+  double lock_wait_max = 0;
+  StageTimes stage1_total;        // the engine's parts of stage 1, summed over every scan
+  std::vector<SlowScan> slowest;  // the run's slowest scans end to end, slowest first
 };
 
 class PipelineMetrics {
@@ -42,7 +46,8 @@ class PipelineMetrics {
  private:
   static constexpr double kRateWindowS = 10.0;
   std::mutex mutex_;
-  LatencyWindow shoot_, octree_, e2e_, decode_, queue_wait_, handoff_wait_;
+  LatencyWindow shoot_, octree_, e2e_, decode_, queue_wait_, handoff_wait_, lock_wait_;
+  double lock_wait_max_ = 0;
   StageTimes stage1_total_;
   SlowestScans slowest_;
   std::deque<std::pair<Clock::time_point, int64_t>> recent_;  // applied scans: time, points

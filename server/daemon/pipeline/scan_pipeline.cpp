@@ -6,14 +6,12 @@
 
 #include "core/clock.h"
 #include "daemon/intake/scan_to_map.h"
+#include "daemon/map/map_identity.h"
+#include "daemon/map/map_replica.h"
 #include "daemon/map/map_residency.h"
 
 namespace ort::daemon {
 namespace {
-std::string lower_case(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 // Keeps the robots_seen table within its bound: the stalest robot goes first.
 void note_robot_seen(MapState& map, const std::string& robot, const octomap::point3d& origin) {
   map.robots_seen[robot] = MapState::RobotSeen{origin, Clock::now()};
@@ -228,15 +226,17 @@ void ScanPipeline::apply(ShotJob& job) {
     // robots may have.
     const int64_t utime = std::min(job.utime, now_utime() + gate_.max_future_us());
     map_.order.append(AppliedEntry{job.robot_id, job.seq, utime});
-    map_.version++;
+    map_.scans++;
+    count_map_change(map_);
     map_.last_scan_utime = std::max(map_.last_scan_utime, utime);
     map_.last_scan_origin = job.origin;
     const auto updated = Clock::now();
     if (map_.observer) map_.observer->applied(changes_, *map_.tree, map_.version);
-    const std::string robot = lower_case(job.robot_id);
-    map_.applied_seq[robot] = job.seq;
+    const std::string robot = robot_key(job.robot_id);
+    map_.newest_scan[robot] = MapState::NewestScan{job.robot_id, job.seq, map_.scans};
     note_robot_seen(map_, robot, job.origin);
     if (map_.residency) map_.residency->enforce(*map_.tree);
+    if (map_.replica) map_.replica->scan_applied(job.shot.voxels, map_, robot);
     parts = {ms_between(t0, locked), ms_between(locked, updated), ms_between(updated, Clock::now())};
   } catch (const std::exception& e) {
     set_busy(1, false);

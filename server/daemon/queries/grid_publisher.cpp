@@ -39,7 +39,7 @@ void GridPublisher::compute_if_changed() {
   std::shared_lock lock(map_.mutex);
   if (map_.version == computed_version_) return;
   computed_version_ = map_.version;
-  const MapStamp stamp{static_cast<int64_t>(map_.version), map_.last_scan_utime};
+  const MapStamp stamp{static_cast<int64_t>(map_.version), map_.last_scan_utime, static_cast<int64_t>(map_.epoch)};
   try {
     query::WorkBudget budget;
     budget.max_work = bounds_.max_work;

@@ -51,6 +51,7 @@ void stamp_reply(M& m, const QueryHeader& h, const MapStamp& s, const std::strin
   m.utime = now_us();
   m.request_id = h.request_id;
   m.snapshot_id = s.snapshot_id;
+  m.map_epoch = s.map_epoch;
   m.map_utime = s.map_utime;
   m.status = status;
   m.server_id = server_id;

@@ -28,6 +28,7 @@ std::string validate_query(const QueryMessage& q, double resolution);
 
 struct MapStamp {
   int64_t snapshot_id = 0, map_utime = 0;
+  int64_t map_epoch = 0;  // the history snapshot_id counts in
 };
 
 struct EncodedReplies {

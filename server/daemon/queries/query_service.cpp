@@ -27,11 +27,6 @@ constexpr size_t kMaxParked = 256;  // queries waiting for their map state, all 
 // Longest a batch of queries holds the map for reading (stage 2 may be waiting to write).
 constexpr auto kReadTurn = std::chrono::milliseconds(10);
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 // The ack's status for what the pipeline did with an edit.
 int8_t ack_status(const MapEditResult& r) {
   switch (r.refusal) {
@@ -174,6 +169,7 @@ void QueryService::on_edit(const lcm::ReceiveBuffer& rb, const std::string& chan
     a.utime = now_us();
     a.request_id = msg.request_id;
     a.snapshot_id = static_cast<int64_t>(r.version);
+    a.map_epoch = static_cast<int64_t>(r.epoch);
     a.map_utime = r.map_utime;
     a.status = status;
     a.op = msg.op;
@@ -214,14 +210,14 @@ void QueryService::on_edit(const lcm::ReceiveBuffer& rb, const std::string& chan
 
 bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& out) {
   const QueryHeader h = header_of(q.msg);
-  const MapStamp stamp{static_cast<int64_t>(map_.version), map_.last_scan_utime};
+  const MapStamp stamp{static_cast<int64_t>(map_.version), map_.last_scan_utime, static_cast<int64_t>(map_.epoch)};
   // The robot id keys the wait: "" = no wait, whatever wait_seq holds (a default message
   // has wait_seq 0), so a plain query is never parked for a robot that does not exist.
   const bool waits_for_scan = !h.wait_robot_id.empty();
   int64_t applied = -1;
   if (waits_for_scan) {
-    auto it = map_.applied_seq.find(lower(h.wait_robot_id));
-    if (it != map_.applied_seq.end()) applied = it->second;
+    auto it = map_.newest_scan.find(robot_key(h.wait_robot_id));
+    if (it != map_.newest_scan.end()) applied = it->second.seq;
   }
   const bool ready = stamp.snapshot_id >= h.min_snapshot_id && (!waits_for_scan || applied >= h.wait_seq);
   if (!ready) {

@@ -34,8 +34,9 @@ DeltaPublisher::~DeltaPublisher() {
   } catch (...) {}
 }
 
-void DeltaPublisher::start(uint64_t version) {
+void DeltaPublisher::start(uint64_t version, uint64_t epoch) {
   from_version_ = to_version_ = version;
+  epoch_ = epoch;
   if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
 }
 
@@ -78,11 +79,12 @@ void DeltaPublisher::give_back(std::vector<LeafChanges>& logs) {
   }
 }
 
-void DeltaPublisher::replaced(const octomap::OcTree&, uint64_t version) {
+void DeltaPublisher::replaced(const octomap::OcTree&, uint64_t version, uint64_t epoch) {
   std::lock_guard lock(mutex_);
   pending_.clear();
   pending_scans_ = 0;
   from_version_ = to_version_ = version;
+  epoch_ = epoch;
   skip_seqs_++;
 }
 
@@ -110,7 +112,7 @@ void DeltaPublisher::run() {
 
 void DeltaPublisher::flush() {
   std::vector<LeafChanges> logs;
-  uint64_t from, to;
+  uint64_t from, to, epoch;
   int64_t scans;
   float thr;
   {
@@ -120,6 +122,7 @@ void DeltaPublisher::flush() {
     thr = occupancy_thres_log_;
     from = from_version_;
     to = to_version_;
+    epoch = epoch_;
     from_version_ = to;
     scans = pending_scans_;
     pending_scans_ = 0;
@@ -141,6 +144,7 @@ void DeltaPublisher::flush() {
   Delta d{};
   d.from_version = static_cast<int64_t>(from);
   d.to_version = static_cast<int64_t>(to);
+  d.map_epoch = static_cast<int64_t>(epoch);
   d.snapshot_id = latest_snapshot_id_ ? latest_snapshot_id_() : -1;
   d.num_parts = static_cast<int32_t>(parts.size());
   d.mode = mode;

@@ -50,15 +50,15 @@ class DeltaPublisher : public MapChangeObserver {
   DeltaPublisher(const DeltaPublisher&) = delete;
   DeltaPublisher& operator=(const DeltaPublisher&) = delete;
 
-  // `version`: the map state id now (the first change set applies on it).
-  void start(uint64_t version);
+  // `version`, `epoch`: the map's identity now (the first change set applies on it).
+  void start(uint64_t version, uint64_t epoch);
   // Sends what is pending, then ends the thread. Idempotent.
   void stop();
   // Takes `changes` over and leaves it empty with some capacity (a used log given back).
   void applied(LeafChanges& changes, const octomap::OcTree& tree, uint64_t version) override;
   // Drops what is pending and skips one delta_seq on purpose: every mirror sees a gap and
   // resyncs from a snapshot at `version` or newer.
-  void replaced(const octomap::OcTree& tree, uint64_t version) override;
+  void replaced(const octomap::OcTree& tree, uint64_t version, uint64_t epoch) override;
   DeltaStats stats() const;
   int64_t last_seq() const { return last_seq_; }
 
@@ -80,7 +80,7 @@ class DeltaPublisher : public MapChangeObserver {
   std::vector<LeafChanges> pending_;
   std::vector<LeafChanges> spare_;  // emptied logs, handed back to stage 2 to keep their capacity
   float occupancy_thres_log_ = 0;   // the map's, as of the newest pending scan
-  uint64_t from_version_ = 0, to_version_ = 0;
+  uint64_t from_version_ = 0, to_version_ = 0, epoch_ = 0;
   int64_t pending_scans_ = 0;
   int64_t skip_seqs_ = 0;
   bool stop_ = false;

@@ -235,6 +235,7 @@ void MapService::send_chunks(const octomap_rt::map_request_t& req, const Snapsho
   c.compression = blob.compression;
   c.uncompressed_size = blob.raw_size;
   c.num_scans = static_cast<int64_t>(blob.contents.scans);
+  c.map_epoch = static_cast<int64_t>(blob.contents.epoch);
   c.chunk_size = static_cast<int32_t>(chunk);
   c.server_id = cfg_.server_id;
   c.client_id = req.client_id;
@@ -260,6 +261,7 @@ void MapService::publish_info() {
   {
     std::shared_lock lock(map_.mutex);
     m.map_version = static_cast<int64_t>(map_.version);
+    m.map_epoch = static_cast<int64_t>(map_.epoch);
   }
   m.delta_seq = last_delta_seq_ ? last_delta_seq_() : -1;
   m.resolution = cfg_.resolution;
@@ -270,7 +272,8 @@ void MapService::publish_info() {
   m.server_id = cfg_.server_id;
   m.map_frame = cfg_.map_frame;
   m.chunk_size = static_cast<int32_t>(protocol::kChunkDataBytes);
-  if (const auto b = store_.last_made()) {
+  // A snapshot of an earlier epoch (before a reset) is not one of this map's states.
+  if (const auto b = store_.last_made(); b && static_cast<int64_t>(b->contents.epoch) == m.map_epoch) {
     const SnapshotContents& c = b->contents;
     m.snapshot_id = static_cast<int64_t>(c.snapshot_id);
     m.map_utime = c.map_utime;

@@ -16,7 +16,9 @@ MapCopy copy_locked(const MapState& map, std::chrono::steady_clock::time_point t
   // With a memory bound the copy is the whole map: its stand-ins get their regions back.
   if (map.residency) map.residency->fill_copy(*c.tree);
   c.version = map.version;
-  c.scans = map.order.size();
+  c.epoch = map.epoch;
+  c.scans = map.scans;
+  c.newest_scan = map.newest_scan;
   c.last_scan_utime = map.last_scan_utime;
   c.lock_ms = ms_since(t0);
   return c;

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -16,10 +17,12 @@ namespace ort::daemon {
 
 struct MapCopy {
   std::unique_ptr<octomap::OcTree> tree;
-  uint64_t version = 0;         // the map state id (MapState::version) the copy shows
-  size_t scans = 0;             // applied-order entries it contains (order.entries(scans))
-  int64_t last_scan_utime = 0;  // utime of the newest scan in it
-  double lock_ms = 0;           // how long the copy held the map lock
+  uint64_t version = 0;  // the map state id (MapState::version) the copy shows
+  uint64_t epoch = 0;    // and its epoch
+  size_t scans = 0;      // applied scans it contains (the first `scans` lines of the order)
+  std::map<std::string, MapState::NewestScan> newest_scan;  // each robot's newest scan in it
+  int64_t last_scan_utime = 0;                              // utime of the newest scan in it
+  double lock_ms = 0;                                       // how long the copy held the map lock
 };
 
 // Copies the map under its lock. OcTree's copy constructor holds the lock for less time than

@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <fstream>
+#include <shared_mutex>
 
+#include "daemon/map/map_replica.h"
 #include "daemon/serving/map_snapshot.h"
 #include "daemon/serving/octomap_raw_map.h"
 
@@ -44,12 +46,25 @@ std::string OctomapRawPublisher::note() const {
 }
 
 void OctomapRawPublisher::encode_if_changed() {
-  auto copy = copy_map_if_changed(map_, encoded_version_);
-  if (!copy) return;
-  encoded_version_ = copy->version;
-  if (std::isfinite(cfg_.occupancy_min_z) || std::isfinite(cfg_.occupancy_max_z))
-    drop_occupied_outside_band(*copy->tree, cfg_.occupancy_min_z, cfg_.occupancy_max_z);
-  const RawMap raw = make_raw_map(*copy->tree, copy->last_scan_utime, RawMapOptions{cfg_.max_bytes, cfg_.min_depth});
+  RawMap raw;
+  const RawMapOptions options{cfg_.max_bytes, cfg_.min_depth};
+  const bool band = std::isfinite(cfg_.occupancy_min_z) || std::isfinite(cfg_.occupancy_max_z);
+  if (map_.replica && !band) {
+    // Encoded straight from the read replica, under its lock: no copy of the map, and the
+    // octree stage does not wait (the replica's thread does).
+    MapState& r = readable_map(map_);
+    std::shared_lock lock(r.mutex);
+    if (r.version == encoded_version_) return;
+    encoded_version_ = r.version;
+    raw = make_raw_map(*r.tree, r.last_scan_utime, options);
+  } else {
+    // The band filter changes the tree it encodes: a copy (of the replica when there is one).
+    auto copy = copy_map_if_changed(map_.replica ? readable_map(map_) : map_, encoded_version_);
+    if (!copy) return;
+    encoded_version_ = copy->version;
+    if (band) drop_occupied_outside_band(*copy->tree, cfg_.occupancy_min_z, cfg_.occupancy_max_z);
+    raw = make_raw_map(*copy->tree, copy->last_scan_utime, options);
+  }
   encoded_.clear();
   if (raw.message) {
     encoded_.resize(static_cast<size_t>(raw.message->getEncodedSize()));

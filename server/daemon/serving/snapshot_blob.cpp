@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "core/clock.h"
+#include "core/file_checks/octree_binary.h"
 #include "octomap_rt/map_chunk_t.hpp"
 #include "protocol/map_protocol.h"
 #include "protocol/zstd_codec.h"
@@ -25,29 +26,24 @@ std::string serialize(const octomap::OcTree& tree, int8_t format) {
     return std::move(out).str();
   }
   if (format != Chunk::FORMAT_OCTOMAP_BINARY) throw std::invalid_argument("unknown snapshot format");
-  // OcTree::writeBinary (what OctoMap's .bt files are) first turns the tree to maximum
-  // likelihood and prunes it: do that on a copy, the served copy stays as it is.
-  octomap::OcTree ml(tree);
-  ml.writeBinary(out);
-  return std::move(out).str();
+  // What OcTree::writeBinary writes (max likelihood, pruned), the served copy left as it is.
+  return octomap_binary_bytes(tree);
 }
 
 }  // namespace
 
-SnapshotContents describe_snapshot(const octomap::OcTree& tree, const std::vector<AppliedEntry>& order) {
+SnapshotContents describe_snapshot(const octomap::OcTree& tree,
+                                   const std::map<std::string, MapState::NewestScan>& newest_scan, size_t scans,
+                                   int64_t map_utime) {
   SnapshotContents c;
-  c.scans = order.size();
-  std::map<std::string, std::pair<size_t, int64_t>> last;  // robot id -> (index of its newest scan, seq)
-  for (size_t i = 0; i < order.size(); ++i) {
-    last[order[i].robot_id] = {i, order[i].seq};
-    c.map_utime = std::max(c.map_utime, order[i].utime);
-  }
-  std::vector<std::pair<size_t, std::pair<std::string, int64_t>>> recent;
-  for (const auto& [id, at] : last) recent.push_back({at.first, {id, at.second}});
-  std::sort(recent.begin(), recent.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  c.scans = scans;
+  c.map_utime = map_utime;
+  std::vector<const MapState::NewestScan*> recent;
+  for (const auto& [id, newest] : newest_scan) recent.push_back(&newest);
+  std::sort(recent.begin(), recent.end(), [](const auto* a, const auto* b) { return a->scans > b->scans; });
   if (recent.size() > SnapshotContents::kMaxListedProducers) recent.resize(SnapshotContents::kMaxListedProducers);
-  for (auto& r : recent) c.producer_last_seq.push_back(std::move(r.second));
-  c.producers_total = static_cast<int64_t>(last.size());
+  for (const auto* r : recent) c.producer_last_seq.push_back({r->robot_id, r->seq});
+  c.producers_total = static_cast<int64_t>(newest_scan.size());
   if (tree.size() > 0) {
     tree.getMetricMin(c.bbox_min[0], c.bbox_min[1], c.bbox_min[2]);
     tree.getMetricMax(c.bbox_max[0], c.bbox_max[1], c.bbox_max[2]);

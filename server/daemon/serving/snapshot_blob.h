@@ -5,18 +5,20 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <octomap/OcTree.h>
 
-#include "daemon/map/applied_order.h"
+#include "daemon/map/map_state.h"
 
 namespace ort::daemon {
 
 struct SnapshotContents {
   uint64_t snapshot_id = 0;  // map state id of the copy
+  uint64_t epoch = 0;        // its epoch
   size_t scans = 0;
   int64_t map_utime = 0;
   double bbox_min[3] = {0, 0, 0}, bbox_max[3] = {0, 0, 0};
@@ -42,8 +44,11 @@ struct SnapshotBlob {
   }
 };
 
-// What a copy at `scans` applied scans contains: bbox and each producer's newest seq.
-SnapshotContents describe_snapshot(const octomap::OcTree& tree, const std::vector<AppliedEntry>& order);
+// What a copy contains: bbox, scans, newest scan time and the newest seq of the producers
+// with the most recent scans (MapState::newest_scan at the copy).
+SnapshotContents describe_snapshot(const octomap::OcTree& tree,
+                                   const std::map<std::string, MapState::NewestScan>& newest_scan, size_t scans,
+                                   int64_t map_utime);
 
 // Serializes `tree` (FORMAT_OCTOMAP_FULL: AbstractOcTree::write; FORMAT_OCTOMAP_BINARY:
 // OcTree::writeBinary as OctoMap's own .bt, i.e. of a max-likelihood pruned copy) and

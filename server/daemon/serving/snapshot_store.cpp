@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "daemon/map/map_replica.h"
 #include "daemon/serving/map_snapshot.h"
 
 namespace ort::daemon {
@@ -38,10 +39,12 @@ std::shared_ptr<const SnapshotBlob> SnapshotStore::find(uint64_t id, int8_t form
 }
 
 void SnapshotStore::take(MapState& map) {
-  MapCopy copy = copy_map(map);
+  // From the read replica when there is one: the octree stage does not wait for the copy.
+  MapCopy copy = copy_map(readable_map(map));
   Entry e;
-  e.contents = describe_snapshot(*copy.tree, map.order.entries(copy.scans));
+  e.contents = describe_snapshot(*copy.tree, copy.newest_scan, copy.scans, copy.last_scan_utime);
   e.contents.snapshot_id = copy.version;
+  e.contents.epoch = copy.epoch;
   e.contents.copy_lock_ms = copy.lock_ms;
   e.tree = std::move(copy.tree);
   if (!kept_.empty()) kept_.back().tree.reset();

@@ -121,6 +121,8 @@ octomap_rt::server_status_t make_status(const StatusInputs& in) {
   s.shoot_ms_p99 = static_cast<float>(m.shoot_p99);
   s.octree_ms_p50 = static_cast<float>(m.octree_p50);
   s.octree_ms_p99 = static_cast<float>(m.octree_p99);
+  s.octree_lock_wait_ms_p99 = static_cast<float>(m.lock_wait.p99);
+  s.octree_lock_wait_ms_max = static_cast<float>(m.lock_wait_max);
   s.end_to_end_ms_p50 = static_cast<float>(m.e2e_p50);
   s.end_to_end_ms_p99 = static_cast<float>(m.e2e_p99);
   s.stage1_busy_s = m.overlap.busy_s[0];
@@ -142,6 +144,7 @@ octomap_rt::server_status_t make_status(const StatusInputs& in) {
   s.last_save_utime = in.last_save_utime;
   s.latest_snapshot_id = in.latest_snapshot_id;
   s.map_version = in.map_version;
+  s.map_epoch = in.map_epoch;
   s.requests_served = in.requests_served;
   s.requests_rejected = in.requests_rejected;
   s.snapshots_taken = in.snapshots_taken;

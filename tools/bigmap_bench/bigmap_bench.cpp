@@ -1,0 +1,272 @@
+// octomap-rt-bigmap-bench: whole-map readers against a big map (issue 23), in one process
+// over memq:// (the server's own work only: no network).
+//
+//   octomap-rt-bigmap-bench grow --preset campus -r 0.1 --target-nodes 5000000 --map big.ot
+//   octomap-rt-bigmap-bench run --map big.ot -r 0.1 --readers on --duration 60
+//
+// `grow` feeds the preset's scans one at a time until the map has --target-nodes nodes and
+// saves it. `run` starts a fresh server on a copy of that map and streams the preset's scans
+// from --producers robots at --rate each for --duration seconds, with the readers on (a fresh
+// snapshot pulled every --snapshot-period, autosave every --save-interval, the viewer
+// publisher at --octomap-raw-rate, --query-rate point queries a second) or off, then prints
+// the octree stage's lock waits (the stall readers caused), scans' end-to-end p50/p99,
+// queries' p50/p99, snapshot fetch times and the process's memory. docs/BENCHMARKS.md.
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+
+#include "bigmap_readers.h"
+#include "daemon/mapping_server.h"
+#include "engine/engine_flags.h"
+#include "scene/scan_set.h"
+#include "scene/scene_presets.h"
+
+namespace {
+
+using namespace ort;
+using Clock = std::chrono::steady_clock;
+
+octomap_rt::scan_t to_message(const PosedScan& scan, const std::string& robot, int64_t seq) {
+  octomap_rt::scan_t m;
+  m.utime = seq + 1;
+  m.seq = seq;
+  for (int i = 0; i < 3; ++i) m.sensor_position[i] = scan.pose.trans()(i);
+  m.sensor_orientation[0] = scan.pose.rot().u();
+  m.sensor_orientation[1] = scan.pose.rot().x();
+  m.sensor_orientation[2] = scan.pose.rot().y();
+  m.sensor_orientation[3] = scan.pose.rot().z();
+  m.max_range = -1;
+  m.points_frame = octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME;
+  for (const auto& p : scan.points)
+    for (int a = 0; a < 3; ++a) m.xyz.push_back(p(a));
+  m.num_xyz = static_cast<int32_t>(m.xyz.size());
+  m.robot_id = robot;
+  m.map_frame = "map";
+  return m;
+}
+
+int64_t finished(daemon::MappingServer& s) {
+  int64_t done = 0;
+  for (const auto& p : s.producer_stats()) done += p.applied + p.rejected + p.dropped;
+  return done;
+}
+
+double rss_mib(const char* key) {
+  FILE* f = std::fopen("/proc/self/status", "r");
+  if (!f) return -1;
+  char line[256];
+  double kib = -1;
+  while (std::fgets(line, sizeof line, f))
+    if (std::strncmp(line, key, std::strlen(key)) == 0) kib = std::atof(line + std::strlen(key));
+  std::fclose(f);
+  return kib / 1024.0;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())))];
+}
+
+struct Args {
+  std::string preset = "campus", map;
+  double scan_scale = 1.0, point_scale = 0.25, stream_point_scale = 0.05;
+  int64_t target_nodes = 5'000'000;
+  int producers = 3;
+  double rate = 1.0, duration = 60;
+  std::string readers = "on", replica = "on";
+  double snapshot_period = 1, save_interval = 10, raw_rate = 1, query_rate = 100;
+  cli::EngineFlags engine;
+};
+
+daemon::ServerConfig server_config(const Args& a) {
+  daemon::ServerConfig cfg;
+  cfg.engine = cli::to_engine_options(a.engine);
+  cfg.queue_budget_bytes = 1ull << 30;
+  cfg.warm_up_points = 0;
+  cfg.chunk_interval_ms = 0.2;
+  cfg.latency_bound_s = 60;
+  cfg.read_replica = a.replica == "on";
+  return cfg;
+}
+
+int grow(const Args& a) {
+  PresetOptions po;
+  po.scan_scale = a.scan_scale;
+  po.point_scale = a.point_scale;
+  const ScanSet set = make_preset(a.preset, po);
+  daemon::ServerConfig cfg = server_config(a);
+  cfg.map_path = a.map;
+  cfg.save_interval_s = 0;
+  std::filesystem::remove(a.map);
+  lcm::LCM lc("memq://");
+  std::ostringstream log;
+  daemon::MappingServer server(cfg, lc, log);
+  server.start();
+  const auto t0 = Clock::now();
+  int64_t seq = 0, nodes = 0;
+  while (nodes < a.target_nodes && seq < 100'000) {
+    const auto m = to_message(set.scans[static_cast<size_t>(seq) % set.scans.size()], "grow", seq);
+    lc.publish("OCTOMAP_RT_SCAN_GROW", &m);
+    ++seq;
+    while (finished(server) < seq) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    nodes = server.status().num_nodes;
+    std::printf("grow: scan %lld, %lld nodes, %.0f s\n", (long long)seq, (long long)nodes,
+                std::chrono::duration<double>(Clock::now() - t0).count());
+    std::fflush(stdout);
+    if (static_cast<size_t>(seq) == set.scans.size() && nodes < a.target_nodes)
+      std::printf("grow: every scan applied once; going round again (more scans: --scan-scale)\n");
+  }
+  server.stop();
+  std::printf("grow: saved %s: %lld nodes after %lld scans (%s)\n", a.map.c_str(), (long long)nodes, (long long)seq,
+              set.name.c_str());
+  return nodes >= a.target_nodes ? 0 : 1;
+}
+
+int run(const Args& a) {
+  const bool readers = a.readers == "on";
+  PresetOptions po;
+  po.scan_scale = a.scan_scale;
+  po.point_scale = a.stream_point_scale;
+  const ScanSet set = make_preset(a.preset, po);
+  const std::string dir = std::filesystem::temp_directory_path() / ("bigmap-bench-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  daemon::ServerConfig cfg = server_config(a);
+  cfg.map_path = dir + "/map.ot";
+  std::filesystem::copy_file(a.map, cfg.map_path);
+  cfg.save_interval_s = readers ? a.save_interval : 0;
+  cfg.octomap_raw.rate_hz = readers ? a.raw_rate : 0;
+  const double rss_before = rss_mib("VmRSS:");
+  lcm::LCM lc("memq://");
+  std::ostringstream log;
+  const auto load0 = Clock::now();
+  daemon::MappingServer server(cfg, lc, log);
+  const double load_s = std::chrono::duration<double>(Clock::now() - load0).count();
+  const auto loaded = server.status();
+  const double rss_loaded = rss_mib("VmRSS:");
+  // Queries go where the map is: its bounding box.
+  double lo[3], hi[3];
+  server.with_map([&](const octomap::OcTree& t) {
+    t.getMetricMin(lo[0], lo[1], lo[2]);
+    t.getMetricMax(hi[0], hi[1], hi[2]);
+    return 0;
+  });
+  bench::BenchReaders r(server, lc, readers ? a.snapshot_period : 0, readers ? a.query_rate : 0, lo, hi);
+  server.start();
+  r.start();
+  std::vector<octomap_rt::scan_t> msgs;
+  for (size_t k = 0; k < set.scans.size(); ++k) msgs.push_back(to_message(set.scans[k], "p", 0));
+  std::vector<std::thread> producers;
+  std::atomic<int64_t> published{0};
+  const auto t0 = Clock::now();
+  for (int p = 0; p < a.producers; ++p)
+    producers.emplace_back([&, p] {
+      const std::string robot = "bench" + std::to_string(p);
+      const std::string channel = "OCTOMAP_RT_SCAN_BENCH" + std::to_string(p);
+      const auto period = std::chrono::duration<double>(1.0 / a.rate);
+      auto next = t0 + std::chrono::duration_cast<Clock::duration>(period * p / a.producers);
+      for (int64_t seq = 0; Clock::now() - t0 < std::chrono::duration<double>(a.duration); ++seq) {
+        std::this_thread::sleep_until(next);
+        octomap_rt::scan_t m = msgs[static_cast<size_t>(seq * a.producers + p) % msgs.size()];
+        m.robot_id = robot;
+        m.seq = seq;
+        m.utime = seq + 1;
+        lc.publish(channel, &m);
+        published++;
+        next += std::chrono::duration_cast<Clock::duration>(period);
+      }
+    });
+  for (auto& t : producers) t.join();
+  while (finished(server) < published && Clock::now() - t0 < std::chrono::duration<double>(a.duration + 300))
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  r.stop();
+  const auto st = server.status();
+  const double rss_end = rss_mib("VmRSS:"), hwm = rss_mib("VmHWM:");
+  const bench::ReaderStats rs = r.stats();
+  server.stop();
+  const auto replica = server.replica_stats();
+  std::filesystem::remove_all(dir);
+  std::printf(
+      "bigmap: readers %s (read replica %s), map %lld nodes (loaded in %.1f s), %lld scans applied of %lld in %.1f s (%d producers x "
+      "%.2f Hz, %s at point scale %g), backend %s\n",
+      readers ? "on" : "off", a.replica.c_str(), (long long)loaded.num_nodes, load_s, (long long)st.scans_applied,
+      (long long)published.load(), seconds, a.producers, a.rate, a.preset.c_str(), a.stream_point_scale,
+      st.backend.c_str());
+  std::printf("  octree stage: lock wait max %.1f ms, p99 %.2f ms; octree p50 %.1f ms p99 %.1f ms\n",
+              st.octree_lock_wait_ms_max, st.octree_lock_wait_ms_p99, st.octree_ms_p50, st.octree_ms_p99);
+  std::printf("  scans end to end: p50 %.1f ms, p99 %.1f ms\n", st.end_to_end_ms_p50, st.end_to_end_ms_p99);
+  std::printf("  queries: %lld sent, %zu answered, p50 %.2f ms, p99 %.2f ms, %lld unanswered\n",
+              (long long)rs.queries_sent, rs.query_ms.size(), percentile(rs.query_ms, 0.5),
+              percentile(rs.query_ms, 0.99), (long long)rs.queries_unanswered);
+  std::printf("  snapshots: %lld fetched (%lld timed out), mean %.2f s, max %.2f s, %.1f MB; saves %lld\n",
+              (long long)rs.snapshots, (long long)rs.snapshot_timeouts,
+              rs.snapshots ? rs.snapshot_s_sum / double(rs.snapshots) : 0.0, rs.snapshot_s_max,
+              double(rs.snapshot_bytes) / 1e6, (long long)st.map_saves);
+  if (replica)
+    std::printf(
+        "  read replica: %.1f s of updates on its thread, at most %.1f MB pending, stage 2 waited %.1f ms for "
+        "room\n",
+        replica->apply_ms_total / 1e3, double(replica->max_pending_bytes_seen) / 1e6, replica->writer_waited_ms);
+  std::printf("  memory: RSS %.0f MiB before the map, %.0f MiB loaded, %.0f MiB at the end, peak %.0f MiB\n",
+              rss_before, rss_loaded, rss_end, hwm);
+  std::printf("csv,%s,%s,%lld,%lld,%.1f,%.3f,%.3f,%.2f,%.2f,%.2f,%.2f,%lld,%.2f,%.0f,%.0f\n", readers ? "on" : "off",
+              a.replica.c_str(), (long long)loaded.num_nodes, (long long)st.scans_applied, seconds,
+              st.octree_lock_wait_ms_max, st.octree_lock_wait_ms_p99, st.end_to_end_ms_p50, st.end_to_end_ms_p99,
+              percentile(rs.query_ms, 0.5), percentile(rs.query_ms, 0.99), (long long)rs.snapshots, rs.snapshot_s_max,
+              rss_loaded, hwm);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"octomap-rt-bigmap-bench: whole-map readers against a big map, in-process over memq://"};
+  app.require_subcommand(1);
+  Args a;
+  auto common = [&](CLI::App* c) {
+    c->add_option("--preset", a.preset, "scan preset (octomap-rt scenegen's)")->capture_default_str();
+    c->add_option("--scan-scale", a.scan_scale, "share of the preset's scans")->capture_default_str();
+    c->add_option("--map", a.map, "the big map (.ot): written by grow, read by run")->required();
+    cli::add_engine_flags(*c, a.engine, /*require_resolution=*/true);
+  };
+  CLI::App* g = app.add_subcommand("grow", "grow a map to --target-nodes and save it");
+  common(g);
+  g->add_option("--point-scale", a.point_scale, "share of each scan's points")->capture_default_str();
+  g->add_option("--target-nodes", a.target_nodes, "octree nodes to reach")->capture_default_str();
+  CLI::App* r = app.add_subcommand("run", "serve the map to streaming producers, readers on or off");
+  common(r);
+  r->add_option("--stream-point-scale", a.stream_point_scale, "share of each streamed scan's points")
+      ->capture_default_str();
+  r->add_option("--producers", a.producers, "streaming robots")->capture_default_str();
+  r->add_option("--rate", a.rate, "scans a second per robot")->capture_default_str();
+  r->add_option("--duration", a.duration, "seconds of streaming")->capture_default_str();
+  r->add_option("--readers", a.readers, "on: snapshots, autosave, viewer publisher, queries; off: none")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  r->add_option("--read-replica", a.replica, "on: readers read the server's read replica; off: the map of record")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  r->add_option("--snapshot-period", a.snapshot_period, "a fresh snapshot pulled this often [s]")
+      ->capture_default_str();
+  r->add_option("--save-interval", a.save_interval, "autosave period [s]")->capture_default_str();
+  r->add_option("--octomap-raw-rate", a.raw_rate, "viewer publisher rate [Hz]")->capture_default_str();
+  r->add_option("--query-rate", a.query_rate, "point queries a second")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  try {
+    return g->parsed() ? grow(a) : run(a);
+  } catch (const std::exception& e) {
+    std::cerr << "octomap-rt-bigmap-bench: error: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,142 @@
+#include "bigmap_readers.h"
+
+#include <algorithm>
+#include <random>
+
+#include "octomap_rt/map_chunk_t.hpp"
+#include "octomap_rt/map_request_t.hpp"
+#include "octomap_rt/occupancy_query_t.hpp"
+#include "octomap_rt/occupancy_reply_t.hpp"
+#include "protocol/channels.h"
+
+namespace ort::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr const char* kMapReply = "BENCH_MAP_REPLY";
+constexpr const char* kQueryReply = "BENCH_QUERY_REPLY";
+
+double seconds_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+}  // namespace
+
+BenchReaders::BenchReaders(daemon::MappingServer& server, lcm::LCM& lc, double snapshot_period_s, double query_rate_hz,
+                           const double box_min[3], const double box_max[3])
+    : server_(server), lc_(lc), snapshot_period_s_(snapshot_period_s), query_rate_hz_(query_rate_hz) {
+  std::copy(box_min, box_min + 3, box_min_);
+  std::copy(box_max, box_max + 3, box_max_);
+  server_.lcm_loop().subscribe(kMapReply, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
+    octomap_rt::map_chunk_t c;
+    if (c.decode(rb.data, 0, static_cast<int>(rb.data_size)) < 0) return;
+    std::lock_guard lock(mutex_);
+    if (c.request_id != chunk_request_) return;
+    chunks_expected_ = c.num_chunks;
+    chunks_got_++;
+    stats_.snapshot_bytes += c.data_size;
+  });
+  server_.lcm_loop().subscribe(kQueryReply, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
+    octomap_rt::occupancy_reply_t r;
+    if (r.decode(rb.data, 0, static_cast<int>(rb.data_size)) < 0) return;
+    const auto now = Clock::now();
+    std::lock_guard lock(mutex_);
+    auto it =
+        std::find_if(in_flight_.begin(), in_flight_.end(), [&](const auto& q) { return q.first == r.request_id; });
+    if (it == in_flight_.end()) return;
+    if (r.status == octomap_rt::occupancy_reply_t::REPLY_OK)
+      stats_.query_ms.push_back(1e3 * seconds_between(it->second, now));
+    in_flight_.erase(it);
+  });
+}
+
+BenchReaders::~BenchReaders() { stop(); }
+
+void BenchReaders::start() {
+  if (snapshot_period_s_ > 0) snapshots_ = std::thread([this] { pull_snapshots(); });
+  if (query_rate_hz_ > 0) queries_ = std::thread([this] { send_queries(); });
+}
+
+void BenchReaders::stop() {
+  stop_ = true;
+  if (snapshots_.joinable()) snapshots_.join();
+  if (queries_.joinable()) queries_.join();
+}
+
+ReaderStats BenchReaders::stats() {
+  std::lock_guard lock(mutex_);
+  ReaderStats s = stats_;
+  s.queries_unanswered = static_cast<int64_t>(in_flight_.size());
+  return s;
+}
+
+// One fresh snapshot at a time; the next is asked for a period after the last was asked for
+// (or at once, when fetching took longer).
+void BenchReaders::pull_snapshots() {
+  int64_t id = 0;
+  while (!stop_) {
+    const auto t0 = Clock::now();
+    octomap_rt::map_request_t r{};
+    r.request_id = ++id;
+    r.snapshot_id = -1;
+    r.format = octomap_rt::map_chunk_t::FORMAT_OCTOMAP_FULL;
+    r.client_id = "bench";
+    r.reply_channel = kMapReply;
+    {
+      std::lock_guard lock(mutex_);
+      chunk_request_ = id;
+      chunks_expected_ = -1;
+      chunks_got_ = 0;
+    }
+    lc_.publish(ort::protocol::kMapRequestChannel, &r);
+    bool done = false;
+    while (!stop_ && !done && seconds_between(t0, Clock::now()) < 120) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      std::lock_guard lock(mutex_);
+      done = chunks_expected_ > 0 && chunks_got_ >= chunks_expected_;
+    }
+    const double s = seconds_between(t0, Clock::now());
+    {
+      std::lock_guard lock(mutex_);
+      if (done) {
+        stats_.snapshots++;
+        stats_.snapshot_s_sum += s;
+        stats_.snapshot_s_max = std::max(stats_.snapshot_s_max, s);
+      } else if (!stop_) {
+        stats_.snapshot_timeouts++;
+      }
+    }
+    while (!stop_ && seconds_between(t0, Clock::now()) < snapshot_period_s_)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+}
+
+// Point queries of 64 random points in the map's box, at the rate (no waiting for scans).
+void BenchReaders::send_queries() {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  const auto period = std::chrono::duration<double>(1.0 / query_rate_hz_);
+  auto next = Clock::now();
+  int64_t id = 0;
+  while (!stop_) {
+    octomap_rt::occupancy_query_t q{};
+    q.request_id = ++id;
+    q.wait_seq = -1;
+    q.client_id = "bench-queries";
+    q.reply_channel = kQueryReply;
+    for (int i = 0; i < 64; ++i)
+      for (int k = 0; k < 3; ++k)
+        q.xyz.push_back(static_cast<float>(box_min_[k] + u(rng) * (box_max_[k] - box_min_[k])));
+    q.num_xyz = static_cast<int32_t>(q.xyz.size());
+    {
+      std::lock_guard lock(mutex_);
+      in_flight_.emplace_back(id, Clock::now());
+      stats_.queries_sent++;
+    }
+    lc_.publish(ort::protocol::kQueryChannel, &q);
+    next += std::chrono::duration_cast<Clock::duration>(period);
+    std::this_thread::sleep_until(next);
+  }
+}
+
+}  // namespace ort::bench
