@@ -52,11 +52,10 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
   if (cfg_.resolution_from_file) take_resolution_from_file();
   load_or_create_map();
   open_memory_bound();
-  // The upkeep's slices are not replayable steps yet, and the read replica would hold the
-  // whole map past a memory bound: with decay, clearing or --max-map-memory, readers read the
-  // map of record (as with --no-read-replica).
-  if (cfg_.read_replica && (cfg_.upkeep.decay_on() || cfg_.upkeep.clearing_on() || cfg_.max_map_memory > 0))
-    log_.info("decay, clearing or a memory bound on: whole-map readers copy the map under its lock (no read replica)");
+  // The read replica would hold the whole map a memory bound keeps out of memory: with
+  // --max-map-memory, readers read the map of record (as with --no-read-replica).
+  if (cfg_.read_replica && cfg_.max_map_memory > 0)
+    log_.info("a memory bound on: whole-map readers copy the map under its lock (no read replica)");
   else if (cfg_.read_replica) {
     OctreeUpdateOptions o = cfg_.engine.octree;
     // A quarter of the cores: it runs beside the octree stage, which keeps the rest.

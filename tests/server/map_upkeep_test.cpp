@@ -48,7 +48,11 @@ TEST(MapUpkeep, DecayStepsBetweenScansGiveTheRulesMap) {
     server.upkeep()->decay_steps(k % 2 ? 2 : 1);
     decay_tree(*reference, region_grid(10), k % 2 ? two : one);
     server.with_map([&](const octomap::OcTree& t) { EXPECT_EQ(compare_structure(*reference, t), "") << "scan " << k; });
+    // The read replica replays the slices: what snapshots and saves read is the same map.
+    server.with_readable_map(
+        [&](const octomap::OcTree& t) { EXPECT_EQ(compare_structure(*reference, t), "") << "replica, scan " << k; });
   }
+  ASSERT_TRUE(server.replica_stats().has_value()) << "the server runs with its read replica while decay is on";
   const auto st = server.upkeep()->stats();
   EXPECT_EQ(st.decay_steps, 6u);
   EXPECT_EQ(st.decay_sweeps, 4u);
@@ -84,6 +88,8 @@ TEST(MapUpkeep, ClearingKeepsWhatIsNearTheRobotsSeenLately) {
   clear_beyond(*reference, region_grid(10), last_origin, 2.5);
   EXPECT_LT(reference->size(), before);
   server.with_map([&](const octomap::OcTree& t) { EXPECT_EQ(compare_structure(*reference, t), ""); });
+  server.with_readable_map(
+      [&](const octomap::OcTree& t) { EXPECT_EQ(compare_structure(*reference, t), "") << "replica"; });
   EXPECT_GT(server.upkeep()->stats().nodes_deleted_by_clearing, 0u);
   server.stop();
 }
@@ -109,6 +115,7 @@ TEST(MapUpkeep, UnseenMapDecaysToNothingOnTheDaemonsClock) {
   }
   EXPECT_EQ(nodes, 0u);
   server.with_map([](const octomap::OcTree& t) { EXPECT_EQ(t.getRoot(), nullptr); });
+  server.with_readable_map([](const octomap::OcTree& t) { EXPECT_EQ(t.size(), 0u); });
   const auto st = server.upkeep()->stats();
   EXPECT_GT(st.decay_steps, 20u);
   EXPECT_GT(st.nodes_deleted_by_decay, 0u);

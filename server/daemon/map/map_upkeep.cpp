@@ -9,6 +9,7 @@
 
 #include "daemon/map/map_identity.h"
 #include "daemon/map/map_residency.h"
+#include "daemon/map/sweep_slices.h"
 #include "octree/decay.h"
 #include "octree/distance_clearing.h"
 
@@ -62,36 +63,46 @@ UpkeepStats MapUpkeep::stats() const {
   return stats_;
 }
 
-void MapUpkeep::count_slice_change() { count_map_change(map_); }
+void MapUpkeep::apply_slice(const MapStep& slice) { apply_map_step(map_, slice); }
 
 template <class Sweep>
-void MapUpkeep::run_sweep(Sweep& sweep, uint64_t& deleted_counter) {
+void MapUpkeep::run_sweep(std::function<std::unique_ptr<Sweep>(const octomap::OcTree&)> make,
+                          uint64_t& deleted_counter) {
+  // With a memory bound, spilled regions come back as the map of record's sweep reaches them
+  // and the bound holds after every slice (daemon/map/map_residency.h).
+  const octomap::OcTree* record = map_.tree.get();
+  auto make_here = [residency = map_.residency, record, make = std::move(make)](const octomap::OcTree& t) {
+    std::unique_ptr<Sweep> s = make(t);
+    if (residency && &t == record) s->regions().set_spill(residency->sweep_hooks());
+    return s;
+  };
+  const auto [slices, slice] = SweepSlices<Sweep>::steps(std::move(make_here), cfg_.slice_nodes);
   bool done = false;
-  uint64_t deleted_before = 0;
-  // With a memory bound, spilled regions come back as the sweep reaches them and the bound
-  // holds after every slice (daemon/map/map_residency.h).
-  if (map_.residency) sweep.regions().set_spill(map_.residency->sweep_hooks());
+  uint64_t deleted_before = 0, deleted = 0;
   while (!done) {
     const auto t0 = SteadyClock::now();
     {
       std::unique_lock lock(map_.mutex);
       try {
-        done = sweep.run_slice(*map_.tree, cfg_.slice_nodes);
+        apply_slice(slice);
+        done = slices->on(*map_.tree)->done();
       } catch (const std::exception& e) {  // the region store could not give a region back
         log_.error(
             text("a sweep stopped before its end (the regions it reached are swept, the rest wait for "
                  "the next): ",
                  e.what()));
+        // Only with a memory bound, where the server runs without a replica: what the slice
+        // did is counted as a change, and the sweep ends.
+        count_map_change(map_);
         done = true;
       }
       if (map_.residency) map_.residency->enforce(*map_.tree);
-      count_slice_change();
+      if (const Sweep* sweep = slices->on(*map_.tree)) deleted = sweep->nodes_deleted();
       // Deltas cannot carry the sweep: mirrors resync once it is whole.
       if (done && map_.observer) map_.observer->replaced(*map_.tree, map_.version, map_.epoch);
     }
     map_.changed.notify_all();
     const double ms = ms_since(t0);
-    const uint64_t deleted = sweep.nodes_deleted();
     {
       std::lock_guard lock(stats_mutex_);
       stats_.slices++;
@@ -108,31 +119,31 @@ void MapUpkeep::run_sweep(Sweep& sweep, uint64_t& deleted_counter) {
 }
 
 void MapUpkeep::run_decay_sweep(uint64_t steps) {
-  DecayRule rule{decay_factor(double(steps) * cfg_.decay_step_s, cfg_.decay_half_life_s), cfg_.decay_delete_below};
-  std::unique_ptr<DecaySweep> sweep;
-  {
-    std::shared_lock lock(map_.mutex);
-    sweep = std::make_unique<DecaySweep>(*map_.tree, grid_, rule);
-  }
-  run_sweep(*sweep, stats_.nodes_deleted_by_decay);
+  const DecayRule rule{decay_factor(double(steps) * cfg_.decay_step_s, cfg_.decay_half_life_s),
+                       cfg_.decay_delete_below};
+  std::function<std::unique_ptr<DecaySweep>(const octomap::OcTree&)> make =
+      [grid = grid_, rule](const octomap::OcTree& t) { return std::make_unique<DecaySweep>(t, grid, rule); };
+  run_sweep(std::move(make), stats_.nodes_deleted_by_decay);
   std::lock_guard lock(stats_mutex_);
   stats_.decay_steps += steps;
   stats_.decay_sweeps++;
 }
 
 void MapUpkeep::run_clear_sweep() {
-  std::unique_ptr<DistanceClearingSweep> sweep;
+  std::vector<octomap::point3d> centres;
   {
     std::shared_lock lock(map_.mutex);
-    std::vector<octomap::point3d> centres;
     const auto now = SteadyClock::now();
     for (const auto& [robot, seen] : map_.robots_seen)
       if (std::chrono::duration<double>(now - seen.applied).count() <= cfg_.clear_recent_s)
         centres.push_back(seen.origin);
-    if (centres.empty()) return;  // no robot seen lately: nothing is cleared
-    sweep = std::make_unique<DistanceClearingSweep>(*map_.tree, grid_, std::move(centres), cfg_.clear_radius_m);
   }
-  run_sweep(*sweep, stats_.nodes_deleted_by_clearing);
+  if (centres.empty()) return;  // no robot seen lately: nothing is cleared
+  std::function<std::unique_ptr<DistanceClearingSweep>(const octomap::OcTree&)> make =
+      [grid = grid_, centres = std::move(centres), radius = cfg_.clear_radius_m](const octomap::OcTree& t) {
+        return std::make_unique<DistanceClearingSweep>(t, grid, centres, radius);
+      };
+  run_sweep(std::move(make), stats_.nodes_deleted_by_clearing);
   std::lock_guard lock(stats_mutex_);
   stats_.clear_sweeps++;
 }

@@ -1,7 +1,8 @@
 // The long-lived map's upkeep (issue 25): decay and clearing by distance, applied on the
 // daemon's own steady clock (never the scans' utimes, which a peer controls), region by
-// region in slices of bounded work, each slice under the map lock and counted as a map
-// change; scans and queries run between slices.
+// region in slices of bounded work, each slice under the map lock and applied as a map step
+// (counted, and replayed on the read replica: daemon/map/sweep_slices.h); scans and queries
+// run between slices.
 //
 // Decay: a step every `decay_step_s`; a sweep applies the steps due when it starts at once
 // (factor 2^(-n * step / half-life) for n steps: octree/decay.h gives the exact rule).
@@ -16,11 +17,14 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <mutex>
 #include <thread>
 
 #include "core/clock.h"
 #include "core/log.h"
+#include "daemon/map/map_identity.h"
 #include "daemon/map/map_state.h"
 #include "octree/region.h"
 
@@ -67,11 +71,12 @@ class MapUpkeep {
   void run();
   void run_decay_sweep(uint64_t steps);
   void run_clear_sweep();
+  // Runs the sweep `make` makes (on each tree at its first slice), slice by slice.
   template <class Sweep>
-  void run_sweep(Sweep& sweep, uint64_t& deleted_counter);
-  // The one place a slice's change of the map is counted (map_identity.h). Its change is not
-  // replayed on a read replica: the server runs without one while upkeep is on.
-  void count_slice_change();
+  void run_sweep(std::function<std::unique_ptr<Sweep>(const octomap::OcTree&)> make, uint64_t& deleted_counter);
+  // The one place a slice changes the map: a map step (map_identity.h), counted and replayed
+  // on the read replica. Caller holds the map lock exclusively.
+  void apply_slice(const MapStep& slice);
 
   MapState& map_;
   UpkeepConfig cfg_;
