@@ -11,7 +11,9 @@ void MappingServer::open_memory_bound() {
   if (const std::string bad = memory_bound_problem(cfg_); !bad.empty())
     throw std::invalid_argument("--max-map-memory " + bad);
   const std::string dir = region_store_dir(cfg_.map_path);
-  region_store_ = std::make_unique<RegionStore>(dir, cfg_.region_store_max_bytes);
+  // Not durable: the store is emptied at every start (below), so its files need not survive a
+  // power cut, and an fsync per evicted region would cost every eviction a disk round trip.
+  region_store_ = std::make_unique<RegionStore>(dir, cfg_.region_store_max_bytes, /*durable=*/false);
   // Every save is the whole map (its copy gets the evicted regions back), so what a previous
   // run left here is in the map file as of its last save, or newer than it (evicted after
   // it, lost with that run's unsaved scans): the map file is the map of record.

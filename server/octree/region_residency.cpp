@@ -55,6 +55,10 @@ void RegionResidency::touch_voxels(octomap::OcTree& tree, std::span<const VoxelU
 
 namespace {
 
+// The id shared by the eight children of one node above the region depth: the region
+// coordinates with their lowest bit cleared (ids pack 16 bits an axis: octree/region.h).
+RegionId sibling_group(RegionId id) { return id & ~RegionId(0x0000'0001'0001'0001ull); }
+
 // Inner nodes of an encoded region (octree/region_codec.h: 5 bytes a node, the last its
 // child bits): each had a child array, freed with the nodes below the stand-in.
 uint64_t inner_nodes(const std::vector<uint8_t>& encoded) {
@@ -71,18 +75,28 @@ size_t RegionResidency::enforce(octomap::OcTree& tree) { return enforce(tree, tr
 EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, uint64_t target) {
   EnforceResult result;
   if (bytes <= target) return result;
+  // Siblings go together, as the group's most recent touch: a touch brings a region's seven
+  // siblings back with it (region_residency.h), so a sibling spilled alone would come back at
+  // the next touch of its neighbour and go again at the next enforce.
   struct Candidate {
     uint64_t touched;
-    RegionId id;
+    RegionId group, id;
   };
   std::vector<Candidate> candidates;
+  std::unordered_map<RegionId, uint64_t> group_touched;
   for_each_region(tree, grid_, [&](RegionId id, const RegionNode& r) {
     if (r.depth != grid_.depth || !tree.nodeHasChildren(r.node)) return;  // coarse leaves, stand-ins
     auto it = last_touch_.find(id);
-    candidates.push_back({it == last_touch_.end() ? 0 : it->second, id});
+    const uint64_t touched = it == last_touch_.end() ? 0 : it->second;
+    const RegionId group = sibling_group(id);
+    uint64_t& g = group_touched[group];
+    g = std::max(g, touched);
+    candidates.push_back({touched, group, id});
   });
+  for (Candidate& c : candidates) c.touched = group_touched[c.group];
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
-    return a.touched != b.touched ? a.touched < b.touched : a.id < b.id;
+    if (a.touched != b.touched) return a.touched < b.touched;
+    return a.group != b.group ? a.group < b.group : a.id < b.id;
   });
   result.listed = candidates.size();
   for (const Candidate& c : candidates) {

@@ -25,7 +25,8 @@ bool full_disk(int e) { return e == ENOSPC || e == EDQUOT; }
 
 std::string region_store_dir(const std::string& map_path) { return map_path + ".regions"; }
 
-RegionStore::RegionStore(const std::string& dir, uint64_t max_bytes) : dir_(dir), max_bytes_(max_bytes) {
+RegionStore::RegionStore(const std::string& dir, uint64_t max_bytes, bool durable)
+    : dir_(dir), max_bytes_(max_bytes), durable_(durable) {
   std::error_code ec;
   std::filesystem::create_directories(dir_, ec);
   if (ec) throw RegionStoreError(RegionStoreError::Kind::kIo, "cannot make " + dir_ + ": " + ec.message());
@@ -98,7 +99,7 @@ void RegionStore::put(RegionId id, std::span<const uint8_t> bytes) {
     }
     done += size_t(n);
   }
-  if (::fsync(fd) != 0) {
+  if (durable_ && ::fsync(fd) != 0) {
     const int e = errno;
     ::close(fd);
     ::unlink(tmp.c_str());
@@ -112,7 +113,7 @@ void RegionStore::put(RegionId id, std::span<const uint8_t> bytes) {
     ::unlink(tmp.c_str());
     throw RegionStoreError(RegionStoreError::Kind::kIo, msg);
   }
-  sync_dir();
+  if (durable_) sync_dir();
   used_ = used_ - replaced + bytes.size();
   sizes_[id] = bytes.size();
 }

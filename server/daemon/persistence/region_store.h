@@ -40,8 +40,11 @@ std::string region_store_dir(const std::string& map_path);
 class RegionStore final : public RegionSpill {
  public:
   // Opens `dir` (made if missing), takes its lock, removes leftover .tmp files and counts the
-  // regions there. `max_bytes` bounds the regions' bytes on disk.
-  RegionStore(const std::string& dir, uint64_t max_bytes);
+  // regions there. `max_bytes` bounds the regions' bytes on disk. Not `durable`: no fsync (a
+  // put still goes through ID.tmp and a rename, and survives a kill -9 in the page cache, not
+  // a power cut), for a caller whose files need not outlive the machine's uptime (the
+  // daemon: its map file is the map of record, and it empties the store at start).
+  RegionStore(const std::string& dir, uint64_t max_bytes, bool durable = true);
   ~RegionStore() override;
   RegionStore(const RegionStore&) = delete;
   RegionStore& operator=(const RegionStore&) = delete;
@@ -60,6 +63,7 @@ class RegionStore final : public RegionSpill {
 
   std::string dir_;
   uint64_t max_bytes_;
+  bool durable_;
   int lock_fd_ = -1;
   uint64_t used_ = 0, leftovers_removed_ = 0;
   std::unordered_map<RegionId, uint64_t> sizes_;

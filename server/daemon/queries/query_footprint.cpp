@@ -82,6 +82,8 @@ std::vector<query::KeyBox> query_footprint(const octomap::OcTree& tree, const Re
       const double lo[3] = {g->use_window ? g->window_min[0] : -big, g->use_window ? g->window_min[1] : -big, g->z_min};
       const double hi[3] = {g->use_window ? g->window_max[0] : big, g->use_window ? g->window_max[1] : big, g->z_max};
       out.push_back(query::key_box(tree, lo, hi));
+    } else {  // a kind of query this file does not know yet: all of the map, to be safe
+      out.push_back(query::KeyBox{OcTreeKey(0, 0, 0), OcTreeKey(65535, 65535, 65535)});
     }
   } catch (const std::exception&) {  // query::QueryError: answered as a refusal, reading nothing
     out.clear();

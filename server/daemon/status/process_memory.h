@@ -1,6 +1,6 @@
 // The server's own resident set, for the status beside the map's counted memory: the two
-// differ because glibc's malloc keeps freed nodes for reuse instead of handing their pages
-// back (docs/ARCHITECTURE.md, "The memory bound").
+// differ by everything else the process holds, and by the pages of freed nodes, which the
+// daemon's jemalloc (server/allocator/) hands back only after its dirty-page decay delay.
 #pragma once
 
 #include <cstdint>
