@@ -73,11 +73,27 @@ GpuRaySpace::GpuRaySpace(std::shared_ptr<const vk::Context> ctx, const GpuRaySpa
   make_buffers();
   compact_.bind_buffers({grid_.handle(), touched_.handle(), counters_.handle(), voxels_.handle()});
   ensure_ray_capacity(kMinRayCapacity);
+  clear_grid();
+}
 
-  // The grid starts clear, once; from then on only compaction clears it.
+// A new grid starts clear, once; from then on only compaction clears it.
+void GpuRaySpace::clear_grid() {
   VkCommandBuffer cmd = runner_.begin();
   vkCmdFillBuffer(cmd, grid_.handle(), 0, VK_WHOLE_SIZE, 0);
   runner_.submit_and_wait();
+}
+
+// Between scans (every submission has been waited for), so no buffer replaced is in use.
+bool GpuRaySpace::fit(uint64_t voxels) {
+  const uint64_t have = opts_.sizing.grid_words;
+  if (!opts_.grow_to || have >= opts_.max_grid_words || voxels <= grid_voxels()) return false;
+  const uint64_t need = (voxels + kVoxelsPerWord - 1) / kVoxelsPerWord;
+  opts_.sizing = opts_.grow_to(std::min(opts_.max_grid_words, std::max(need, 2 * have)));
+  make_buffers();
+  compact_.bind_buffers({grid_.handle(), touched_.handle(), counters_.handle(), voxels_.handle()});
+  if (bind_shoot_buffers_) bind_shoot_buffers_(shoot_buffers());
+  clear_grid();
+  return true;
 }
 
 // Unified memory (lavapipe, integrated GPUs): everything host-visible, read and written in
@@ -170,7 +186,7 @@ void GpuRaySpace::shoot_resident(const RayBatch& header, uint32_t ray_count, std
 void GpuRaySpace::shoot_windows(const RayBatch& batch, uint32_t ray_count, std::span<const KeyBox> windows,
                                 const RecordShoot& record_shoot, VoxelList& out, ShootStats& stats) {
   stats.grid_words = opts_.sizing.grid_words;
-  stats.grid_allocations = grid_allocations_;  // the grid, touched list and output: once, at start-up
+  stats.grid_allocations = grid_allocations_;  // the grid, touched list and output: at start-up and as fit() grows them
   for (const KeyBox& w : windows) {
     if (w.voxel_count() > grid_voxels()) throw std::logic_error("GPU ray space: a window larger than the grid");
     shoot_window(batch, ray_count, w, record_shoot, out, stats);

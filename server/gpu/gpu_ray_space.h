@@ -45,6 +45,10 @@ struct GpuRaySpaceOptions {
   // memory, instead of device-local memory copied back in a submission of its own per
   // chunk. (The rt back end's choice; on unified memory everything is host-visible anyway.)
   bool voxels_in_host_memory = false;
+  // A grid sized from the scans: fit() grows it up to `max_grid_words` (0: never), each time
+  // to `grow_to(words)`'s sizing.
+  uint64_t max_grid_words = 0;
+  std::function<RaySpaceSizing(uint64_t words)> grow_to;
 };
 
 // The storage buffers of shaders/ray_space.glsl, bindings 0..3.
@@ -66,8 +70,14 @@ class GpuRaySpace {
   const RaySpaceSizing& sizing() const { return opts_.sizing; }
   uint64_t grid_voxels() const { return opts_.sizing.grid_words * kVoxelsPerWord; }
 
+  // A ray space of `voxels` (a scan's window before it is planned) fits in one window: grows
+  // the grid to it (at least doubling, at most max_grid_words) when it can. True when it grew.
+  bool fit(uint64_t voxels);
+  bool can_grow() const { return opts_.grow_to && opts_.max_grid_words > opts_.sizing.grid_words; }
+  uint64_t max_grid_words() const { return opts_.max_grid_words; }
+
   // `bind` gets the shooting pass's buffers now and again whenever one is re-created (the
-  // rays buffer grows), always between submissions.
+  // rays buffer or the grid grows), always between submissions.
   void on_shoot_buffers(std::function<void(const ShootBuffers&)> bind);
 
   // One scan through `windows` (disjoint key boxes of at most grid_voxels() voxels each, in
@@ -85,6 +95,7 @@ class GpuRaySpace {
 
  private:
   void make_buffers();
+  void clear_grid();
   void upload_rays(const RayBatch& batch, ShootStats& stats);
   void ensure_ray_capacity(uint64_t rays);
   void shoot_windows(const RayBatch& batch, uint32_t ray_count, std::span<const KeyBox> windows,

@@ -14,7 +14,6 @@ uint64_t auto_grid_budget(uint64_t max_storage_buffer_range, uint64_t device_loc
 
 RaySpaceSizing size_ray_space(double max_range, double resolution, uint64_t budget_bytes, uint64_t max_buffer_bytes,
                               uint32_t max_dispatch_groups, uint64_t output_voxels) {
-  RaySpaceSizing s;
   // Voxel indices inside a window are uint32 in the shaders: at most 2^28 words.
   uint64_t words = std::min({budget_bytes, max_buffer_bytes, uint64_t(1) << 30}) / 4;
   if (max_range >= 0.0) {
@@ -25,6 +24,12 @@ RaySpaceSizing size_ray_space(double max_range, double resolution, uint64_t budg
     const double voxels = side * side * side;
     if (voxels < double(words) * kVoxelsPerWord) words = (uint64_t(voxels) + kVoxelsPerWord - 1) / kVoxelsPerWord;
   }
+  return ray_space_of_words(words, max_buffer_bytes, max_dispatch_groups, output_voxels);
+}
+
+RaySpaceSizing ray_space_of_words(uint64_t words, uint64_t max_buffer_bytes, uint32_t max_dispatch_groups,
+                                  uint64_t output_voxels) {
+  RaySpaceSizing s;
   if (words == 0) throw std::invalid_argument("the ray-space grid budget holds no voxels");
   s.grid_words = words;
   const uint64_t output_cap = std::min<uint64_t>(max_buffer_bytes, uint64_t(512) << 20) / 8;

@@ -27,4 +27,13 @@ uint64_t auto_grid_budget(uint64_t max_storage_buffer_range, uint64_t device_loc
 RaySpaceSizing size_ray_space(double max_range, double resolution, uint64_t budget_bytes, uint64_t max_buffer_bytes,
                               uint32_t max_dispatch_groups, uint64_t output_voxels = 0);
 
+// A grid of `words` with the output and compaction chunks size_ray_space gives it.
+RaySpaceSizing ray_space_of_words(uint64_t words, uint64_t max_buffer_bytes, uint32_t max_dispatch_groups,
+                                  uint64_t output_voxels = 0);
+
+// Without a max range and without a grid budget given, the grid is sized from the scans: it
+// starts at this many words (4 MiB, 16M voxels) and grows (GpuRaySpace::fit) as a scan's ray
+// space needs, up to the automatic budget.
+inline constexpr uint64_t kStartGridWords = uint64_t(1) << 20;
+
 }  // namespace ort::gpu

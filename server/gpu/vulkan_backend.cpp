@@ -37,25 +37,47 @@ std::shared_ptr<vk::Context> make_context(const BackendOptions& opts) {
   return std::make_shared<vk::Context>(co);
 }
 
-gpu::RaySpaceSizing sizing_for(const vk::Context& ctx, const BackendOptions& opts, const VulkanTuning& tuning) {
+// The ray space: a max range sizes it (the cube any scan fits in), a budget given fixes it;
+// otherwise it is sized from the scans, starting small and growing up to the automatic budget.
+gpu::GpuRaySpaceOptions ray_space_for(const vk::Context& ctx, const BackendOptions& opts, const VulkanTuning& tuning) {
   const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
   const uint64_t budget = opts.grid_budget_bytes
                               ? opts.grid_budget_bytes
                               : gpu::auto_grid_budget(limits.maxStorageBufferRange, ctx.device_local_bytes());
-  return gpu::size_ray_space(opts.max_range, opts.resolution, budget, limits.maxStorageBufferRange,
-                             limits.maxComputeWorkGroupCount[0], tuning.output_voxels);
+  gpu::GpuRaySpaceOptions o;
+  o.voxels_in_host_memory = opts.compact_into_host_memory;
+  o.sizing = gpu::size_ray_space(opts.max_range, opts.resolution, budget, limits.maxStorageBufferRange,
+                                 limits.maxComputeWorkGroupCount[0], tuning.output_voxels);
+  const uint64_t start = tuning.start_grid_words ? tuning.start_grid_words : gpu::kStartGridWords;
+  if (opts.grid_budget_bytes == 0 && opts.max_range < 0 && o.sizing.grid_words > start) {
+    o.max_grid_words = o.sizing.grid_words;
+    o.grow_to = [max_buffer = uint64_t(limits.maxStorageBufferRange), groups = limits.maxComputeWorkGroupCount[0],
+                 output = tuning.output_voxels](uint64_t words) {
+      return gpu::ray_space_of_words(words, max_buffer, groups, output);
+    };
+    o.sizing = o.grow_to(start);
+  }
+  return o;
+}
+
+// A scan's ray space as its windows will be planned: the key box widened by the margin.
+uint64_t widened_voxels(const KeyBox& keys, int margin) {
+  if (keys.empty()) return 0;
+  uint64_t v = 1;
+  for (int i = 0; i < 3; ++i) v *= uint64_t(keys.hi[i] - keys.lo[i] + 1 + 2 * margin);
+  return v;
 }
 
 class VulkanBackend final : public RayBackend {
  public:
   VulkanBackend(const BackendOptions& opts, const VulkanTuning& tuning, const Log& log)
       : ctx_(make_context(opts)),
-        space_(ctx_,
-               {.sizing = sizing_for(*ctx_, opts, tuning), .voxels_in_host_memory = opts.compact_into_host_memory}),
+        space_(ctx_, ray_space_for(*ctx_, opts, tuning)),
         shoot_octomap_(*ctx_, shoot_octomap_spv, 4, sizeof(gpu::ShootPush)),
         shoot_exact_(*ctx_, shoot_exact_spv, 4, sizeof(gpu::ShootPush)),
         max_groups_(ctx_->properties().limits.maxComputeWorkGroupCount[0]),
-        resolution_(opts.resolution) {
+        resolution_(opts.resolution),
+        log_(log) {
     if (opts.gpu_prepare) prepare_ = std::make_unique<gpu::GpuPrepare>(ctx_);
     space_.on_shoot_buffers([this](const gpu::ShootBuffers& b) {
       for (vk::ComputePipeline* p : {&shoot_octomap_, &shoot_exact_}) {
@@ -65,8 +87,11 @@ class VulkanBackend final : public RayBackend {
     name_ = ctx_->device_name() + " (" + vk::device_type_name(ctx_->properties().deviceType) + ")";
     const uint64_t words = space_.sizing().grid_words;
     log.info("vulkan: " + name_ + ", grid " + std::to_string((words * 4 + 1023) >> 10) + " KiB (" +
-             std::to_string(space_.grid_voxels()) + " voxels), " +
-             (ctx_->unified_memory() ? "unified memory" : "device-local memory with staging"));
+             std::to_string(space_.grid_voxels()) + " voxels" +
+             (space_.can_grow()
+                  ? ", grows with the scans up to " + std::to_string(space_.max_grid_words() >> 18) + " MiB"
+                  : std::string()) +
+             "), " + (ctx_->unified_memory() ? "unified memory" : "device-local memory with staging"));
   }
 
   BackendKind kind() const override { return BackendKind::kVulkan; }
@@ -74,6 +99,7 @@ class VulkanBackend final : public RayBackend {
 
   void shoot(const RayBatch& batch, Traversal mode, VoxelList& out, ShootStats& stats) override {
     const vk::ComputePipeline& pass = mode == Traversal::kOctomap ? shoot_octomap_ : shoot_exact_;
+    fit_ray_space(batch.keys);
     const std::vector<KeyBox> windows = plan_windows(batch.keys, space_.grid_voxels(), kWindowMargin);
     space_.shoot(
         batch, windows, [&](VkCommandBuffer cmd, gpu::ShootPush push) { record_shoot(cmd, pass, push); }, out, stats);
@@ -111,6 +137,7 @@ class VulkanBackend final : public RayBackend {
       return;
     }
     const vk::ComputePipeline& pass = mode == Traversal::kOctomap ? shoot_octomap_ : shoot_exact_;
+    fit_ray_space(header.keys);
     const std::vector<KeyBox> windows = plan_windows(header.keys, space_.grid_voxels(), kWindowMargin);
     space_.shoot_resident(
         header, uint32_t(points), windows,
@@ -118,6 +145,13 @@ class VulkanBackend final : public RayBackend {
   }
 
  private:
+  void fit_ray_space(const KeyBox& keys) {
+    const uint64_t voxels = widened_voxels(keys, kWindowMargin);
+    if (space_.fit(voxels))
+      log_.info("vulkan: ray space grown to " + std::to_string((space_.sizing().grid_words * 4 + 1023) >> 10) +
+                " KiB for a scan of " + std::to_string(voxels) + " voxels");
+  }
+
   // PosedPoints' bounds: the key box widened by the window margin, and a walk bound (no ray
   // of the scan visits more keys than the box's extents summed, plus one).
   static bool over_device_bounds(const KeyBox& keys, uint64_t rays, const PosedPoints& scan) {
@@ -146,6 +180,7 @@ class VulkanBackend final : public RayBackend {
   vk::ComputePipeline shoot_octomap_, shoot_exact_;
   uint32_t max_groups_;
   double resolution_;
+  Log log_;
   std::unique_ptr<gpu::GpuPrepare> prepare_;  // null without BackendOptions::gpu_prepare
   std::string name_;
 };

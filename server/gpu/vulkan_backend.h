@@ -13,6 +13,9 @@ namespace ort {
 // Knobs below BackendOptions, for tests and measurements; zero means automatic.
 struct VulkanTuning {
   uint64_t output_voxels = 0;  // capacity of the voxel output (compaction chunks follow from it)
+  // The grid a ray space sized from the scans starts with (0: gpu::kStartGridWords); tests
+  // start small to see it grow.
+  uint64_t start_grid_words = 0;
 };
 
 // Throws Unsupported (core/errors.h, with the reason) when no usable Vulkan device exists;

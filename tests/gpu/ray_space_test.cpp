@@ -71,6 +71,37 @@ TEST(VulkanRaySpace, TinyGridSplitsScansIntoWindowsAndStillEqualsCpu) {
   }
 }
 
+TEST(VulkanRaySpace, AGridSizedFromTheScansGrowsToThemAndStillEqualsCpu) {
+  // No max range and no budget given: the grid starts at 2048 words (32768 voxels, far less
+  // than a room scan's ray space) and grows to what the scans need, each then in one window.
+  BackendOptions o;
+  o.kind = BackendKind::kVulkan;
+  o.resolution = 0.1;
+  if (const char* d = std::getenv("OCTOMAP_RT_TEST_DEVICE")) o.device = d;
+  VulkanTuning tuning;
+  tuning.start_grid_words = 2048;
+  auto gpu = make_vulkan_backend(o, tuning);
+  uint64_t allocations = 0;
+  for (size_t scan : {size_t(0), size_t(1), size_t(0)}) {
+    const RayBatch batch = synthetic_batch(scan, 0.1, -1.0, 4);
+    VoxelList got;
+    ShootStats stats;
+    gpu->shoot(batch, Traversal::kOctomap, got, stats);
+    sort_voxels(got);
+    const VoxelList want = cpu_states(batch, Traversal::kOctomap);
+    EXPECT_TRUE(same_voxels(got, want)) << "scan " << scan;
+    EXPECT_EQ(stats.windows, 1u) << "scan " << scan;
+    EXPECT_GT(stats.grid_words, 2048u);
+    EXPECT_GE(stats.grid_words * 16, batch.keys.voxel_count());
+    EXPECT_LT(stats.grid_words * 4, uint64_t(1) << 30) << "sized from the scan, not the budget";
+    EXPECT_GE(stats.grid_allocations, allocations);
+    if (scan == 0 && allocations) {
+      EXPECT_EQ(stats.grid_allocations, allocations) << "a scan seen before: no growth";
+    }
+    allocations = stats.grid_allocations;
+  }
+}
+
 TEST(VulkanRaySpace, ManyScansOneGridNothingLeftBehind) {
   // With max range the grid is sized to hold any scan in one window; over many scans the
   // grid is never re-allocated and every scan's touched words are exactly those read back
