@@ -78,8 +78,7 @@ std::vector<uint8_t> encode_region(const octomap::OcTree& tree, const RegionGrid
   std::vector<uint8_t> out(kHeaderBytes);
   uint64_t count = 0;
   encode_node(tree, r.node, out, count);
-  std::vector<uint8_t> header;
-  header.insert(header.end(), kMagic, kMagic + 4);
+  std::vector<uint8_t> header(kMagic, kMagic + 4);
   put(header, kVersion);
   put(header, uint64_t(id));
   put(header, uint32_t(grid.depth));

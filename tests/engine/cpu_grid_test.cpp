@@ -191,7 +191,7 @@ TEST(CpuGridWalk, EndsOutsideTheWindowStopNoLaneInside) {
   const double res = 0.1;
   std::mt19937 rng(21);
   std::uniform_real_distribution<float> u(-1.6f, 3.2f), uz(-0.8f, 1.6f);
-  for (const octomap::point3d origin :
+  for (const octomap::point3d& origin :
        {octomap::point3d(0.001f, 1.205f, 0.15f), octomap::point3d(0.75f, 0.85f, 0.35f)}) {
     RayBatch b;
     PrepareReport rep;
@@ -201,7 +201,7 @@ TEST(CpuGridWalk, EndsOutsideTheWindowStopNoLaneInside) {
     // From the first origin: through (0, 11, 1) to (16, 3, 1), whose brick arithmetic names (0, 11, 1).
     b.ends.push_back(RayEnd{1.65f, 0.35f, 0.15f, kRayEndOccupied});
     for (int i = 0; i < 20000; ++i)
-      b.ends.push_back(RayEnd{u(rng), u(rng), uz(rng), uint32_t(i % 3 ? kRayEndOccupied : 0)});
+      b.ends.push_back(RayEnd{u(rng), u(rng), uz(rng), i % 3 ? uint32_t(kRayEndOccupied) : 0u});
     for (bool rows : {false, true}) {
       const BrickLayout layout(w, rows);
       ASSERT_TRUE(layout.contains(b.origin_key));

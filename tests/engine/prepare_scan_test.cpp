@@ -71,7 +71,9 @@ TEST(CoordToKey, MatchesOctomap) {
     const bool ok_a = tree.coordToKeyChecked(p, a);
     const bool ok_b = coord_to_key_checked(p, 0.1, b);
     ASSERT_EQ(ok_a, ok_b) << p;
-    if (ok_a) ASSERT_TRUE(a == b) << p;
+    if (ok_a) {
+      ASSERT_TRUE(a == b) << p;
+    }
   }
 }
 
@@ -104,7 +106,9 @@ TEST(CoordToKey, MatchesOctomapOnBordersAndRangeEdges) {
       const bool ok_a = tree.coordToKeyChecked(p, a);
       const bool ok_b = coord_to_key_checked(p, res, b);
       ASSERT_EQ(ok_a, ok_b) << p << " res " << res;
-      if (ok_a) ASSERT_TRUE(a == b) << p << " res " << res;
+      if (ok_a) {
+        ASSERT_TRUE(a == b) << p << " res " << res;
+      }
     }
   }
 }
@@ -226,7 +230,9 @@ TEST(PrepareScan, ThreadsGiveTheSameBatchRayForRay) {
     EXPECT_EQ(r1.out_of_range, r7.out_of_range);
     EXPECT_EQ(r1.cut_at_max_range, r7.cut_at_max_range);
     EXPECT_GT(r1.nonfinite, 0u);
-    if (max_range < 0) EXPECT_GT(r1.out_of_range, 0u);  // with a max range they are cut, not dropped
+    if (max_range < 0) {  // with a max range they are cut, not dropped
+      EXPECT_GT(r1.out_of_range, 0u);
+    }
     for (int i = 0; i < 3; ++i) {
       EXPECT_EQ(b1.keys.lo[i], b7.keys.lo[i]);
       EXPECT_EQ(b1.keys.hi[i], b7.keys.hi[i]);
@@ -276,7 +282,9 @@ TEST(PrepareScan, FourPointsAtATimeGiveThePointByPointBatch) {
         EXPECT_EQ(rs.nonfinite, rv.nonfinite);
         EXPECT_EQ(rs.out_of_range, rv.out_of_range);
         EXPECT_EQ(rs.cut_at_max_range, rv.cut_at_max_range);
-        if (count > 1000) EXPECT_GT(rs.nonfinite, 0u);
+        if (count > 1000) {
+          EXPECT_GT(rs.nonfinite, 0u);
+        }
         for (int i = 0; i < 3; ++i) {
           EXPECT_EQ(s.keys.lo[i], v.keys.lo[i]) << "count " << count;
           EXPECT_EQ(s.keys.hi[i], v.keys.hi[i]) << "count " << count;

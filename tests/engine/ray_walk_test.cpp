@@ -123,7 +123,9 @@ TEST(CpuGridBackend, OccupiedWinsOverFreeInOneScan) {
   grid->shoot(b, Traversal::kOctomap, out, st);
   int occupied = 0, free = 0;
   for (const auto& v : out) {
-    if (v.x == 32768 + 5 && v.y == 32768 && v.z == 32768) EXPECT_TRUE(v.occupied());
+    if (v.x == 32768 + 5 && v.y == 32768 && v.z == 32768) {
+      EXPECT_TRUE(v.occupied());
+    }
     (v.occupied() ? occupied : free)++;
   }
   EXPECT_EQ(occupied, 2);

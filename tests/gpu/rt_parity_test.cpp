@@ -279,7 +279,9 @@ TEST(RtBackend, FaceRaysInDetail) {
         if (m == 3 || ++shown > 6) continue;
         std::printf("    %s (%d %d %d)\n", m == 1 ? "extra  " : "missing", k[0], k[1], k[2]);
       }
-      if (!v.candidates && v.margin == rt::kAabbMargin) EXPECT_TRUE(same(got, want)) << c.name;
+      if (!v.candidates && v.margin == rt::kAabbMargin) {
+        EXPECT_TRUE(same(got, want)) << c.name;
+      }
     }
   }
 }

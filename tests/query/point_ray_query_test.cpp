@@ -109,8 +109,12 @@ TEST(RayQuery, SameAsOctomapCastRay) {
       const bool in_map = t.coordToKeyChecked(o, key);
       const bool hit = in_map && t.castRay(o, d, end, opt.ignore_unknown, opt.max_range);
       ASSERT_EQ(a.hit, hit) << m.name << " ray " << o << " -> " << d;
-      if (in_map) ASSERT_EQ(a.end, end) << m.name << " ray " << o << " -> " << d;
-      if (a.hit) EXPECT_EQ(a.end_state, VoxelState::kOccupied);
+      if (in_map) {
+        ASSERT_EQ(a.end, end) << m.name << " ray " << o << " -> " << d;
+      }
+      if (a.hit) {
+        EXPECT_EQ(a.end_state, VoxelState::kOccupied);
+      }
       hits += a.hit;
       unknown_ends += a.end_state == VoxelState::kUnknown;
       // Mutation check: the ignore_unknown flag changes answers on these rays.

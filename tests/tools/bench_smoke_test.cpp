@@ -102,7 +102,9 @@ TEST(BenchSmoke, TinyPresetGivesAWellFormedCsv) {
                             "octomap_total_ms", "speedup", "points_per_s", "free_diff_pct", "occupied_diff_pct"}) {
       const double v = number(r, col);
       EXPECT_TRUE(std::isfinite(v)) << col;
-      if (std::string(col).find("diff") == std::string::npos) EXPECT_GE(v, 0) << col;
+      if (std::string(col).find("diff") == std::string::npos) {
+        EXPECT_GE(v, 0) << col;
+      }
     }
     EXPECT_GT(number(r, "speedup"), 0);
     EXPECT_NEAR(number(r, "speedup"), number(r, "octomap_total_ms") / number(r, "total_ms"),
