@@ -97,6 +97,11 @@ daemon::ServerConfig server_config(const Args& a) {
   cfg.chunk_interval_ms = 0.2;
   cfg.latency_bound_s = 60;
   cfg.read_replica = a.replica == "on";
+  // The producers go round the preset's scans (origins far apart, many new nodes a second at
+  // the GPU machine's rates): the per-producer cost gates would refuse the scans it measures.
+  cfg.scan_costs.max_origin_jump_m = 0;
+  cfg.scan_costs.max_new_nodes_per_s = 0;
+  cfg.scan_costs.max_map_new_nodes_per_s = 0;
   return cfg;
 }
 
@@ -213,6 +218,7 @@ int run(const Args& a) {
               (long long)rs.snapshots, (long long)rs.snapshot_timeouts,
               rs.snapshots ? rs.snapshot_s_sum / double(rs.snapshots) : 0.0, rs.snapshot_s_max,
               double(rs.snapshot_bytes) / 1e6, (long long)st.map_saves);
+  if (!rs.snapshot_error.empty()) std::printf("  snapshot refused: %s\n", rs.snapshot_error.c_str());
   if (replica)
     std::printf(
         "  read replica: %.1f s of updates on its thread, at most %.1f MB pending, stage 2 waited %.1f ms for "

@@ -13,7 +13,8 @@ namespace ort::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr const char* kMapReply = "BENCH_MAP_REPLY";
+// A map request's reply channel must carry the protocol's prefix (else it is refused unanswered).
+const std::string kMapReply = std::string(ort::protocol::kMapReplyPrefix) + "BENCH";
 constexpr const char* kQueryReply = "BENCH_QUERY_REPLY";
 
 double seconds_between(Clock::time_point a, Clock::time_point b) {
@@ -34,6 +35,7 @@ BenchReaders::BenchReaders(daemon::MappingServer& server, lcm::LCM& lc, double s
     if (c.request_id != chunk_request_) return;
     chunks_expected_ = c.num_chunks;
     chunks_got_++;
+    if (c.num_chunks == 0) stats_.snapshot_error = c.error;  // a refusal (busy, bad request)
     stats_.snapshot_bytes += c.data_size;
   });
   server_.lcm_loop().subscribe(kQueryReply, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
@@ -94,6 +96,7 @@ void BenchReaders::pull_snapshots() {
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
       std::lock_guard lock(mutex_);
       done = chunks_expected_ > 0 && chunks_got_ >= chunks_expected_;
+      if (chunks_expected_ == 0) break;  // refused: counted below, asked again next period
     }
     const double s = seconds_between(t0, Clock::now());
     {

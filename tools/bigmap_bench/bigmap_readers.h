@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstdint>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -15,7 +16,8 @@
 namespace ort::bench {
 
 struct ReaderStats {
-  int64_t snapshots = 0, snapshot_timeouts = 0;
+  int64_t snapshots = 0, snapshot_timeouts = 0;  // timeouts: not whole in 120 s, or refused
+  std::string snapshot_error;                    // the server's last refusal, if any
   double snapshot_s_max = 0, snapshot_s_sum = 0;
   int64_t snapshot_bytes = 0;
   std::vector<double> query_ms;  // one per answered query
