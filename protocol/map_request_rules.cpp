@@ -25,16 +25,15 @@ const char* to_string(RequestRefusal r) {
   return "?";
 }
 
-bool can_reply(const octomap_rt::map_request_t& r) {
-  const std::string prefix = kMapReplyPrefix;
+bool can_reply(const octomap_rt::map_request_t& r, const std::string& prefix) {
   return r.reply_channel.size() > prefix.size() && r.reply_channel.compare(0, prefix.size(), prefix) == 0 &&
          valid_name(r.reply_channel);
 }
 
-RequestRefusal check_map_request(const octomap_rt::map_request_t& r) {
+RequestRefusal check_map_request(const octomap_rt::map_request_t& r, const std::string& reply_prefix) {
   using Chunk = octomap_rt::map_chunk_t;
   if (!valid_name(r.client_id)) return RequestRefusal::kBadClientId;
-  if (!can_reply(r)) return RequestRefusal::kBadReplyChannel;
+  if (!can_reply(r, reply_prefix)) return RequestRefusal::kBadReplyChannel;
   if (r.format != Chunk::FORMAT_OCTOMAP_BINARY && r.format != Chunk::FORMAT_OCTOMAP_FULL)
     return RequestRefusal::kUnknownFormat;
   for (int32_t i : r.chunk_indices)

@@ -28,10 +28,11 @@ inline constexpr size_t kRequestRefusalCount = static_cast<size_t>(RequestRefusa
 
 const char* to_string(RequestRefusal r);
 
-// Checks what can be checked without the snapshot: names, format, indices.
-RequestRefusal check_map_request(const octomap_rt::map_request_t& r);
-// Whether a refusal can be answered (the reply channel is usable).
-bool can_reply(const octomap_rt::map_request_t& r);
+// Checks what can be checked without the snapshot: names, format, indices. `reply_prefix`: the
+// server's map reply prefix (its namespace's: protocol::channels_in(ns).map_reply_prefix).
+RequestRefusal check_map_request(const octomap_rt::map_request_t& r, const std::string& reply_prefix);
+// Whether a refusal can be answered (the reply channel is usable: the prefix and a name).
+bool can_reply(const octomap_rt::map_request_t& r, const std::string& reply_prefix);
 
 // The chunks a request makes the server send: each index once, in increasing order (a
 // request repeating one index must not make the server send it again and again); all of a

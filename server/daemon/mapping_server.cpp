@@ -160,6 +160,7 @@ void MappingServer::open_map_serving() {
   MapServiceConfig m;
   m.request_channel = cfg_.map_request_channel;
   m.info_channel = cfg_.map_info_channel;
+  m.reply_prefix = cfg_.map_reply_prefix;
   m.snapshots = SnapshotPolicy{cfg_.snapshots_kept, cfg_.snapshot_zstd_level, cfg_.snapshot_min_interval_s};
   m.fresh_interval_s = cfg_.fresh_snapshot_interval_s;
   m.request_queue = cfg_.map_request_queue;

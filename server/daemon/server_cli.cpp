@@ -173,9 +173,9 @@ void apply_namespace(ServerConfig& c, const std::string& ns) {
   }
   c.ns = ns;
   for (std::string* channel :
-       {&c.status_channel, &c.map_request_channel, &c.map_info_channel, &c.map_delta_channel, &c.octomap_raw.channel,
-        &c.queries.points_channel, &c.queries.rays_channel, &c.queries.boxes_channel, &c.queries.grid_channel,
-        &c.queries.edit_channel, &c.queries.grid.channel}) {
+       {&c.status_channel, &c.map_request_channel, &c.map_info_channel, &c.map_delta_channel, &c.map_reply_prefix,
+        &c.octomap_raw.channel, &c.queries.points_channel, &c.queries.rays_channel, &c.queries.boxes_channel,
+        &c.queries.grid_channel, &c.queries.edit_channel, &c.queries.grid.channel}) {
     *channel = protocol::in_namespace(ns, *channel);
     if (const std::string why = protocol::check_channel_length(*channel); !why.empty())
       throw CLI::ValidationError("--namespace", why);

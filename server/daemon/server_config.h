@@ -57,9 +57,10 @@ struct ServerConfig {
   std::string map_request_channel = ort::protocol::kMapRequestChannel;
   std::string map_info_channel = ort::protocol::kMapInfoChannel;
   std::string map_delta_channel = ort::protocol::kMapDeltaChannel;
-  int snapshot_zstd_level = 3;             // 0: snapshots uncompressed
-  size_t snapshots_kept = 4;               // for re-sends of chunks
-  double snapshot_min_interval_s = 0.5;    // a new snapshot at most this often
+  std::string map_reply_prefix = ort::protocol::kMapReplyPrefix;  // map requests must name a reply channel of it
+  int snapshot_zstd_level = 3;                                    // 0: snapshots uncompressed
+  size_t snapshots_kept = 4;                                      // for re-sends of chunks
+  double snapshot_min_interval_s = 0.5;                           // a new snapshot at most this often
   double fresh_snapshot_interval_s = 2.0;  // a new snapshot for fresh requests at most this often
   size_t map_request_queue = 256;          // map requests waiting, all clients; more: busy
   size_t map_requests_per_client = 2;      // map requests of one client waiting; more: busy

@@ -9,6 +9,7 @@
 #include <exception>
 #include <vector>
 
+#include "protocol/channels.h"
 #include "protocol/inbound_checks.h"
 #include "protocol/map_request_rules.h"
 
@@ -21,8 +22,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } catch (const std::exception&) {
     std::abort();
   }
-  if (ort::protocol::check_map_request(req) != ort::protocol::RequestRefusal::kNone) return 0;
-  (void)ort::protocol::can_reply(req);
+  if (ort::protocol::check_map_request(req, ort::protocol::kMapReplyPrefix) != ort::protocol::RequestRefusal::kNone)
+    return 0;
+  (void)ort::protocol::can_reply(req, ort::protocol::kMapReplyPrefix);
   // Bytes it makes the server send: each chunk of the snapshot at most once, whatever the
   // request repeats (a snapshot of 64 chunks here; indices past it are refused first).
   constexpr int32_t kChunks = 64;

@@ -6,11 +6,14 @@
 
 #include <gtest/gtest.h>
 
+#include "octomap_rt/map_chunk_t.hpp"
 #include "octomap_rt/map_info_t.hpp"
+#include "octomap_rt/map_request_t.hpp"
 #include "octomap_rt/server_status_t.hpp"
 #include "protocol/channels.h"
 #include "protocol/ids.h"
 #include "protocol/inbound_checks.h"
+#include "protocol/map_request_rules.h"
 #include "protocol/version.h"
 
 namespace ort::test {
@@ -51,6 +54,20 @@ TEST(ProtocolRules, NamespacesAreCheckedAtStart) {
   }
   EXPECT_EQ(check_channel_length(std::string(63, 'C')), "");
   EXPECT_NE(check_channel_length(std::string(64, 'C')), "");
+}
+
+// A server in a namespace answers map requests whose reply channel is in that namespace (a
+// namespaced client's), and only those.
+TEST(ProtocolRules, MapRequestsAreAnsweredOnTheServersNamespacesReplyChannels) {
+  octomap_rt::map_request_t r{};
+  r.client_id = "planner";
+  r.format = octomap_rt::map_chunk_t::FORMAT_OCTOMAP_FULL;
+  r.reply_channel = channels_in("lab2").map_reply_prefix + "PLANNER";
+  EXPECT_EQ(check_map_request(r, channels_in("lab2").map_reply_prefix), RequestRefusal::kNone);
+  EXPECT_EQ(check_map_request(r, kMapReplyPrefix), RequestRefusal::kBadReplyChannel);
+  r.reply_channel = std::string(kMapReplyPrefix) + "PLANNER";
+  EXPECT_EQ(check_map_request(r, kMapReplyPrefix), RequestRefusal::kNone);
+  EXPECT_FALSE(can_reply(r, channels_in("lab2").map_reply_prefix));
 }
 
 TEST(ProtocolRules, OneClientIdRuleForMapRequestsAndQueries) {

@@ -50,9 +50,9 @@ TEST(ServerCli, ANamespacePrefixesEveryChannel) {
   const daemon::ServerConfig& c = p.config;
   for (const std::string* channel :
        {&c.status_channel, &c.scan_channels, &c.map_request_channel, &c.map_info_channel, &c.map_delta_channel,
-        &c.octomap_raw.channel, &c.queries.points_channel, &c.queries.rays_channel, &c.queries.boxes_channel,
-        &c.queries.grid_channel, &c.queries.edit_channel, &c.queries.grid.channel, &c.queries.scan_prefix,
-        &c.queries.status_channel})
+        &c.map_reply_prefix, &c.octomap_raw.channel, &c.queries.points_channel, &c.queries.rays_channel,
+        &c.queries.boxes_channel, &c.queries.grid_channel, &c.queries.edit_channel, &c.queries.grid.channel,
+        &c.queries.scan_prefix, &c.queries.status_channel})
     EXPECT_EQ(channel->rfind("lab2_", 0), 0u) << *channel;
   EXPECT_EQ(c.octomap_raw.channel, "lab2_OCTOMAP");
   EXPECT_EQ(c.scan_channels, "lab2_OCTOMAP_RT_SCAN_.*");
@@ -115,6 +115,7 @@ TEST(ServerCli, AShardHearsTheNamespacesScansAndServesOnItsOwnChannels) {
   EXPECT_EQ(c.status_channel, "lab2_OCTOMAP_RT_STATUS");
   EXPECT_EQ(c.queries.status_channel, "lab2_OCTOMAP_RT_STATUS");
   EXPECT_EQ(c.map_request_channel, "lab2_SHARD1_OCTOMAP_RT_MAP_REQUEST");
+  EXPECT_EQ(c.map_reply_prefix, "lab2_SHARD1_OCTOMAP_RT_MAP_REPLY_");
   EXPECT_EQ(c.queries.points_channel, "lab2_SHARD1_OCTOMAP_RT_QUERY");
   EXPECT_EQ(c.octomap_raw.channel, "lab2_SHARD1_OCTOMAP");
   const std::string west = "-inf,-inf,-inf:0,inf,inf", east = "0,-inf,-inf:inf,inf,inf";

@@ -161,7 +161,7 @@ void MapService::run() {
 
 void MapService::serve(const protocol::QueuedMapRequest& queued) {
   const octomap_rt::map_request_t& req = queued.req;
-  protocol::RequestRefusal why = protocol::check_map_request(req);
+  protocol::RequestRefusal why = protocol::check_map_request(req, cfg_.reply_prefix);
   if (why != protocol::RequestRefusal::kNone) return refuse(&req, why, "");
   bool took_new = false;
   // snapshot_id: < 0 a fresh snapshot, 0 the latest kept (maybe older than the map), > 0 that one.
@@ -206,7 +206,7 @@ void MapService::refuse(const octomap_rt::map_request_t* req, protocol::RequestR
     stats_.requests_rejected++;
     stats_.refusals[static_cast<size_t>(why)]++;
   }
-  if (!req || !protocol::can_reply(*req)) return;  // nowhere safe to answer: ignored (counted)
+  if (!req || !protocol::can_reply(*req, cfg_.reply_prefix)) return;  // nowhere safe to answer: ignored (counted)
   Chunk c{};
   c.utime = utime_now();
   c.request_id = req->request_id;

@@ -33,6 +33,8 @@ namespace ort::daemon {
 struct MapServiceConfig {
   std::string request_channel = ort::protocol::kMapRequestChannel;
   std::string info_channel = ort::protocol::kMapInfoChannel;
+  // Replies go only to channels of this prefix + a client id (the namespace's).
+  std::string reply_prefix = ort::protocol::kMapReplyPrefix;
   SnapshotPolicy snapshots;
   double chunk_interval_ms = 1.5;  // between two chunks sent (pacing)
   double info_period_s = 1.0;
