@@ -43,6 +43,10 @@ inline constexpr const char* kGridChannel = "OCTOMAP_RT_GRID";
 // octomap.raw_t, server -> LCM's OctoMap viewers (--octomap-raw-rate): their channel name.
 inline constexpr const char* kOctomapRawChannel = "OCTOMAP";
 
+// A shard's own channels are in namespace NS_ + this + its index (SHARD2, lab2_SHARD2;
+// protocol/shards/shard_set.h's shard_namespace).
+inline constexpr const char* kShardNamespacePrefix = "SHARD";
+
 // --- Namespaces ---------------------------------------------------------------------------
 // Where the namespace comes from when no --namespace is given.
 inline constexpr const char* kNamespaceEnv = "OCTOMAP_RT_NAMESPACE";

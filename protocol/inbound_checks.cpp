@@ -81,10 +81,11 @@ WireCheck check_map_delta_bytes(const uint8_t* d, size_t n) {
               {fixed(kDeltaDataSizeOffset - 8), count(kMaxMessageBytes), array(1), str(kAnyString)});
 }
 WireCheck check_map_info_bytes(const uint8_t* d, size_t n) {
-  // Each producer: an int64 seq (all seqs first), then one id string each.
+  // Each producer: an int64 seq (all seqs first), then one id string each; then the shard
+  // set's boxes, six int32 each.
   return walk(d, n, kMaxMessageBytes + 4096, octomap_rt::map_info_t::getHash(),
-              {fixed(kInfoNumProducersOffset - 8), count(4096), array(8), wire_strings(1, kAnyString), str(kAnyString),
-               str(kAnyString)});
+              {fixed(kInfoNumProducersOffset - 8), count(4096), array(8), wire_strings(1, kAnyString),
+               count(6 * kMaxShards), array(4), str(kAnyString), str(kAnyString)});
 }
 
 }  // namespace ort::protocol

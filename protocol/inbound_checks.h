@@ -29,7 +29,7 @@ inline constexpr size_t kScanXyzOffset = 89;     // scan_t.xyz[0]
 inline constexpr size_t kChunkDataSizeOffset = 94;
 inline constexpr size_t kDeltaDataSizeOffset = 82;
 inline constexpr size_t kRequestNumIndicesOffset = 33;
-inline constexpr size_t kInfoNumProducersOffset = 210;
+inline constexpr size_t kInfoNumProducersOffset = 216;
 // Where protocol_version sits in map_info_t and server_status_t, in every version
 // (protocol/version.h).
 inline constexpr size_t kVersionOffset = 8;

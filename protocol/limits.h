@@ -46,4 +46,8 @@ inline constexpr int64_t kMaxQueryBoxes = 1000;
 inline constexpr int kRegionChunkVoxels = 4000;
 inline constexpr int kGridChunkCells = 60000;
 
+// --- Shards (docs/PROTOCOL.md, "Shards") -------------------------------------------------
+// Most daemons in one shard set (map_info_t/server_status_t.shard_count; 6 box values each).
+inline constexpr uint32_t kMaxShards = 64;
+
 }  // namespace ort::protocol

@@ -136,7 +136,7 @@ RegionBox region_box_of(const double min[3], const double max[3], double resolut
 }
 
 std::string shard_namespace(std::string_view ns, uint32_t index) {
-  return in_namespace(ns, "SHARD" + std::to_string(index));
+  return in_namespace(ns, kShardNamespacePrefix + std::to_string(index));
 }
 
 const char* to_string(ShardRule rule) {

@@ -12,10 +12,9 @@
 #include <string_view>
 #include <vector>
 
-namespace ort::protocol {
+#include "protocol/limits.h"
 
-// Most daemons in one shard set.
-inline constexpr uint32_t kMaxShards = 64;
+namespace ort::protocol {
 
 // How a shard set divides the regions (the values travel as int8 in map_info_t and
 // server_status_t: SHARD_RULE_*).

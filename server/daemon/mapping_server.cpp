@@ -168,12 +168,19 @@ void MappingServer::open_map_serving() {
   m.chunk_interval_ms = cfg_.chunk_interval_ms;
   m.server_id = server_id_;
   m.resolution = cfg_.engine.resolution;
-  // This server maps the whole key space of its tree (one region; sharding would narrow it).
+  // The part of space this server maps: the whole key space of its tree, or its shard box.
   const double half = 32768.0 * cfg_.engine.resolution;
+  const double region_m = cfg_.engine.resolution * double(1u << (16 - cfg_.shard.region_depth));
   for (int k = 0; k < 3; ++k) {
     m.region_min[k] = -half;
     m.region_max[k] = half;
+    if (cfg_.shard.rule == protocol::ShardRule::kBoxes) {
+      const protocol::RegionBox& b = cfg_.shard.boxes[cfg_.shard.index];
+      m.region_min[k] = b.min[k] * region_m - half;
+      m.region_max[k] = b.max[k] * region_m - half;
+    }
   }
+  m.shard = cfg_.shard;
   map_service_ = std::make_unique<MapService>(
       *loop_, map_, m, [this] { return deltas_ ? deltas_->last_seq() : -1; }, log_);
 }

@@ -123,6 +123,7 @@ StatusInputs MappingServer::gather_status() {
   in.state = state_;
   in.message = message_;
   in.seq = status_seq_;
+  in.shard = cfg_.shard;
   return in;
 }
 

@@ -51,6 +51,7 @@ std::map<std::string, std::string> expected() {
       {"QUERY_REPLY_PREFIX", kQueryReplyPrefix},
       {"GRID_CHANNEL", kGridChannel},
       {"OCTOMAP_RAW_CHANNEL", kOctomapRawChannel},
+      {"SHARD_NAMESPACE_PREFIX", kShardNamespacePrefix},
       {"NAMESPACE_ENV", kNamespaceEnv},
       {"DEFAULT_LCM_URL", kDefaultLcmUrl},
       {"MAX_CHANNEL_LENGTH", std::to_string(kMaxChannelLength)},
@@ -70,6 +71,7 @@ std::map<std::string, std::string> expected() {
       {"MAX_QUERY_BOXES", std::to_string(kMaxQueryBoxes)},
       {"REGION_CHUNK_VOXELS", std::to_string(kRegionChunkVoxels)},
       {"GRID_CHUNK_CELLS", std::to_string(kGridChunkCells)},
+      {"MAX_SHARDS", std::to_string(kMaxShards)},
       {"PROTOCOL_VERSION", std::to_string(kProtocolVersion)},
   };
   return e;

@@ -9,8 +9,10 @@
 
 #include "daemon/pipeline/shard_filter.h"
 #include "map_client/shard_merge.h"
+#include "octomap_rt/server_status_t.hpp"
 #include "octree/region.h"
 #include "protocol/channels.h"
+#include "protocol/shards/shard_wire.h"
 #include "scene/scan_set.h"
 #include "server/scan_fixtures.h"
 #include "support/octomap_reference.h"
@@ -154,6 +156,41 @@ TEST(ShardRule, BoxesMustTileTheKeySpace) {
   EXPECT_EQ(n, 3u);
 }
 
+// The announcement's fields, read back with every field range-checked and a named fault.
+TEST(ShardRule, AnnouncedFieldsAreRangeCheckedWithNamedFaults) {
+  octomap_rt::server_status_t m{};
+  ShardSet boxes;
+  boxes.index = 1, boxes.count = 2, boxes.rule = ShardRule::kBoxes, boxes.region_depth = 3;
+  boxes.boxes = {RegionBox{{0, 0, 0}, {4, 8, 8}}, RegionBox{{4, 0, 0}, {8, 8, 8}}};
+  protocol::put_shard_set(boxes, m);
+  ShardSet back;
+  ASSERT_EQ(protocol::read_shard_set(m, back), protocol::ShardFieldFault::kNone);
+  EXPECT_TRUE(protocol::same_shard_set(back, boxes));
+  EXPECT_EQ(back.index, 1u);
+  auto fault = [&](auto change) {
+    octomap_rt::server_status_t c = m;
+    change(c);
+    ShardSet ignored;
+    return protocol::read_shard_set(c, ignored);
+  };
+  using F = protocol::ShardFieldFault;
+  EXPECT_EQ(fault([](auto& c) { c.shard_rule = 3; }), F::kUnknownRule);
+  EXPECT_EQ(fault([](auto& c) { c.shard_rule = -1; }), F::kUnknownRule);
+  EXPECT_EQ(fault([](auto& c) { c.shard_region_depth = 0; }), F::kBadDepth);
+  EXPECT_EQ(fault([](auto& c) { c.shard_region_depth = 17; }), F::kBadDepth);
+  EXPECT_EQ(fault([](auto& c) { c.shard_count = 0; }), F::kBadCount);
+  EXPECT_EQ(fault([](auto& c) { c.shard_count = 65; }), F::kBadCount);
+  EXPECT_EQ(fault([](auto& c) { c.shard_index = 2; }), F::kBadIndex);
+  EXPECT_EQ(fault([](auto& c) { c.shard_index = -1; }), F::kBadIndex);
+  EXPECT_EQ(fault([](auto& c) { c.shard_box.pop_back(), c.num_shard_box_values--; }), F::kBadBoxValues);
+  EXPECT_EQ(fault([](auto& c) { c.num_shard_box_values = 1 << 30; }), F::kBadBoxValues);
+  EXPECT_EQ(fault([](auto& c) { c.shard_box[3] = 5; }), F::kBadBoxes);   // box 0 overlaps box 1
+  EXPECT_EQ(fault([](auto& c) { c.shard_box[9] = 9; }), F::kBadBoxes);   // past the key space
+  EXPECT_EQ(fault([](auto& c) { c.shard_box[0] = -1; }), F::kBadBoxes);  // negative
+  EXPECT_EQ(fault([](auto& c) { c.shard_rule = 0; }), F::kBadCount);     // the whole map in two
+  EXPECT_STREQ(protocol::to_string(F::kBadIndex), "shard index not below the count");
+}
+
 // The engine's voxel lists of the real scans, cut per shard: every shard equals OctoMap
 // restricted to its regions; the merge equals the one-daemon map.
 TEST(Shards, RealScansShardByShardEqualOctomapAndMergeToTheWholeMap) {
@@ -232,6 +269,12 @@ TEST(Shards, DaemonsOverMemqMergeToTheOneDaemonMap) {
     for (auto& bus : buses) bus->publish(scan_channel("husky1"), &msg);
   }
   std::vector<std::unique_ptr<octomap::OcTree>> maps;
+  for (size_t i = 0; i < servers.size(); ++i) {  // each announces the whole set it belongs to
+    ShardSet heard;
+    EXPECT_EQ(protocol::read_shard_set(servers[i]->status(), heard), protocol::ShardFieldFault::kNone);
+    EXPECT_TRUE(protocol::same_shard_set(heard, sets[i])) << protocol::describe(heard);
+    EXPECT_EQ(heard.index, sets[i].index);
+  }
   for (auto& server : servers) {
     ASSERT_TRUE(wait_until_done(*server, static_cast<int64_t>(set.scans.size())));
     server->stop();

@@ -1,4 +1,5 @@
 #include "daemon/serving/map_service.h"
+#include "protocol/shards/shard_wire.h"
 
 #include <algorithm>
 #include <chrono>
@@ -257,6 +258,7 @@ void MapService::send_chunks(const octomap_rt::map_request_t& req, const Snapsho
 void MapService::publish_info() {
   octomap_rt::map_info_t m{};
   m.protocol_version = protocol::kProtocolVersion;
+  protocol::put_shard_set(cfg_.shard, m);
   m.utime = utime_now();
   {
     std::shared_lock lock(map_.mutex);

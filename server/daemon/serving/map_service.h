@@ -27,6 +27,7 @@
 #include "octomap_rt/map_request_t.hpp"
 #include "protocol/channels.h"
 #include "protocol/map_request_rules.h"
+#include "protocol/shards/shard_set.h"
 
 namespace ort::daemon {
 
@@ -46,6 +47,7 @@ struct MapServiceConfig {
   std::string server_id, map_frame = "map";
   double resolution = 0;
   double region_min[3] = {0, 0, 0}, region_max[3] = {0, 0, 0};  // set by the server
+  protocol::ShardSet shard;                                     // announced in every map_info_t
 };
 
 struct MapServiceStats {

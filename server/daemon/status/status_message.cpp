@@ -1,4 +1,5 @@
 #include "daemon/status/status_message.h"
+#include "protocol/shards/shard_wire.h"
 
 #include <algorithm>
 #include <array>
@@ -97,6 +98,7 @@ void add_queries(octomap_rt::server_status_t& s, const QueryServiceStats& q) {
 octomap_rt::server_status_t make_status(const StatusInputs& in) {
   octomap_rt::server_status_t s;
   s.protocol_version = protocol::kProtocolVersion;
+  protocol::put_shard_set(in.shard, s);
   s.utime = in.utime;
   s.seq = in.seq;
   s.start_utime = in.start_utime;

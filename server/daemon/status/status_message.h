@@ -9,10 +9,12 @@
 #include "daemon/pipeline/pipeline_metrics.h"
 #include "daemon/queries/query_clients.h"
 #include "octomap_rt/server_status_t.hpp"
+#include "protocol/shards/shard_set.h"
 
 namespace ort::daemon {
 
 struct StatusInputs {
+  protocol::ShardSet shard;  // the shard set this server belongs to (announced in every status)
   int64_t utime = 0, seq = 0, start_utime = 0;
   int32_t pid = 0;
   double uptime_s = 0;
