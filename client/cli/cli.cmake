@@ -11,7 +11,7 @@ octomap_rt_lcm_handler_sources(octomap_rt_client ${CMAKE_CURRENT_LIST_DIR}/repla
                                ${CMAKE_CURRENT_LIST_DIR}/status_command.cpp)
 include(${CMAKE_CURRENT_LIST_DIR}/status/status.cmake)
 target_link_libraries(octomap_rt_client PUBLIC octomap_rt_status octomap_rt_render octomap_rt_query_client
-                      octomap_rt_map_client)
+                      octomap_rt_map_client octomap_rt_shard_client)
 
 add_executable(octomap-rt ${CMAKE_CURRENT_LIST_DIR}/main.cpp)
 target_compile_definitions(octomap-rt PRIVATE OCTOMAP_RT_VERSION="${PROJECT_VERSION}")

@@ -11,6 +11,7 @@
 #include "cli/map_commands.h"
 #include "cli/namespace_flag.h"
 #include "cli/progress_bar.h"
+#include "cli/shard_commands.h"
 #include "map_client/map_client.h"
 #include "protocol/lcm_url.h"
 
@@ -102,7 +103,14 @@ void register_map_command(CLI::App& app) {
   CLI::App* get = map->add_subcommand("get", "fetch a snapshot of the server's map into a .bt or .ot file");
   get->add_option("-o,--output", *out, "FILE.bt or FILE.ot")->required();
   add_common(get, *args);
-  get->callback([args, out] { run_get(*args, *out); });
+  get->add_flag("--shards", args->shards,
+                "the namespace is a shard set (octomap-rt-server --shard): find the shards by their statuses, fetch "
+                "each one's map and merge them into one (each shard's snapshot id and scans are printed)");
+  get->add_flag("--partial", args->partial, "with --shards: write the merged map even when a shard is missing");
+  get->callback([args, out] {
+    if (!args->shards) return run_get(*args, *out);
+    if (const int rc = run_get_shards(*args, *out, args->partial); rc != 0) throw CLI::RuntimeError(rc);
+  });
   CLI::App* info = map->add_subcommand("info", "print the server's next map_info_t");
   add_common(info, *args);
   info->callback([args] { run_info(*args); });

@@ -10,8 +10,10 @@ struct MapArgs {
   std::string ns;  // --namespace
   double timeout_s = 30;
   bool json = false, quiet = false;
-  double seconds = 0;  // watch: 0 = until Ctrl-C
-  std::string save;    // watch: .ot written at the end
+  double seconds = 0;    // watch: 0 = until Ctrl-C
+  std::string save;      // watch: .ot written at the end
+  bool shards = false;   // get: the namespace is a shard set: merge every shard's map
+  bool partial = false;  // get --shards: write the merged map even when a shard is missing
 };
 
 void run_map_watch(const MapArgs& a);

@@ -8,6 +8,7 @@
 #include "cli/commands.h"
 #include "cli/grid_picture.h"
 #include "cli/namespace_flag.h"
+#include "cli/shard_commands.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "protocol/lcm_url.h"
 #include "query_client/query_args.h"
@@ -22,7 +23,7 @@ using namespace ort::client;
 struct CommonArgs {
   std::string lcm_url, client_id, ns;
   double timeout_s = 5;
-  bool json = false;
+  bool json = false, shards = false;
   std::string wait_robot;
   int64_t wait_seq = -1;
   int64_t min_snapshot = 0;
@@ -37,6 +38,27 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
   cmd->add_option("--wait-robot", a.wait_robot, "answer only once this robot's --wait-seq scan is applied");
   cmd->add_option("--wait-seq", a.wait_seq, "the scan seq to wait for (with --wait-robot)");
   cmd->add_option("--min-snapshot", a.min_snapshot, "answer from map state >= this");
+  cmd->add_flag("--shards", a.shards,
+                "the namespace is a shard set (octomap-rt-server --shard): route by region, say which shard did "
+                "not answer (exit status 3); no --wait-robot/--min-snapshot");
+}
+
+// The namespace's shard set and a client routing to it (query --shards).
+std::unique_ptr<ShardQueries> connect_shards(const CommonArgs& a) {
+  if (!a.wait_robot.empty() || a.min_snapshot != 0)
+    throw CLI::ValidationError("--shards", "does not wait for a robot or a map state (each shard has its own)");
+  const std::string url = ort::protocol::lcm_url_or_default(a.lcm_url), ns = protocol::namespace_from(a.ns);
+  const ShardRoster roster = find_shards_for_query(url, ns, a.timeout_s);
+  const std::string id = a.client_id.empty() ? "cli-" + std::to_string(::getpid()) : a.client_id;
+  return std::make_unique<ShardQueries>(url, id, std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)),
+                                        ns, *roster.set(), roster.resolution());
+}
+
+// A routed answer: its reply, and exit status 3 when a shard's part is missing.
+template <class R>
+R routed(const Routed<R>& r, bool& partial) {
+  partial = say_partial(r.shards);
+  return r.reply;
 }
 
 std::unique_ptr<QueryClient> connect(const CommonArgs& a) {
@@ -80,9 +102,12 @@ void register_points(CLI::App& parent) {
       xyz.insert(xyz.end(), more.begin(), more.end());
     }
     if (xyz.empty()) throw CLI::ValidationError("points", "give X,Y,Z points or --file");
-    const auto r = connect(*a)->points(xyz, *depth, wait_for(*a));
+    bool partial = false;
+    const auto r = a->shards ? routed(connect_shards(*a)->points(xyz, *depth), partial)
+                             : connect(*a)->points(xyz, *depth, wait_for(*a));
     if (a->json) write_points_json(std::cout, xyz, r);
     if (refused(r)) std::exit(2);
+    if (partial) std::exit(3);
     if (!a->json)
       for (int i = 0; i < r.num_results; ++i)
         std::cout << xyz[3 * i] << " " << xyz[3 * i + 1] << " " << xyz[3 * i + 2] << " " << state_name(r.occupancy[i])
@@ -107,9 +132,12 @@ void register_rays(CLI::App& parent) {
       o.insert(o.end(), {float(b.min[0]), float(b.min[1]), float(b.min[2])});
       d.insert(d.end(), {float(b.max[0]), float(b.max[1]), float(b.max[2])});
     }
-    const auto r = connect(*a)->rays(o, d, *max_range, *ignore, wait_for(*a));
+    bool partial = false;
+    const auto r = a->shards ? routed(connect_shards(*a)->rays(o, d, *max_range, *ignore), partial)
+                             : connect(*a)->rays(o, d, *max_range, *ignore, wait_for(*a));
     if (a->json) write_rays_json(std::cout, r);
     if (refused(r)) std::exit(2);
+    if (partial) std::exit(3);
     if (!a->json)
       for (int i = 0; i < r.num_rays; ++i)
         std::cout << (r.hit[i] ? "hit " : "no hit ") << r.end_xyz[3 * i] << " " << r.end_xyz[3 * i + 1] << " "
@@ -133,6 +161,20 @@ void register_box(CLI::App& parent) {
   cmd->callback([=] {
     std::vector<Box> bs;
     for (const std::string& s : *boxes) bs.push_back(parse_box(s));
+    if (a->shards) {
+      if (*region) throw CLI::ValidationError("--region", "is not routed across shards; ask each shard's namespace");
+      bool partial = false;
+      const int8_t mode = *any ? octomap_rt::box_query_t::MODE_ANY_OCCUPIED : octomap_rt::box_query_t::MODE_COUNTS;
+      const auto r = routed(connect_shards(*a)->boxes(bs, mode), partial);
+      if (a->json) write_boxes_json(std::cout, r);
+      if (refused(r)) std::exit(2);
+      if (!a->json)
+        for (int i = 0; i < r.num_boxes; ++i)
+          std::cout << "occupied " << r.occupied[i] << " free " << r.free[i] << " unknown " << r.unknown[i]
+                    << (r.any_occupied[i] ? " (occupied)" : " (clear)") << "\n";
+      if (partial) std::exit(3);
+      return;
+    }
     auto client = connect(*a);
     if (*region) {
       if (bs.size() != 1) throw CLI::ValidationError("--region", "takes exactly one box");

@@ -2,6 +2,7 @@
 // out for a terminal (client/cli/status/), once or refreshing in place.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -11,6 +12,7 @@
 
 #include "cli/commands.h"
 #include "cli/namespace_flag.h"
+#include "cli/shard_commands.h"
 #include "cli/status/status_json.h"
 #include "cli/status/status_text.h"
 #include "core/clock.h"
@@ -23,7 +25,7 @@ namespace {
 
 struct StatusArgs {
   std::string lcm_url, channel = ort::protocol::kStatusChannel, ns;
-  bool watch = false, json = false;
+  bool watch = false, json = false, shards = false;
   double timeout_s = 5;
   int64_t count = 0;  // --watch: stop after this many statuses (0: never)
 };
@@ -120,6 +122,9 @@ int run_watch(const StatusArgs& a, lcm::LCM& lc, const std::string& url, Inbox& 
 }
 
 int run_status(StatusArgs a) {
+  if (a.shards)
+    return run_status_shards(protocol::lcm_url_or_default(a.lcm_url), protocol::namespace_from(a.ns),
+                             std::min(a.timeout_s, 3.0), a.json);
   a.channel = protocol::in_namespace(protocol::channels_in(protocol::namespace_from(a.ns)).ns, a.channel);
   const std::string url = ort::protocol::lcm_url_or_default(a.lcm_url);
   std::optional<lcm::LCM> slot;
@@ -138,6 +143,9 @@ void register_status_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("status", "Show octomap-rt-server's status (OCTOMAP_RT_STATUS), once or --watch");
   cmd->add_flag("-w,--watch", args->watch, "Keep showing the newest status, refreshed in place");
   cmd->add_flag("--json", args->json, "One line of JSON per status instead of text");
+  cmd->add_flag("--shards", args->shards,
+                "The namespace's shards (octomap-rt-server --shard) side by side, each one's newest status; "
+                "says which shard is missing or late (exit status 3)");
   cmd->add_option("--lcm-url", args->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else the host-local udpm URL)");
   cmd->add_option("--channel", args->channel, "Status channel (in the --namespace)")->capture_default_str();
   add_namespace_flag(cmd, args->ns);
@@ -147,7 +155,7 @@ void register_status_command(CLI::App& app) {
   cmd->add_option("--count", args->count, "With --watch: stop after N statuses (0: never)")
       ->check(CLI::NonNegativeNumber);
   cmd->callback([args] {
-    if (run_status(*args) != 0) throw std::runtime_error("status failed");
+    if (const int rc = run_status(*args); rc != 0) throw CLI::RuntimeError(rc);
   });
 }
 

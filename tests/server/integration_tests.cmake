@@ -30,3 +30,6 @@ octomap_rt_add_integration_test(query_integration_test 300)
 target_link_libraries(query_integration_test PRIVATE octomap_rt_query_client)
 octomap_rt_add_integration_test(server_signals_integration_test 300)
 octomap_rt_add_integration_test(map_identity_integration_test 300)
+# Issue 26: three shards in one namespace; the CLI merges their maps, queries routed by region.
+octomap_rt_add_integration_test(shards_integration_test 300)
+target_link_libraries(shards_integration_test PRIVATE octomap_rt_shard_client)

@@ -1,0 +1,220 @@
+#include "shard_client/shard_queries.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <future>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+
+#include <octomap/OcTree.h>
+
+#include "octomap_rt/box_query_t.hpp"
+
+namespace ort::client {
+namespace {
+
+using Occ = octomap_rt::occupancy_reply_t;
+
+// Runs ask(i) for every shard i in `which` side by side; each result or the reason it failed.
+template <class Reply>
+std::vector<std::optional<Reply>> ask_each(const std::vector<uint32_t>& which, size_t count, ShardAnswer& answer,
+                                           const std::function<Reply(uint32_t)>& ask) {
+  std::vector<std::optional<Reply>> out(count);
+  std::vector<std::pair<uint32_t, std::future<Reply>>> pending;
+  for (uint32_t i : which) pending.emplace_back(i, std::async(std::launch::async, ask, i));
+  answer.snapshot_ids.assign(count, -1);
+  for (auto& [i, f] : pending) {
+    try {
+      Reply r = f.get();
+      if (r.status != Occ::REPLY_OK) throw std::runtime_error("refused: " + r.error);
+      answer.snapshot_ids[i] = r.snapshot_id;
+      out[i] = std::move(r);
+    } catch (const std::exception& e) {
+      answer.missing.push_back(i);
+      answer.errors.push_back(e.what());
+    }
+  }
+  return out;
+}
+
+std::vector<uint32_t> every_shard(uint32_t count) {
+  std::vector<uint32_t> v(count);
+  for (uint32_t i = 0; i < count; ++i) v[i] = i;
+  return v;
+}
+
+// Which of the shards' hits the ray meets first: each is the first occupied voxel of its shard
+// on the same walk, so the first of them on that walk is the map's first. OctoMap's own castRay
+// on a tree holding just those voxels walks it (its step order decides ties: a ray from a voxel
+// corner meets two voxels at the same parameter). Returns the index into `hits`.
+size_t first_on_walk(const float* o, const float* d, float max_range, double resolution,
+                     const std::vector<const float*>& hits) {
+  octomap::OcTree probe(resolution);
+  for (const float* h : hits) probe.updateNode(octomap::point3d(h[0], h[1], h[2]), true);
+  octomap::point3d end;
+  if (probe.castRay(octomap::point3d(o[0], o[1], o[2]), octomap::point3d(d[0], d[1], d[2]), end, true, max_range)) {
+    const octomap::OcTreeKey k = probe.coordToKey(end);
+    for (size_t i = 0; i < hits.size(); ++i)
+      if (probe.coordToKey(octomap::point3d(hits[i][0], hits[i][1], hits[i][2])) == k) return i;
+  }
+  return 0;
+}
+
+template <class Reply>
+void merged_header(Reply& out, const std::vector<std::optional<Reply>>& got) {
+  out.status = Occ::REPLY_BAD_REQUEST;
+  out.error = "no shard answered";
+  for (const auto& r : got)
+    if (r) {
+      out.status = Occ::REPLY_OK, out.error.clear();
+      out.utime = std::max(out.utime, r->utime);
+      out.snapshot_id = std::max(out.snapshot_id, r->snapshot_id);
+      out.map_utime = std::max(out.map_utime, r->map_utime);
+    }
+}
+
+}  // namespace
+
+std::string ShardAnswer::shortfall() const {
+  std::string out;
+  for (size_t k = 0; k < missing.size(); ++k)
+    out += (out.empty() ? "" : "; ") + std::string("shard ") + std::to_string(missing[k]) + " did not answer (" +
+           errors[k] + "): its part is unknown";
+  return out;
+}
+
+ShardQueries::ShardQueries(const std::string& url, const std::string& client_id, std::chrono::milliseconds timeout,
+                           const std::string& ns, const protocol::ShardSet& set, double resolution)
+    : set_(set), resolution_(resolution) {
+  if (!(resolution > 0)) throw std::invalid_argument("a shard set's resolution must be > 0");
+  for (uint32_t i = 0; i < set.count; ++i)
+    clients_.push_back(
+        std::make_unique<QueryClient>(url, client_id, timeout, set.sharded() ? protocol::shard_namespace(ns, i) : ns));
+}
+
+uint32_t ShardQueries::shard_of_point(double x, double y, double z) const {
+  uint16_t key[3];
+  const double p[3] = {x, y, z};
+  for (int k = 0; k < 3; ++k) {  // OctoMap's coordToKeyChecked
+    const double scaled = std::floor((1.0 / resolution_) * p[k]);
+    if (!(scaled >= -32768.0 && scaled < 32768.0)) return set_.count;
+    key[k] = static_cast<uint16_t>(static_cast<int>(scaled) + 32768);
+  }
+  return protocol::shard_of(set_, protocol::region_coords(set_.region_depth, key[0], key[1], key[2]));
+}
+
+Routed<Occ> ShardQueries::points(const std::vector<float>& xyz, int depth) {
+  const size_t n = xyz.size() / 3;
+  Routed<Occ> out;
+  out.reply.num_results = static_cast<int32_t>(n);
+  out.reply.occupancy.assign(n, Occ::OCC_UNKNOWN);
+  out.reply.probability.assign(n, -1.0f);
+  const bool coarse = depth > 0 && depth < static_cast<int>(set_.region_depth);
+  std::vector<std::vector<size_t>> mine(set_.count);  // point indices each shard is asked
+  for (size_t j = 0; j < n; ++j) {
+    if (coarse) {
+      for (auto& m : mine) m.push_back(j);
+      continue;
+    }
+    const uint32_t s = shard_of_point(xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]);
+    if (s < set_.count) mine[s].push_back(j);  // outside the key range: unknown, as a server says
+  }
+  std::vector<uint32_t> asked;
+  for (uint32_t i = 0; i < set_.count; ++i)
+    if (!mine[i].empty()) asked.push_back(i);
+  const auto got = ask_each<Occ>(asked, set_.count, out.shards, [&](uint32_t i) {
+    std::vector<float> sub;
+    for (size_t j : mine[i]) sub.insert(sub.end(), {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]});
+    return clients_[i]->points(sub, depth);
+  });
+  merged_header(out.reply, got);
+  if (asked.empty()) out.reply.status = Occ::REPLY_OK, out.reply.error.clear();
+  for (uint32_t i = 0; i < set_.count; ++i) {
+    if (!got[i] || got[i]->num_results != static_cast<int32_t>(mine[i].size())) continue;
+    for (size_t k = 0; k < mine[i].size(); ++k) {
+      const size_t j = mine[i][k];
+      // A coarse node's value is the largest of its children's (OctoMap's inner nodes).
+      if (got[i]->probability[k] > out.reply.probability[j]) {
+        out.reply.probability[j] = got[i]->probability[k];
+        out.reply.occupancy[j] = got[i]->occupancy[k];
+      }
+    }
+  }
+  return out;
+}
+
+Routed<octomap_rt::box_reply_t> ShardQueries::boxes(const std::vector<Box>& boxes, int8_t mode) {
+  Routed<octomap_rt::box_reply_t> out;
+  const auto got = ask_each<octomap_rt::box_reply_t>(every_shard(set_.count), set_.count, out.shards,
+                                                     [&](uint32_t i) { return clients_[i]->boxes(boxes, mode); });
+  auto& r = out.reply;
+  merged_header(r, got);
+  const size_t n = boxes.size();
+  r.num_boxes = static_cast<int32_t>(n);
+  r.occupied.assign(n, 0), r.free.assign(n, 0), r.unknown.assign(n, 0), r.any_occupied.assign(n, 0);
+  r.cut = Occ::CUT_NONE, r.cut_at = -1;
+  std::vector<int64_t> voxels(n, -1);
+  for (const auto& g : got) {
+    if (!g || g->num_boxes != static_cast<int32_t>(n)) continue;
+    if (g->cut != Occ::CUT_NONE && (r.cut_at < 0 || g->cut_at < r.cut_at)) r.cut = g->cut, r.cut_at = g->cut_at;
+    for (size_t b = 0; b < n; ++b) {
+      r.occupied[b] += g->occupied[b], r.free[b] += g->free[b];
+      r.any_occupied[b] = static_cast<int8_t>(r.any_occupied[b] || g->any_occupied[b]);
+      voxels[b] = g->occupied[b] + g->free[b] + g->unknown[b];  // the box's voxels, the same on every shard
+    }
+  }
+  for (size_t b = 0; b < n; ++b) r.unknown[b] = voxels[b] < 0 ? 0 : voxels[b] - r.occupied[b] - r.free[b];
+  return out;
+}
+
+Routed<octomap_rt::ray_reply_t> ShardQueries::rays(const std::vector<float>& origins,
+                                                   const std::vector<float>& directions, float max_range,
+                                                   bool ignore_unknown) {
+  if (!ignore_unknown)
+    throw std::invalid_argument(
+        "a ray across shards needs ignore_unknown (--ignore-unknown): each shard knows only its own unknown space");
+  Routed<octomap_rt::ray_reply_t> out;
+  const auto got = ask_each<octomap_rt::ray_reply_t>(every_shard(set_.count), set_.count, out.shards, [&](uint32_t i) {
+    return clients_[i]->rays(origins, directions, max_range, ignore_unknown);
+  });
+  auto& r = out.reply;
+  merged_header(r, got);
+  const size_t n = origins.size() / 3;
+  r.num_rays = static_cast<int32_t>(n);
+  r.hit.assign(n, 0), r.end_state.assign(n, Occ::OCC_UNKNOWN), r.end_xyz.assign(3 * n, 0.0f);
+  r.num_xyz = static_cast<int32_t>(3 * n);
+  r.cut = Occ::CUT_NONE, r.cut_at = -1;
+  for (size_t j = 0; j < n; ++j) {
+    std::vector<const float*> hits;
+    std::vector<int> hit_shard;
+    for (uint32_t i = 0; i < set_.count; ++i) {
+      const auto& g = got[i];
+      if (!g || g->num_rays != static_cast<int32_t>(n) || !g->hit[j]) continue;
+      hits.push_back(&g->end_xyz[3 * j]);
+      hit_shard.push_back(static_cast<int>(i));
+    }
+    int from = hits.empty() ? -1
+               : hits.size() == 1
+                   ? hit_shard[0]
+                   : hit_shard[first_on_walk(&origins[3 * j], &directions[3 * j], max_range, resolution_, hits)];
+    if (from < 0) {  // no shard hit: every walk ended at the same place; its owner knows its state
+      for (uint32_t i = 0; i < set_.count && from < 0; ++i)
+        if (got[i] && got[i]->num_rays == static_cast<int32_t>(n)) from = static_cast<int>(i);
+      if (from < 0) continue;
+      const float* e = &got[from]->end_xyz[3 * j];
+      const uint32_t owner = shard_of_point(e[0], e[1], e[2]);
+      if (owner < set_.count && got[owner] && got[owner]->num_rays == static_cast<int32_t>(n))
+        from = static_cast<int>(owner);
+    }
+    const auto& g = *got[from];
+    r.hit[j] = g.hit[j], r.end_state[j] = g.end_state[j];
+    std::copy(&g.end_xyz[3 * j], &g.end_xyz[3 * j] + 3, &r.end_xyz[3 * j]);
+  }
+  for (const auto& g : got)
+    if (g && g->cut != Occ::CUT_NONE && (r.cut_at < 0 || g->cut_at < r.cut_at)) r.cut = g->cut, r.cut_at = g->cut_at;
+  return out;
+}
+
+}  // namespace ort::client

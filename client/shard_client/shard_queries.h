@@ -1,0 +1,57 @@
+// Queries across a shard set (docs/PROTOCOL.md, "Shards"): each shard answers for its own
+// regions, so a point goes to the shard owning its region (a coarse depth above the region
+// depth asks every shard and takes the largest value, as OctoMap's inner nodes do), a box is
+// counted on every shard and summed, and a ray is cast on every shard and gets the hit the ray
+// enters first. A shard that does not answer leaves its part unknown, and the answer says so.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "protocol/shards/shard_set.h"
+#include "query_client/query_client.h"
+
+namespace ort::client {
+
+// What every routed answer carries besides the reply itself.
+struct ShardAnswer {
+  std::vector<uint32_t> missing;      // shards that did not answer (timeout or refusal)
+  std::vector<std::string> errors;    // why, one per missing shard
+  std::vector<int64_t> snapshot_ids;  // each shard's map state id, by index (-1: none)
+  bool partial() const { return !missing.empty(); }
+  std::string shortfall() const;  // "shard 2 did not answer: ...; its part is unknown"
+};
+
+template <class Reply>
+struct Routed {
+  Reply reply{};  // merged; status REPLY_OK unless every shard refused
+  ShardAnswer shards;
+};
+
+class ShardQueries {
+ public:
+  // `set` and `resolution` as the shards announced them (ShardRoster); one QueryClient per
+  // shard on its own namespace protocol::shard_namespace(ns, i).
+  ShardQueries(const std::string& url, const std::string& client_id, std::chrono::milliseconds timeout,
+               const std::string& ns, const protocol::ShardSet& set, double resolution);
+
+  Routed<octomap_rt::occupancy_reply_t> points(const std::vector<float>& xyz, int depth = 0);
+  Routed<octomap_rt::box_reply_t> boxes(const std::vector<Box>& boxes, int8_t mode);
+  // Only with `ignore_unknown` (each shard knows only its own unknown space); throws
+  // std::invalid_argument otherwise.
+  Routed<octomap_rt::ray_reply_t> rays(const std::vector<float>& origins, const std::vector<float>& directions,
+                                       float max_range, bool ignore_unknown);
+
+  // The shard owning the voxel of point (x, y, z); set.count for a point outside the key range.
+  uint32_t shard_of_point(double x, double y, double z) const;
+
+ private:
+  protocol::ShardSet set_;
+  double resolution_;
+  std::vector<std::unique_ptr<QueryClient>> clients_;
+};
+
+}  // namespace ort::client

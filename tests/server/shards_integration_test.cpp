@@ -1,0 +1,164 @@
+// A shard set with real processes in a network namespace (docs/PROTOCOL.md, "Shards"): three
+// octomap-rt-server --shard i/3 in one namespace hear a robot's real scans (3DTK) over udpm.
+// The CLI finds them by their statuses and merges their snapshots into one .bt that is OctoMap's
+// map of those scans; points and rays routed by region get OctoMap's answers; with one shard
+// stopped, the map and the answers say they are partial and which shard is missing.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+
+#include <chrono>
+
+#include "cli/replay/scan_message.h"
+#include "integration_harness.h"
+#include "protocol/shards/shard_set.h"
+#include "query/point_query.h"
+#include "query/ray_query.h"
+#include "scene/scan_set.h"
+#include "shard_client/shard_queries.h"
+#include "shard_client/shard_roster.h"
+#include "support/octomap_reference.h"
+#include "support/test_data.h"
+#include "support/tree_compare.h"
+
+namespace ort::test {
+namespace {
+
+constexpr double kRes = 0.2;
+constexpr int kShards = 3;
+const char* kNs = "fleet";
+
+int64_t now_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// Every n-th end point of the scans, as x y z floats.
+std::vector<float> end_points(const ScanSet& set, size_t stride) {
+  std::vector<float> xyz;
+  for (const PosedScan& s : set.scans) {
+    const octomap::Pointcloud w = world_points(s);
+    for (size_t i = 0; i < w.size(); i += stride) xyz.insert(xyz.end(), {w[i].x(), w[i].y(), w[i].z()});
+  }
+  return xyz;
+}
+
+TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
+  const std::string graph = data_file("3dtk_dat/3dtk_3scans.graph");
+  if (graph.empty()) return;
+  const ScanSet scans = load_scan_graph(graph);
+  NetworkNamespace netns("shards");
+  ASSERT_TRUE(netns.ok()) << netns.error();
+  const std::string dir = make_test_dir("shards");
+  const std::string url = test_lcm_url(7, netns.rmem_max());
+  const std::string client_url = url.substr(0, url.find("&recv_buf_size"));
+  StatusWatcher status(url, protocol::channels_in(kNs).status);
+  std::vector<std::unique_ptr<ChildProcess>> shards;
+  for (int i = 0; i < kShards; ++i)
+    shards.push_back(std::make_unique<ChildProcess>(
+        std::vector<std::string>{server_program(), "--lcm-url", url, "-r", std::to_string(kRes), "--namespace", kNs,
+                                 "--shard", std::to_string(i) + "/" + std::to_string(kShards), "--warm-up-points", "0",
+                                 "--backend", "cpu"},
+        dir + "/shard" + std::to_string(i) + ".log"));
+  for (auto& s : shards) ASSERT_TRUE(status.wait_for([&](const auto& m) { return m.pid == s->pid(); }, 60)) << s->log();
+
+  lcm::LCM robot(client_url);
+  ASSERT_TRUE(robot.good());
+  for (size_t k = 0; k < scans.scans.size(); ++k) {
+    cli::ScanMessageFields fields;
+    fields.robot_id = "rover", fields.seq = static_cast<int64_t>(k), fields.utime = now_us();
+    const octomap_rt::scan_t msg = cli::make_scan_message(scans.scans[k], fields);
+    robot.publish(cli::scan_channel(protocol::channels_in(kNs).scan_prefix, "rover"), &msg);
+  }
+  const int64_t n = static_cast<int64_t>(scans.scans.size());
+  for (auto& s : shards)  // every shard applies every scan (each keeps its own regions' voxels)
+    ASSERT_TRUE(status.wait_for([&](const auto& m) { return m.pid == s->pid() && total_applied(m) == n; }, 120))
+        << s->log();
+  const auto reference = octomap_reference(scans, kRes, -1.0);
+
+  // The merged map, through the CLI: OctoMap's map of the scans (its .bt: max likelihood).
+  ChildProcess get({client_program(), "map", "get", "--shards", "--namespace", kNs, "--lcm-url", client_url, "-o",
+                    dir + "/merged.bt", "--timeout", "30", "--json"},
+                   dir + "/get.log");
+  ASSERT_EQ(get.wait(60), 0) << get.log();
+  EXPECT_NE(get.log().find("\"partial\": false"), std::string::npos) << get.log();
+  EXPECT_NE(get.log().find("\"snapshot_id\": 3"), std::string::npos) << get.log();
+  octomap::OcTree merged(kRes);
+  ASSERT_TRUE(merged.readBinary(dir + "/merged.bt"));
+  octomap::OcTree want(*reference);
+  want.toMaxLikelihood();
+  want.prune();
+  const TreeDiff d = compare_leaves(merged, want);
+  EXPECT_TRUE(d.maps_equal()) << d.differing_voxels << " voxels, " << d.differing_logodds
+                              << " log-odds differ: " << d.first_difference;
+  EXPECT_GT(d.leaves_a, 10000u);
+
+  // The shards side by side.
+  ChildProcess stat({client_program(), "status", "--shards", "--namespace", kNs, "--lcm-url", client_url, "--json"},
+                    dir + "/status.log");
+  ASSERT_EQ(stat.wait(30), 0) << stat.log();
+  EXPECT_NE(stat.log().find("\"count\": 3"), std::string::npos) << stat.log();
+  EXPECT_NE(stat.log().find("\"shortfall\": \"\""), std::string::npos) << stat.log();
+
+  // Points and rays routed by region: OctoMap's answers.
+  const client::ShardRoster roster = client::discover_shards(client_url, kNs, 5);
+  ASSERT_TRUE(roster.complete()) << roster.shortfall(now_us(), 3);
+  client::ShardQueries q(client_url, "planner", std::chrono::seconds(3), kNs, *roster.set(), roster.resolution());
+  const std::vector<float> xyz = end_points(scans, 50);
+  const auto points = q.points(xyz, 0);
+  ASSERT_FALSE(points.shards.partial()) << points.shards.shortfall();
+  const auto truth = query::query_points(*reference, xyz, 0);
+  int differing = 0;
+  for (size_t i = 0; i < truth.size(); ++i)
+    differing +=
+        points.reply.occupancy[i] != int8_t(truth[i].state) || points.reply.probability[i] != truth[i].probability;
+  EXPECT_EQ(differing, 0) << "of " << truth.size() << " points";
+  std::vector<float> origins, directions;
+  for (size_t i = 0; i + 3 <= xyz.size() && origins.size() < 3 * 300; i += 3 * 7) {
+    const octomap::point3d o = sensor_origin(scans.scans[0]);
+    origins.insert(origins.end(), {o.x(), o.y(), o.z()});
+    directions.insert(directions.end(), {xyz[i] - o.x(), xyz[i + 1] - o.y(), xyz[i + 2] - o.z()});
+  }
+  const auto rays = q.rays(origins, directions, 60.0f, true);
+  ASSERT_FALSE(rays.shards.partial()) << rays.shards.shortfall();
+  query::RayBatchOptions opt;
+  opt.ignore_unknown = true, opt.max_range = 60.0;
+  const auto cast = query::cast_rays(*reference, origins, directions, opt);
+  int ray_differing = 0, hits = 0;
+  for (size_t i = 0; i < cast.size(); ++i) {
+    hits += cast[i].hit;
+    ray_differing += rays.reply.hit[i] != cast[i].hit || rays.reply.end_xyz[3 * i] != cast[i].end.x() ||
+                     rays.reply.end_xyz[3 * i + 1] != cast[i].end.y() ||
+                     rays.reply.end_xyz[3 * i + 2] != cast[i].end.z();
+  }
+  EXPECT_EQ(ray_differing, 0) << "of " << cast.size() << " rays";
+  std::cerr << "origin " << origins[0] << " " << origins[1] << " " << origins[2] << " dir " << directions[0] << " "
+            << directions[1] << " " << directions[2] << "\n";
+  for (int i = 0; i < 3; ++i) {
+    client::QueryClient one(client_url, "dbg", std::chrono::seconds(3), protocol::shard_namespace(kNs, i));
+    const auto r =
+        one.rays({origins[0], origins[1], origins[2]}, {directions[0], directions[1], directions[2]}, 60.0f, true);
+    std::cerr << "shard " << i << " hit " << int(r.hit[0]) << " at " << r.end_xyz[0] << " " << r.end_xyz[1] << " "
+              << r.end_xyz[2] << "\n";
+  }
+  EXPECT_GT(hits, static_cast<int>(cast.size() / 2));
+
+  // Shard 2 stops: a merged map and a routed answer say what is missing.
+  shards[2]->signal(SIGTERM);
+  ASSERT_EQ(shards[2]->wait(60), 0) << shards[2]->log();
+  ChildProcess partial({client_program(), "map", "get", "--shards", "--namespace", kNs, "--lcm-url", client_url, "-o",
+                        dir + "/partial.bt", "--timeout", "3"},
+                       dir + "/partial.log");
+  EXPECT_EQ(partial.wait(60), 1) << partial.log();  // without --partial: refused, nothing written
+  EXPECT_NE(partial.log().find("shard 2 of 3 missing"), std::string::npos) << partial.log();
+  const auto after = q.points(xyz, 0);
+  ASSERT_TRUE(after.shards.partial());
+  EXPECT_EQ(after.shards.missing, std::vector<uint32_t>{2});
+  EXPECT_NE(after.shards.shortfall().find("shard 2 did not answer"), std::string::npos);
+  for (auto& s : shards)
+    if (s->running()) s->signal(SIGTERM);
+  for (int i = 0; i < 2; ++i) EXPECT_EQ(shards[i]->wait(60), 0) << shards[i]->log();
+}
+
+}  // namespace
+}  // namespace ort::test
