@@ -1,0 +1,142 @@
+// octomap-rt-shard-bench GRAPH -r RES [--shards 1,2,3,4] [--depth 10] [--backend cpu-grid]
+//
+// One process, one thread a stage: every scan is encoded as a robot sends it (scan_t), decoded
+// as the daemon's LCM thread decodes it, shot once (every shard walks every ray: the walk is
+// the same for all) and, for each set size N, cut to each shard's regions and applied to that
+// shard's tree. Prints per scan: the bus bytes, decode and walk time (paid by every shard), the
+// cut, and the octree update of the busiest shard against one daemon's; then whether the
+// merged map equals the one-daemon map node for node. Times are of this process on this
+// machine; with a core per daemon, a set's rate is bounded by decode + walk + cut + its
+// busiest shard's update (docs/BENCHMARKS.md, "Shards").
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/replay/scan_message.h"
+#include "core/backend_kind.h"
+#include "daemon/intake/scan_to_map.h"
+#include "daemon/pipeline/shard_filter.h"
+#include "engine/map_engine.h"
+#include "map_client/shard_merge.h"
+#include "protocol/scan_decode.h"
+#include "scene/scan_set.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+std::vector<int> parse_list(const std::string& s) {
+  std::vector<int> out;
+  std::stringstream in(s);
+  for (std::string item; std::getline(in, item, ',');) out.push_back(std::stoi(item));
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("octomap-rt-shard-bench: per-shard cost of a shard set against one daemon");
+  std::string input, backend = "cpu-grid", shards = "1,2,3,4";
+  double res = 0.1, max_range = -1;
+  unsigned depth = 10;
+  int repeat = 1;
+  app.add_option("input", input, "ScanGraph file (.graph)")->required();
+  app.add_option("-r,--resolution", res, "[m]")->capture_default_str();
+  app.add_option("--max-range", max_range, "[m]; < 0: none")->capture_default_str();
+  app.add_option("--shards", shards, "set sizes, comma-separated")->capture_default_str();
+  app.add_option("--depth", depth, "region depth (1..16)")->capture_default_str();
+  app.add_option("--backend", backend, "ray back end (cpu, cpu-grid, vulkan)")->capture_default_str();
+  app.add_option("--repeat", repeat, "go over the scans this many times")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  const ort::ScanSet set = ort::load_scan_graph(input);
+  ort::EngineOptions opts;
+  opts.resolution = res, opts.max_range = max_range;
+  if (!ort::parse_backend(backend, opts.backend.kind)) {
+    std::fprintf(stderr, "octomap-rt-shard-bench: unknown back end '%s'\n", backend.c_str());
+    return 2;
+  }
+  opts.octree.threads = 1;  // one core per daemon
+  ort::MapEngine engine(opts);
+  const std::vector<int> sizes = parse_list(shards);
+  struct PerSize {
+    std::vector<std::unique_ptr<octomap::OcTree>> trees;
+    std::vector<ort::daemon::ShardFilter> filters;
+    std::vector<double> cut_ms, apply_ms;
+    std::vector<uint64_t> voxels;
+  };
+  std::vector<PerSize> runs(sizes.size());
+  for (size_t s = 0; s < sizes.size(); ++s)
+    for (int i = 0; i < sizes[s]; ++i) {
+      ort::protocol::ShardSet sh;
+      if (sizes[s] > 1) sh.index = i, sh.count = sizes[s], sh.rule = ort::protocol::ShardRule::kHash;
+      sh.region_depth = depth;
+      runs[s].trees.push_back(engine.make_tree());
+      runs[s].filters.emplace_back(sh);
+      runs[s].cut_ms.push_back(0), runs[s].apply_ms.push_back(0), runs[s].voxels.push_back(0);
+    }
+  double decode_ms = 0, walk_ms = 0;
+  uint64_t bytes = 0, scans = 0;
+  ort::ShotScan shot;
+  for (int rep = 0; rep < repeat; ++rep)
+    for (size_t k = 0; k < set.scans.size(); ++k, ++scans) {
+      ort::cli::ScanMessageFields f;
+      f.robot_id = "bench", f.seq = static_cast<int64_t>(scans);
+      const octomap_rt::scan_t msg = ort::cli::make_scan_message(set.scans[k], f);
+      std::vector<uint8_t> wire(static_cast<size_t>(msg.getEncodedSize()));
+      msg.encode(wire.data(), 0, static_cast<int>(wire.size()));
+      bytes += wire.size();
+      octomap_rt::scan_t got;
+      auto t = Clock::now();
+      ort::protocol::decode_scan(wire.data(), wire.size(), got);
+      decode_ms += ms_since(t);
+      const octomap::pose6d pose = ort::daemon::scan_pose(got);
+      const std::span<const float> xyz(got.xyz.data(), got.xyz.size());
+      t = Clock::now();
+      engine.shoot_posed_xyz(pose, pose.trans(), xyz, max_range, shot);
+      walk_ms += ms_since(t);
+      for (PerSize& run : runs)
+        for (size_t i = 0; i < run.trees.size(); ++i) {
+          ort::ShotScan mine = shot;
+          t = Clock::now();
+          run.filters[i].keep_owned(mine);
+          run.cut_ms[i] += ms_since(t);
+          run.voxels[i] += mine.voxels.size();
+          t = Clock::now();
+          engine.apply(mine, *run.trees[i]);
+          run.apply_ms[i] += ms_since(t);
+        }
+    }
+  const double n = static_cast<double>(scans);
+  std::printf("%s: %llu scans, %.1f MB a scan on the bus, resolution %g m, regions at depth %u, back end %s\n",
+              input.c_str(), (unsigned long long)scans, bytes / n / 1e6, res, depth, backend.c_str());
+  std::printf("every shard: decode %.2f ms, walk %.2f ms a scan\n", decode_ms / n, walk_ms / n);
+  std::printf("%6s %12s %14s %14s %12s %14s %10s\n", "shards", "cut ms", "update ms max", "update ms mean",
+              "voxels max", "bound scans/s", "merged");
+  const octomap::OcTree* whole = nullptr;
+  for (size_t s = 0; s < sizes.size(); ++s)
+    if (sizes[s] == 1) whole = runs[s].trees[0].get();
+  for (size_t s = 0; s < sizes.size(); ++s) {
+    const PerSize& r = runs[s];
+    const double cut = *std::max_element(r.cut_ms.begin(), r.cut_ms.end()) / n;
+    const double upd_max = *std::max_element(r.apply_ms.begin(), r.apply_ms.end()) / n;
+    double upd_sum = 0;
+    for (double a : r.apply_ms) upd_sum += a;
+    const uint64_t vox = *std::max_element(r.voxels.begin(), r.voxels.end());
+    std::string merged = "-";
+    if (whole && sizes[s] > 1) {
+      std::vector<const octomap::OcTree*> views;
+      for (const auto& t : r.trees) views.push_back(t.get());
+      const auto m = ort::client::merge_shard_trees(views, depth);
+      merged = (m->size() == whole->size() && *m == *whole) ? "identical" : "DIFFERS";
+    }
+    std::printf("%6d %12.2f %14.2f %14.2f %12.0f %14.1f %10s\n", sizes[s], cut, upd_max, upd_sum / n / r.trees.size(),
+                vox / n, 1000.0 / (decode_ms / n + walk_ms / n + cut + upd_max), merged.c_str());
+  }
+  return 0;
+}
