@@ -61,6 +61,7 @@ Channels channels_in(std::string_view ns) {
   c.query_rays = name(kQueryRaysChannel);
   c.query_boxes = name(kQueryBoxesChannel);
   c.query_grid = name(kQueryGridChannel);
+  c.query_distance = name(kQueryDistanceChannel);
   c.map_edit = name(kMapEditChannel);
   c.query_reply_prefix = prefix(kQueryReplyPrefix);
   c.grid = name(kGridChannel);

@@ -35,6 +35,10 @@ inline constexpr const char* kQueryRaysChannel = "OCTOMAP_RT_QUERY_RAYS";
 inline constexpr const char* kQueryBoxesChannel = "OCTOMAP_RT_QUERY_BOXES";
 // grid_query_t -> grid_t rows.
 inline constexpr const char* kQueryGridChannel = "OCTOMAP_RT_QUERY_GRID";
+// distance_query_t -> distance_points_reply_t, distance_box_chunk_t (a box's field, zstd, in
+// chunks) or distance_path_reply_t: distance to the nearest obstacle. Short, so that no name
+// is longer than OCTOMAP_RT_MAP_REQUEST and a 40-character namespace still fits every one.
+inline constexpr const char* kQueryDistanceChannel = "OCTOMAP_RT_QUERY_DIST";
 // map_edit_t -> map_edit_ack_t: clear a box, reset (refused without the control token).
 inline constexpr const char* kMapEditChannel = "OCTOMAP_RT_MAP_EDIT";
 inline constexpr const char* kQueryReplyPrefix = "OCTOMAP_RT_REPLY_";
@@ -57,7 +61,7 @@ inline constexpr size_t kMaxChannelLength = 63;
 struct Channels {
   std::string ns;  // "" = today's names
   std::string scan_prefix, status, map_request, map_info, map_delta, map_reply_prefix, query_points, query_rays,
-      query_boxes, query_grid, map_edit, query_reply_prefix, grid, octomap_raw;
+      query_boxes, query_grid, query_distance, map_edit, query_reply_prefix, grid, octomap_raw;
 
   // The server's default scan subscription: every scan channel of the namespace.
   std::string scan_regex() const { return scan_prefix + ".*"; }

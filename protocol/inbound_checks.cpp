@@ -3,6 +3,7 @@
 #include "protocol/limits.h"
 
 #include "octomap_rt/box_query_t.hpp"
+#include "octomap_rt/distance_query_t.hpp"
 #include "octomap_rt/grid_query_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/occupancy_query_t.hpp"
@@ -65,6 +66,12 @@ WireCheck check_box_query_bytes(const uint8_t* d, size_t n) {
 WireCheck check_grid_query_bytes(const uint8_t* d, size_t n) {
   return walk(d, n, kMaxInboundQueryBytes, octomap_rt::grid_query_t::getHash(),
               {fixed(kQueryHeader + 8 * 3 + 1 + 16 + 16), str(kClientId), str(kReplyChannel), str(kMaxRobotIdLength)});
+}
+WireCheck check_distance_query_bytes(const uint8_t* d, size_t n) {
+  // mode, unknown_as, with_gradient, cell_voxels, max_distance, box_min, box_max.
+  return walk(d, n, kMaxInboundQueryBytes, octomap_rt::distance_query_t::getHash(),
+              {fixed(kQueryHeader + 1 + 1 + 1 + 4 + 8 + 24 + 24), count(3 * kMaxQueryPoints), array(4), str(kClientId),
+               str(kReplyChannel), str(kMaxRobotIdLength)});
 }
 WireCheck check_map_edit_bytes(const uint8_t* d, size_t n) {
   return walk(d, n, kMaxInboundQueryBytes, octomap_rt::map_edit_t::getHash(),

@@ -42,6 +42,7 @@ WireCheck check_occupancy_query_bytes(const uint8_t* data, size_t size);
 WireCheck check_ray_query_bytes(const uint8_t* data, size_t size);
 WireCheck check_box_query_bytes(const uint8_t* data, size_t size);
 WireCheck check_grid_query_bytes(const uint8_t* data, size_t size);
+WireCheck check_distance_query_bytes(const uint8_t* data, size_t size);
 WireCheck check_map_edit_bytes(const uint8_t* data, size_t size);
 
 // --- Client side --------------------------------------------------------------------------

@@ -1,8 +1,8 @@
 # client/cli/: the `octomap-rt` command-line program. One file per subcommand (*_command.cpp);
 # everything but main.cpp is the library octomap_rt_client (also linked by the load test and
-# the integration tests); bench/, replay/ and status/ hold the helpers of those subcommands.
+# the integration tests); bench/, query/, replay/ and status/ hold the helpers of those subcommands.
 file(GLOB CLI_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_LIST_DIR}/*.cpp ${CMAKE_CURRENT_LIST_DIR}/bench/*.cpp
-     ${CMAKE_CURRENT_LIST_DIR}/replay/*.cpp)
+     ${CMAKE_CURRENT_LIST_DIR}/query/*.cpp ${CMAKE_CURRENT_LIST_DIR}/replay/*.cpp)
 list(FILTER CLI_SOURCES EXCLUDE REGEX "/main\\.cpp$")
 add_library(octomap_rt_client STATIC ${CLI_SOURCES})
 target_include_directories(octomap_rt_client PUBLIC ${CMAKE_CURRENT_LIST_DIR}/..)

@@ -1,4 +1,4 @@
-// `octomap-rt query points|rays|box|grid`: ask a running octomap-rt-server about its map
+// `octomap-rt query points|rays|box|grid|distance`: ask a running octomap-rt-server about its map
 // (the query service, docs/ARCHITECTURE.md "Queries"); text or one JSON document on stdout.
 #include <unistd.h>
 
@@ -8,6 +8,7 @@
 #include "cli/commands.h"
 #include "cli/grid_picture.h"
 #include "cli/namespace_flag.h"
+#include "cli/query/query_common.h"
 #include "cli/shard_commands.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "protocol/lcm_url.h"
@@ -20,24 +21,9 @@ namespace {
 
 using namespace ort::client;
 
-struct CommonArgs {
-  std::string lcm_url, client_id, ns;
-  double timeout_s = 5;
-  bool json = false, shards = false;
-  std::string wait_robot;
-  int64_t wait_seq = -1;
-  int64_t min_snapshot = 0;
-};
-
-void add_common(CLI::App* cmd, CommonArgs& a) {
-  cmd->add_option("--lcm-url", a.lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else the host-local udpm URL)");
-  add_namespace_flag(cmd, a.ns);
-  cmd->add_option("--timeout", a.timeout_s, "seconds to wait for the answer")->capture_default_str();
-  cmd->add_flag("--json", a.json, "one JSON document on stdout");
-  cmd->add_option("--client-id", a.client_id, "client name (default cli-<pid>); replies come on OCTOMAP_RT_REPLY_<ID>");
-  cmd->add_option("--wait-robot", a.wait_robot, "answer only once this robot's --wait-seq scan is applied");
-  cmd->add_option("--wait-seq", a.wait_seq, "the scan seq to wait for (with --wait-robot)");
-  cmd->add_option("--min-snapshot", a.min_snapshot, "answer from map state >= this");
+// The flags every subcommand here shares, and --shards (distance queries are not routed).
+void add_query_flags(CLI::App* cmd, CommonArgs& a) {
+  add_common(cmd, a);
   cmd->add_flag("--shards", a.shards,
                 "the namespace is a shard set (octomap-rt-server --shard): route by region, say which shard did "
                 "not answer (exit status 3); no --wait-robot/--min-snapshot");
@@ -61,37 +47,13 @@ R routed(const Routed<R>& r, bool& partial) {
   return r.reply;
 }
 
-std::unique_ptr<QueryClient> connect(const CommonArgs& a) {
-  const std::string id = a.client_id.empty() ? "cli-" + std::to_string(::getpid()) : a.client_id;
-  return std::make_unique<QueryClient>(ort::protocol::lcm_url_or_default(a.lcm_url), id,
-                                       std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)),
-                                       protocol::namespace_from(a.ns));
-}
-
-WaitFor wait_for(const CommonArgs& a) {
-  WaitFor w;
-  w.min_snapshot_id = a.min_snapshot;
-  w.robot_id = a.wait_robot;
-  w.seq = a.wait_seq;
-  w.timeout_ms = static_cast<int>(a.timeout_s * 1000 * 0.8);
-  return w;
-}
-
-// Non-OK replies: the reason on stderr, exit status 2.
-template <class R>
-bool refused(const R& r) {
-  if (r.status == 0) return false;
-  std::cerr << "octomap-rt query: " << status_name(r.status) << ": " << r.error << "\n";
-  return true;
-}
-
 void register_points(CLI::App& parent) {
   auto* cmd = parent.add_subcommand("points", "occupancy of points: unknown / free / occupied and probability");
   auto a = std::make_shared<CommonArgs>();
   auto pts = std::make_shared<std::vector<std::string>>();
   auto file = std::make_shared<std::string>();
   auto depth = std::make_shared<int>(0);
-  add_common(cmd, *a);
+  add_query_flags(cmd, *a);
   cmd->add_option("points", *pts, "X,Y,Z points [m]");
   cmd->add_option("--file", *file, "points from a file, three numbers a line");
   cmd->add_option("--depth", *depth, "OctoMap search depth 1..16; 0: finest")->capture_default_str();
@@ -121,7 +83,7 @@ void register_rays(CLI::App& parent) {
   auto rays = std::make_shared<std::vector<std::string>>();
   auto max_range = std::make_shared<float>(-1.f);
   auto ignore = std::make_shared<bool>(false);
-  add_common(cmd, *a);
+  add_query_flags(cmd, *a);
   cmd->add_option("rays", *rays, "OX,OY,OZ:DX,DY,DZ (origin : direction)")->required();
   cmd->add_option("--max-range", *max_range, "[m]; <= 0: none")->capture_default_str();
   cmd->add_flag("--ignore-unknown", *ignore, "pass through unknown voxels (needs --max-range)");
@@ -152,7 +114,7 @@ void register_box(CLI::App& parent) {
   auto any = std::make_shared<bool>(false), region = std::make_shared<bool>(false),
        free = std::make_shared<bool>(false);
   auto depth = std::make_shared<int>(0);
-  add_common(cmd, *a);
+  add_query_flags(cmd, *a);
   cmd->add_option("boxes", *boxes, "MINX,MINY,MINZ:MAXX,MAXY,MAXZ [m]")->required();
   cmd->add_flag("--any", *any, "only whether any voxel is occupied (stops at the first)");
   cmd->add_flag("--region", *region, "list the box's occupied nodes (one box)");
@@ -205,7 +167,7 @@ void register_grid(CLI::App& parent) {
   auto z = std::make_shared<std::string>(), window = std::make_shared<std::string>(),
        out = std::make_shared<std::string>();
   auto cell = std::make_shared<double>(0);
-  add_common(cmd, *a);
+  add_query_flags(cmd, *a);
   cmd->add_option("--z", *z, "z band MIN:MAX [m]")->required();
   cmd->add_option("--cell", *cell, "cell size [m], a multiple of the resolution; 0: the resolution");
   cmd->add_option("--window", *window, "X0,Y0:X1,Y1 [m] (default: the map's extent)");
@@ -243,6 +205,7 @@ void register_query_command(CLI::App& app) {
   register_rays(*cmd);
   register_box(*cmd);
   register_grid(*cmd);
+  register_distance_command(*cmd);
 }
 
 }  // namespace ort::cli

@@ -1,10 +1,12 @@
 // octomap-rt-plan: an example planner on the query service. It asks the server for the 2D
 // grid of a z band, plans a path between two points with A* over free cells (8-connected),
-// checks the robot's footprint along the path with box queries (any occupied voxel in a
-// box of --radius around each cell, over the band), replans around cells that fail, and
-// prints the path.
+// checks the robot's clearance along the path with distance queries (the distance to the
+// nearest obstacle at each cell's centre, at heights through the band, must be at least
+// --radius: no obstacles grown on the client), replans around cells that fail, and prints
+// the path with its smallest clearance.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -13,7 +15,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include "octomap_rt/box_query_t.hpp"
 #include "protocol/channels.h"
 #include "protocol/lcm_url.h"
 #include "protocol/limits.h"
@@ -74,7 +75,7 @@ std::vector<Cell> astar(const Grid& g, const std::vector<bool>& blocked, Cell fr
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"octomap-rt-plan: A* on the server's 2D grid, footprint checked with box queries"};
+  CLI::App app{"octomap-rt-plan: A* on the server's 2D grid, clearance checked with distance queries"};
   std::string from_s, to_s, z_s = "0.1:1.5", lcm_url, ns;
   double cell = 0, radius = 0.3, timeout_s = 10;
   bool json = false;
@@ -82,14 +83,14 @@ int main(int argc, char** argv) {
   app.add_option("--to", to_s, "goal X,Y [m]")->required();
   app.add_option("--z", z_s, "z band MIN:MAX [m] the robot occupies")->capture_default_str();
   app.add_option("--cell", cell, "grid cell [m] (a multiple of the resolution; 0: the resolution)");
-  app.add_option("--radius", radius, "footprint half-width [m]")->capture_default_str();
+  app.add_option("--radius", radius, "robot radius [m]: the clearance every path cell needs")->capture_default_str();
   app.add_option("--lcm-url", lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else the host-local udpm URL)");
   app.add_option("--timeout", timeout_s, "seconds to wait for each answer")->capture_default_str();
   app.add_option("--namespace", ns,
                  std::string("the server's namespace (its --namespace); default: $") + ort::protocol::kNamespaceEnv);
   app.add_flag("--json", json,
                "one JSON document on stdout: {\"found\", \"reason\", \"snapshot_id\", \"cells\", \"length_m\", "
-               "\"attempts\", \"path\": [[x, y], ...]}");
+               "\"clearance_m\", \"attempts\", \"path\": [[x, y], ...]}");
   app.set_version_flag("--version", std::string("octomap-rt-plan ") + OCTOMAP_RT_VERSION + " (protocol version " +
                                         std::to_string(ort::protocol::kProtocolVersion) + ")");
   CLI11_PARSE(app, argc, argv);
@@ -129,27 +130,34 @@ int main(int argc, char** argv) {
                       to[1]);
         return no_path(why, g.header.snapshot_id);
       }
-      std::vector<ort::client::Box> boxes;
+      // Each cell's centre at heights through the band, one resolution apart at most.
+      const int levels = std::max(1, int(std::ceil((z1 - z0) / cs)) + 1);
+      std::vector<float> xyz;
       for (const Cell& c : path)
-        boxes.push_back(
-            {{centre(c, 0) - radius, centre(c, 1) - radius, z0}, {centre(c, 0) + radius, centre(c, 1) + radius, z1}});
+        for (int l = 0; l < levels; ++l)
+          xyz.insert(xyz.end(), {float(centre(c, 0)), float(centre(c, 1)),
+                                 float(levels == 1 ? z0 : z0 + (z1 - z0) * l / (levels - 1))});
+      ort::client::DistanceRequest need;
+      need.max_distance = radius + cs;  // enough to tell clear from not
       int failed = 0;
-      const size_t per_query = ort::protocol::kMaxQueryBoxes;
-      for (size_t first = 0; first < boxes.size(); first += per_query) {
-        const std::vector<ort::client::Box> part(boxes.begin() + first,
-                                                 boxes.begin() + std::min(boxes.size(), first + per_query));
-        const auto r = client.boxes(part, octomap_rt::box_query_t::MODE_ANY_OCCUPIED);
-        if (r.status != 0) throw std::runtime_error("box query refused: " + r.error);
-        for (int k = 0; k < r.num_boxes; ++k)
-          if (r.any_occupied[k]) {
-            const Cell c = path[first + k];
+      float lowest = float(need.max_distance);
+      const size_t per_query = size_t(ort::protocol::kMaxQueryPoints / levels) * levels;
+      for (size_t first = 0; first < xyz.size(); first += 3 * per_query) {
+        const std::vector<float> part(xyz.begin() + first, xyz.begin() + std::min(xyz.size(), first + 3 * per_query));
+        const auto r = client.distance_points(part, need);
+        if (r.status != 0) throw std::runtime_error("distance query refused: " + r.error);
+        for (int k = 0; k < r.num_points; ++k) {
+          lowest = std::min(lowest, r.distance[k]);
+          const Cell c = path[(first / 3 + k) / levels];
+          if (r.distance[k] < radius && !blocked[size_t(c.j) * g.header.width + c.i]) {
             blocked[size_t(c.j) * g.header.width + c.i] = true;
             ++failed;
           }
+        }
       }
       if (failed) {
         if (!json)
-          std::printf("attempt %d: %zu cells, %d fail the %g m footprint check; replanning\n", attempt, path.size(),
+          std::printf("attempt %d: %zu cells, %d closer than %g m to an obstacle; replanning\n", attempt, path.size(),
                       failed, radius);
         continue;
       }
@@ -158,20 +166,22 @@ int main(int argc, char** argv) {
         length += cs * std::hypot(path[k].i - path[k - 1].i, path[k].j - path[k - 1].j);
       if (json) {
         std::printf(
-            "{\"found\": true, \"snapshot_id\": %lld, \"cells\": %zu, \"length_m\": %.3f, \"attempts\": %d, "
-            "\"path\": [",
-            (long long)g.header.snapshot_id, path.size(), length, attempt);
+            "{\"found\": true, \"snapshot_id\": %lld, \"cells\": %zu, \"length_m\": %.3f, \"clearance_m\": %.3f, "
+            "\"attempts\": %d, \"path\": [",
+            (long long)g.header.snapshot_id, path.size(), length, lowest, attempt);
         for (size_t k = 0; k < path.size(); ++k)
           std::printf("%s[%.3f, %.3f]", k ? ", " : "", centre(path[k], 0), centre(path[k], 1));
         std::printf("]}\n");
         return 0;
       }
-      std::printf("path: %zu cells, %.2f m, footprint %g m clear (%d box queries)\n", path.size(), length, radius,
-                  attempt);
+      std::printf("path: %zu cells, %.2f m, clearance %.2f m >= %g m (%d attempts)\n", path.size(), length, lowest,
+                  radius, attempt);
       for (const Cell& c : path) std::printf("  %.3f %.3f\n", centre(c, 0), centre(c, 1));
       return 0;
     }
-    return no_path("no footprint-clear path after 8 attempts", g.header.snapshot_id);
+    char why[96];
+    std::snprintf(why, sizeof why, "no path with %g m clearance after 8 attempts", radius);
+    return no_path(why, g.header.snapshot_id);
   } catch (const std::exception& e) {
     std::cerr << "octomap-rt-plan: " << e.what() << "\n";
     return 1;

@@ -2,7 +2,8 @@
 # command-line arguments and JSON output: used by `octomap-rt query|map` and client/examples/.
 # No renderer: the grid's picture is the CLI's (cli/grid_picture).
 add_library(octomap_rt_query_client STATIC ${CMAKE_CURRENT_LIST_DIR}/query_client.cpp
-            ${CMAKE_CURRENT_LIST_DIR}/query_json.cpp ${CMAKE_CURRENT_LIST_DIR}/query_args.cpp)
+            ${CMAKE_CURRENT_LIST_DIR}/query_json.cpp ${CMAKE_CURRENT_LIST_DIR}/query_args.cpp
+            ${CMAKE_CURRENT_LIST_DIR}/distance_box.cpp)
 target_include_directories(octomap_rt_query_client PUBLIC ${CMAKE_CURRENT_LIST_DIR}/..)
 target_link_libraries(octomap_rt_query_client PUBLIC octomap_rt_protocol octomap_rt_lcmtypes octomap_rt_lcm)
 octomap_rt_lcm_handler_sources(octomap_rt_query_client ${CMAKE_CURRENT_LIST_DIR}/query_client.cpp)

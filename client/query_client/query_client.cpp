@@ -6,6 +6,7 @@
 #include <cctype>
 
 #include "octomap_rt/box_query_t.hpp"
+#include "octomap_rt/distance_query_t.hpp"
 #include "octomap_rt/grid_query_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/occupancy_query_t.hpp"
@@ -167,6 +168,51 @@ Grid QueryClient::grid(double z_min, double z_max, double cell_size, const Box* 
   for (const auto& r : rows)
     std::copy(r.cells.begin(), r.cells.end(), g.cells.begin() + size_t(r.row_start) * g.header.width);
   return g;
+}
+
+namespace {
+octomap_rt::distance_query_t distance_query(int8_t mode, const DistanceRequest& d) {
+  octomap_rt::distance_query_t q{};
+  q.mode = mode;
+  q.max_distance = d.max_distance;
+  q.unknown_as = d.unknown_occupied ? q.UNKNOWN_OCCUPIED : q.UNKNOWN_FREE;
+  q.with_gradient = d.gradient;
+  q.cell_voxels = d.cell_voxels;
+  return q;
+}
+}  // namespace
+
+octomap_rt::distance_points_reply_t QueryClient::distance_points(const std::vector<float>& xyz,
+                                                                 const DistanceRequest& d, const WaitFor& w) {
+  auto q = distance_query(octomap_rt::distance_query_t::MODE_POINTS, d);
+  address(q, w);
+  q.xyz = xyz;
+  q.num_xyz = static_cast<int32_t>(xyz.size());
+  return exchange<octomap_rt::distance_points_reply_t>(channels_.query_distance, q,
+                                                       one<octomap_rt::distance_points_reply_t>)
+      .front();
+}
+
+DistanceBox QueryClient::distance_box(const Box& b, const DistanceRequest& d, const WaitFor& w) {
+  auto q = distance_query(octomap_rt::distance_query_t::MODE_BOX, d);
+  address(q, w);
+  std::copy(b.min, b.min + 3, q.box_min);
+  std::copy(b.max, b.max + 3, q.box_max);
+  const auto chunks = exchange<octomap_rt::distance_box_chunk_t>(channels_.query_distance, q, [](const auto& r) {
+    return !r.empty() && (r[0].status != 0 || static_cast<int>(r.size()) >= r[0].num_chunks);
+  });
+  return assemble_distance_box(chunks);
+}
+
+octomap_rt::distance_path_reply_t QueryClient::distance_path(const std::vector<float>& vertices,
+                                                             const DistanceRequest& d, const WaitFor& w) {
+  auto q = distance_query(octomap_rt::distance_query_t::MODE_PATH, d);
+  address(q, w);
+  q.xyz = vertices;
+  q.num_xyz = static_cast<int32_t>(vertices.size());
+  return exchange<octomap_rt::distance_path_reply_t>(channels_.query_distance, q,
+                                                     one<octomap_rt::distance_path_reply_t>)
+      .front();
 }
 
 octomap_rt::map_edit_ack_t QueryClient::edit(int8_t op, const Box& b, const std::string& token, int8_t flags) {

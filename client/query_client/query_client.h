@@ -13,12 +13,15 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "octomap_rt/box_reply_t.hpp"
+#include "octomap_rt/distance_path_reply_t.hpp"
+#include "octomap_rt/distance_points_reply_t.hpp"
 #include "octomap_rt/grid_t.hpp"
 #include "octomap_rt/map_edit_ack_t.hpp"
 #include "octomap_rt/occupancy_reply_t.hpp"
 #include "octomap_rt/ray_reply_t.hpp"
 #include "octomap_rt/region_chunk_t.hpp"
 #include "protocol/channels.h"
+#include "query_client/distance_box.h"
 
 namespace ort::client {
 
@@ -45,6 +48,14 @@ struct Grid {
   std::vector<int8_t> cells;  // width * height, row-major, OCC_*
 };
 
+// What a distance query asks (docs/PROTOCOL.md, "Distance queries").
+struct DistanceRequest {
+  double max_distance = 2.0;  // [m]
+  bool unknown_occupied = false;
+  bool gradient = false;
+  int cell_voxels = 1;  // boxes: cells of this many finest voxels a side
+};
+
 class QueryClient {
  public:
   // `url`: as ort::protocol::lcm_url_or_default(); `client_id`: 1..64 of [A-Za-z0-9_.-].
@@ -60,6 +71,12 @@ class QueryClient {
   octomap_rt::box_reply_t boxes(const std::vector<Box>& boxes, int8_t mode, const WaitFor& w = {});
   std::vector<octomap_rt::region_chunk_t> region(const Box& box, int depth, bool include_free, const WaitFor& w = {});
   Grid grid(double z_min, double z_max, double cell_size, const Box* window, const WaitFor& w = {});
+  // Distance to the nearest obstacle: of points, of every cell of a box, along a polyline.
+  octomap_rt::distance_points_reply_t distance_points(const std::vector<float>& xyz, const DistanceRequest& d,
+                                                      const WaitFor& w = {});
+  DistanceBox distance_box(const Box& box, const DistanceRequest& d, const WaitFor& w = {});
+  octomap_rt::distance_path_reply_t distance_path(const std::vector<float>& vertices, const DistanceRequest& d,
+                                                  const WaitFor& w = {});
   // op: map_edit_t.OP_*; box ignored for OP_RESET; flags: map_edit_t.FLAG_*.
   octomap_rt::map_edit_ack_t edit(int8_t op, const Box& box, const std::string& token, int8_t flags = 0);
 

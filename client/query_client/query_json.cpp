@@ -29,6 +29,8 @@ void head(std::ostream& out, const R& r) {
 
 }  // namespace
 
+std::string json_quoted(const std::string& s) { return quoted(s); }
+
 const char* state_name(int8_t occ) { return occ == 2 ? "occupied" : occ == 1 ? "free" : "unknown"; }
 const char* status_name(int8_t s) {
   switch (s) {

@@ -15,7 +15,8 @@ void write_boxes_json(std::ostream& out, const octomap_rt::box_reply_t& r);
 void write_region_json(std::ostream& out, const std::vector<octomap_rt::region_chunk_t>& chunks);
 void write_grid_json(std::ostream& out, const Grid& g, const std::string& png_path);
 void write_edit_json(std::ostream& out, const octomap_rt::map_edit_ack_t& a);
-const char* state_name(int8_t occ);      // "unknown", "free", "occupied"
-const char* status_name(int8_t status);  // "ok", "bad request", "not ready", "busy", "refused"
+const char* state_name(int8_t occ);             // "unknown", "free", "occupied"
+const char* status_name(int8_t status);         // "ok", "bad request", "not ready", "busy", "refused"
+std::string json_quoted(const std::string& s);  // a JSON string literal
 
 }  // namespace ort::client

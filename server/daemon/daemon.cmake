@@ -6,7 +6,7 @@ file(GLOB_RECURSE DAEMON_SOURCES CONFIGURE_DEPENDS ${DAEMON_DIR}/*.cpp)
 list(FILTER DAEMON_SOURCES EXCLUDE REGEX "/(server_main|server_cli|server_flag_groups)\\.cpp$")
 add_library(octomap_rt_daemon STATIC ${DAEMON_SOURCES})
 target_include_directories(octomap_rt_daemon PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
-target_link_libraries(octomap_rt_daemon PUBLIC octomap_rt_engine octomap_rt_protocol octomap_rt_query octomap_rt_lcmtypes octomap_rt_lcm Threads::Threads)
+target_link_libraries(octomap_rt_daemon PUBLIC octomap_rt_engine octomap_rt_protocol octomap_rt_query octomap_rt_distance octomap_rt_lcmtypes octomap_rt_lcm Threads::Threads)
 octomap_rt_lcm_handler_sources(octomap_rt_daemon ${DAEMON_DIR}/transport/lcm_loop.cpp)
 
 # The engine flags (-r, sensor model, back end, ...) come from engine/engine_flags, shared so

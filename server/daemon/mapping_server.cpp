@@ -113,6 +113,7 @@ void MappingServer::start() {
   queries_ =
       std::make_unique<QueryService>(cfg_.queries, map_, queue_, *loop_, server_id_, cfg_.engine.resolution, log_);
   queries_->open();
+  log_.info(text("distance queries run their EDT on ", queries_->distance_backend()));
   loop_->start();
   raw_publisher_ = std::make_unique<OctomapRawPublisher>(cfg_.octomap_raw, map_, *loop_, log_);
   raw_publisher_->start();

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "daemon/long_lived_flags.h"
+#include "daemon/queries/distance_flags.h"
 #include "daemon/queries/query_answers.h"
 #include "daemon/scan_cost_flags.h"
 #include "daemon/shard_flags.h"
@@ -106,6 +107,7 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                  "most bytes of replies one region or grid query may make the server send")
       ->capture_default_str()
       ->check(CLI::Range(size_t{1024}, size_t{1} << 30));
+  add_distance_flags(app, s.queries.distance);
   app.add_option("--latency-bound", s.latency_bound_s,
                  "overload bound [s]: a scan queued longer is dropped ('over latency bound') and the status is "
                  "DEGRADED while the end-to-end p99 exceeds it; 0: never drop for age")
@@ -175,7 +177,7 @@ void apply_namespace(ServerConfig& c, const std::string& ns) {
   for (std::string* channel :
        {&c.status_channel, &c.map_request_channel, &c.map_info_channel, &c.map_delta_channel, &c.map_reply_prefix,
         &c.octomap_raw.channel, &c.queries.points_channel, &c.queries.rays_channel, &c.queries.boxes_channel,
-        &c.queries.grid_channel, &c.queries.edit_channel, &c.queries.grid.channel}) {
+        &c.queries.grid_channel, &c.queries.distance_channel, &c.queries.edit_channel, &c.queries.grid.channel}) {
     *channel = protocol::in_namespace(ns, *channel);
     if (const std::string why = protocol::check_channel_length(*channel); !why.empty())
       throw CLI::ValidationError("--namespace", why);

@@ -36,6 +36,8 @@ class DistanceTransform {
   // cell with occupied != 0, kEdtNoObstacle without any.
   void run(std::span<const uint8_t> occupied, int nx, int ny, int nz, std::span<uint32_t> out);
   std::string device_name() const { return ctx_->device_name(); }
+  // A CPU implementation of Vulkan (lavapipe): CPU threads are the better choice there.
+  bool on_cpu_device() const { return ctx_->properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
   // Wall time of the last run() [ms]: upload, the three passes, read-back.
   double last_device_ms() const { return last_device_ms_; }
 

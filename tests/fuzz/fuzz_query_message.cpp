@@ -1,10 +1,12 @@
 // libFuzzer target: one raw query message as the query service's LCM handler gets it. The
-// first byte picks the type (points, rays, boxes, grid, map edit), the rest is the message.
+// first byte picks the type (points, rays, boxes, grid, map edit, distance), the rest is the message.
 // Besides memory errors and UB it checks the service's promises: when the raw-byte checks
 // pass, the generated decode() consumes the message exactly and does not throw; a query
 // that validate_query() accepts is answered on a small map without throwing anything but
 // query::QueryError (which the service turns into a BAD_REQUEST reply), and within its cost
-// bounds: the work its walks charge, its time under the (would-be) map lock, its reply bytes.
+// bounds: the work its walks charge, its time under the (would-be) map lock, its reply bytes;
+// a distance query that validate_distance() accepts is read and answered without throwing but
+// DistanceError.
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -15,8 +17,11 @@
 #include <octomap/OcTree.h>
 
 #include "core/clock.h"
+#include "daemon/queries/distance_answers.h"
 #include "daemon/queries/query_answers.h"
+#include "distance/squared_edt.h"
 #include "octomap_rt/box_query_t.hpp"
+#include "octomap_rt/distance_query_t.hpp"
 #include "octomap_rt/grid_query_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/occupancy_query_t.hpp"
@@ -90,17 +95,33 @@ void exercise(const uint8_t* data, size_t size, ort::protocol::WireCheck (*check
   if (static_cast<double>(ort::thread_cpu_ns() - cpu0) / 1e6 > 10 * (bounds.lock_ms + 90)) std::abort();
 }
 
+void exercise_distance(const uint8_t* data, size_t size) {
+  octomap_rt::distance_query_t msg;
+  if (!decoded(data, size, ort::protocol::check_distance_query_bytes, msg)) return;
+  DistanceServiceConfig cfg;
+  cfg.limits.max_grid_cells = 200'000;  // keeps each run quick; the bounds are what is fuzzed
+  if (!validate_distance(msg, 0.1, cfg).empty()) return;
+  try {
+    EncodedReplies r = read_distance(small_map(), msg, MapStamp{1, 0}, "fuzz", cfg, ort::distance::cpu_edt(1));
+    r.finish(r);  // refusals after the lock become a reply, never an exception
+    if (r.messages.empty()) std::abort();
+  } catch (const ort::distance::DistanceError&) {
+    // answered with BAD_REQUEST by the service
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1 || size > 64 * 1024) return 0;  // the service drops messages over 64 KiB first
-  const uint8_t kind = data[0] % 5;
+  const uint8_t kind = data[0] % 6;
   ++data, --size;
   switch (kind) {
     case 0: exercise<octomap_rt::occupancy_query_t>(data, size, ort::protocol::check_occupancy_query_bytes); break;
     case 1: exercise<octomap_rt::ray_query_t>(data, size, ort::protocol::check_ray_query_bytes); break;
     case 2: exercise<octomap_rt::box_query_t>(data, size, ort::protocol::check_box_query_bytes); break;
     case 3: exercise<octomap_rt::grid_query_t>(data, size, ort::protocol::check_grid_query_bytes); break;
+    case 5: exercise_distance(data, size); break;
     default: {
       octomap_rt::map_edit_t edit;
       (void)decoded(data, size, ort::protocol::check_map_edit_bytes, edit);

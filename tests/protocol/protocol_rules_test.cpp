@@ -31,9 +31,9 @@ TEST(ProtocolRules, NoNamespaceMeansTodaysNames) {
 
 TEST(ProtocolRules, ANamespacePrefixesEveryChannelItsViewerChannelIncluded) {
   const Channels c = channels_in("lab2");
-  for (const std::string* name :
-       {&c.scan_prefix, &c.status, &c.map_request, &c.map_info, &c.map_delta, &c.map_reply_prefix, &c.query_points,
-        &c.query_rays, &c.query_boxes, &c.query_grid, &c.map_edit, &c.query_reply_prefix, &c.grid, &c.octomap_raw})
+  for (const std::string* name : {&c.scan_prefix, &c.status, &c.map_request, &c.map_info, &c.map_delta,
+                                  &c.map_reply_prefix, &c.query_points, &c.query_rays, &c.query_boxes, &c.query_grid,
+                                  &c.query_distance, &c.map_edit, &c.query_reply_prefix, &c.grid, &c.octomap_raw})
     EXPECT_EQ(name->rfind("lab2_", 0), 0u) << *name;
   EXPECT_EQ(c.octomap_raw, "lab2_OCTOMAP");
   EXPECT_EQ(c.status, "lab2_OCTOMAP_RT_STATUS");

@@ -47,6 +47,7 @@ std::map<std::string, std::string> expected() {
       {"QUERY_RAYS_CHANNEL", kQueryRaysChannel},
       {"QUERY_BOXES_CHANNEL", kQueryBoxesChannel},
       {"QUERY_GRID_CHANNEL", kQueryGridChannel},
+      {"QUERY_DISTANCE_CHANNEL", kQueryDistanceChannel},
       {"MAP_EDIT_CHANNEL", kMapEditChannel},
       {"QUERY_REPLY_PREFIX", kQueryReplyPrefix},
       {"GRID_CHANNEL", kGridChannel},

@@ -44,6 +44,25 @@ class QueriesTest(ServerTestCase):
         self.assertIn("nearest obstacle", out.stdout)
 
 
+    def test_distance_to_the_wall(self):
+        self.publish_wall(4.0, "pyd")
+        self.client.fetch_map(timeout_s=60)  # the wall is in the map
+        # One metre in front of the wall's middle: 1.0 m, the gradient away from it (-x).
+        d, g = self.client.distance_points([[3.05, 0.05, 1.05], [-20.0, 0.0, 1.0]], max_distance=1.55, gradient=True)
+        self.assertAlmostEqual(float(d[0]), 1.0, places=5)
+        self.assertAlmostEqual(float(g[0, 0]), -1.0, places=5)
+        self.assertAlmostEqual(float(d[1]), 1.55, places=5)  # nothing within reach: the clamp
+        box = self.client.distance_box((3.01, -0.49, 0.51), (4.49, 0.49, 1.49), max_distance=1.55, gradient=True)
+        self.assertEqual(box["distance"].shape, (10, 10, 15))  # corners inside voxels, not on their faces
+        self.assertEqual(float(box["distance"].min()), 0.0)  # the wall's voxels
+        # The box's cell holding (3.05, 0.05, 1.05) has the point query's distance.
+        ox, oy, oz = box["origin"]
+        i, j, k = (int(np.floor((v - o) / box["cell_size"])) for v, o in ((3.05, ox), (0.05, oy), (1.05, oz)))
+        self.assertAlmostEqual(float(box["distance"][k, j, i]), float(d[0]), places=6)
+        path = self.client.distance_path([[0.0, 0.01, 1.01], [3.45, 0.01, 1.01]], max_distance=1.55)
+        self.assertEqual(path["num_samples"], 36)  # 35 steps of 0.0986 m, both ends
+        self.assertAlmostEqual(path["min_distance"], 0.6, places=5)  # the last sample's voxel, 6 before the wall
+
 
 if __name__ == "__main__":
     unittest.main()

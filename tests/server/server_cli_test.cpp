@@ -51,8 +51,8 @@ TEST(ServerCli, ANamespacePrefixesEveryChannel) {
   for (const std::string* channel :
        {&c.status_channel, &c.scan_channels, &c.map_request_channel, &c.map_info_channel, &c.map_delta_channel,
         &c.map_reply_prefix, &c.octomap_raw.channel, &c.queries.points_channel, &c.queries.rays_channel,
-        &c.queries.boxes_channel, &c.queries.grid_channel, &c.queries.edit_channel, &c.queries.grid.channel,
-        &c.queries.scan_prefix, &c.queries.status_channel})
+        &c.queries.boxes_channel, &c.queries.grid_channel, &c.queries.distance_channel, &c.queries.edit_channel,
+        &c.queries.grid.channel, &c.queries.scan_prefix, &c.queries.status_channel})
     EXPECT_EQ(channel->rfind("lab2_", 0), 0u) << *channel;
   EXPECT_EQ(c.octomap_raw.channel, "lab2_OCTOMAP");
   EXPECT_EQ(c.scan_channels, "lab2_OCTOMAP_RT_SCAN_.*");

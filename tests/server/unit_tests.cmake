@@ -76,3 +76,7 @@ octomap_rt_add_test(server_cli_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_cli
 # Issue 26: shards keep their regions' voxels; merged they are the one-daemon map (real data).
 octomap_rt_add_test(server_shard_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/shard_test.cpp ${SERVER_TEST_FIXTURES}
                     LIBS octomap_rt_daemon octomap_rt_map_client TIMEOUT 300)
+# Distance queries (issue 27): points, boxes and paths through the daemon, CPU and Vulkan EDT.
+octomap_rt_add_test(server_distance_query_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/distance_query_test.cpp
+                    ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
+octomap_rt_lcm_handler_sources(server_distance_query_test ${CMAKE_CURRENT_LIST_DIR}/distance_query_test.cpp)

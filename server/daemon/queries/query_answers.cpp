@@ -4,6 +4,7 @@
 #include <cmath>
 #include <span>
 
+#include "daemon/queries/distance_answers.h"
 #include "octomap_rt/box_reply_t.hpp"
 #include "octomap_rt/grid_t.hpp"
 #include "octomap_rt/occupancy_reply_t.hpp"
@@ -108,6 +109,9 @@ std::string validate(const octomap_rt::grid_query_t& q, double res) {
     return "window min > max";
   return "";
 }
+
+// Distance queries are checked by validate_distance, with the service's limits.
+std::string validate(const octomap_rt::distance_query_t&, double) { return ""; }
 
 EncodedReplies points(const octomap::OcTree& t, const octomap_rt::occupancy_query_t& q, const QueryHeader& h,
                       const MapStamp& s, const std::string& id) {
@@ -294,6 +298,8 @@ EncodedReplies answer_query(const octomap::OcTree& t, const QueryMessage& q, con
   if (auto* p = std::get_if<octomap_rt::box_query_t>(&q))
     return p->mode == Box::MODE_REGION ? region(t, *p, h, s, id, bounds, budget)
                                        : box_counts(t, *p, h, s, id, bounds, budget);
+  if (std::holds_alternative<octomap_rt::distance_query_t>(q))
+    throw std::logic_error("distance queries are answered by read_distance (daemon/queries/distance_answers.h)");
   return grid(t, std::get<octomap_rt::grid_query_t>(q), h, s, id, bounds, budget);
 }
 
@@ -323,6 +329,8 @@ EncodedReplies error_reply(const QueryMessage& q, int8_t status, const std::stri
     one(octomap_rt::ray_reply_t{});
   else if (std::holds_alternative<octomap_rt::grid_query_t>(q))
     one(octomap_rt::grid_t{});
+  else if (auto* d = std::get_if<octomap_rt::distance_query_t>(&q))
+    out.messages.push_back(distance_error_message(*d, status, error, s, id));
   else if (std::get<octomap_rt::box_query_t>(q).mode == Box::MODE_REGION)
     one(octomap_rt::region_chunk_t{});
   else

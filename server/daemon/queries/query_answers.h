@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,10 @@ struct EncodedReplies {
   int8_t status = 0;
   bool cut = false;
   std::string error;
+  // Work left for after the map lock (distance queries: the EDT): fills `messages`, and
+  // `refused` with why when a bound cut the answer after all.
+  std::function<void(EncodedReplies&)> finish = {};
+  std::string client_id = {}, refused = {};
 };
 
 // Under the map lock, within `budget` (its max_work and deadline; regions and grids also

@@ -17,6 +17,7 @@
 
 #include "core/clock.h"
 #include "octomap_rt/box_query_t.hpp"
+#include "octomap_rt/distance_query_t.hpp"
 #include "octomap_rt/grid_query_t.hpp"
 #include "octomap_rt/occupancy_query_t.hpp"
 #include "octomap_rt/ray_query_t.hpp"
@@ -24,7 +25,7 @@
 namespace ort::daemon {
 
 using QueryMessage = std::variant<octomap_rt::occupancy_query_t, octomap_rt::ray_query_t, octomap_rt::box_query_t,
-                                  octomap_rt::grid_query_t>;
+                                  octomap_rt::grid_query_t, octomap_rt::distance_query_t>;
 
 struct PendingQuery {
   QueryMessage msg;

@@ -1,10 +1,11 @@
 // What the query service is configured with (server flags --control-token, --query-queue,
-// --grid-rate, --grid-z, --grid-cell: daemon/query_flags).
+// --grid-rate, --grid-z, --grid-cell, --distance-*: server_cli).
 #pragma once
 
 #include <cstddef>
 #include <string>
 
+#include "distance/distance_queries.h"
 #include "protocol/channels.h"
 #include "query/edit_cost.h"
 
@@ -33,11 +34,22 @@ struct QueryBounds {
 inline constexpr int64_t kDefaultMaxEditNewNodes = 1'000'000;
 inline constexpr int64_t kDefaultMaxEditWork = 16'000'000;
 
+// Distance queries (daemon/queries/distance_answers.h): where the EDT runs and its bounds.
+struct DistanceServiceConfig {
+  std::string backend = "cpu";  // cpu | vulkan | auto (vulkan where a GPU that is not a CPU device exists)
+  std::string device;           // Vulkan device (index or name substring); "" automatic
+  int threads = 2;              // CPU EDT workers
+  distance::DistanceLimits limits{.max_grid_cells = 16'000'000, .max_box_cells = 4'000'000};
+  int64_t max_reply_bytes = 16 << 20;  // compressed box blob; larger is refused as too large
+  int zstd_level = 1;
+};
+
 struct QueryServiceConfig {
   std::string points_channel = ort::protocol::kQueryChannel;
   std::string rays_channel = ort::protocol::kQueryRaysChannel;
   std::string boxes_channel = ort::protocol::kQueryBoxesChannel;
   std::string grid_channel = ort::protocol::kQueryGridChannel;
+  std::string distance_channel = ort::protocol::kQueryDistanceChannel;
   std::string edit_channel = ort::protocol::kMapEditChannel;
   // The server's own inputs and heartbeat: a reply_channel naming one of them is refused.
   std::string scan_prefix = ort::protocol::kScanChannelPrefix;
@@ -54,6 +66,7 @@ struct QueryServiceConfig {
   int max_wait_ms = 30000;            // longest wait_timeout_ms honoured
   QueryBounds bounds;
   GridPublishConfig grid;
+  DistanceServiceConfig distance;
 };
 
 }  // namespace ort::daemon

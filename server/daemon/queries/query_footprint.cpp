@@ -58,6 +58,31 @@ void ray_regions(const octomap::OcTree& tree, const RegionGrid& grid, const octo
   }
 }
 
+// A distance query reads its box, points or path grown by the clamp distance and one cell
+// (distance/occupancy_grid.h's padding); one cell more for the cells' alignment.
+void distance_regions(const octomap::OcTree& tree, const octomap_rt::distance_query_t& q,
+                      std::vector<query::KeyBox>& out) {
+  using DQ = octomap_rt::distance_query_t;
+  const int cell = q.mode == DQ::MODE_BOX ? std::max(1, q.cell_voxels) : 1;
+  const double pad = q.max_distance + 2.0 * cell * tree.getResolution();
+  auto grown = [&](const double lo[3], const double hi[3]) {
+    const double a[3] = {lo[0] - pad, lo[1] - pad, lo[2] - pad}, b[3] = {hi[0] + pad, hi[1] + pad, hi[2] + pad};
+    out.push_back(query::key_box(tree, a, b));
+  };
+  if (q.mode == DQ::MODE_BOX) return grown(q.box_min, q.box_max);
+  const size_t n = q.xyz.size() / 3;
+  for (size_t i = 0; i < n; ++i) {
+    // Points: each its own; a path: each segment's bounding box (a lone vertex: itself).
+    const size_t j = q.mode == DQ::MODE_PATH && i + 1 < n ? i + 1 : i;
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(q.xyz[3 * i + a], q.xyz[3 * j + a]);
+      hi[a] = std::max(q.xyz[3 * i + a], q.xyz[3 * j + a]);
+    }
+    grown(lo, hi);
+  }
+}
+
 }  // namespace
 
 std::vector<query::KeyBox> query_footprint(const octomap::OcTree& tree, const RegionGrid& grid, const QueryMessage& q) {
@@ -82,6 +107,8 @@ std::vector<query::KeyBox> query_footprint(const octomap::OcTree& tree, const Re
       const double lo[3] = {g->use_window ? g->window_min[0] : -big, g->use_window ? g->window_min[1] : -big, g->z_min};
       const double hi[3] = {g->use_window ? g->window_max[0] : big, g->use_window ? g->window_max[1] : big, g->z_max};
       out.push_back(query::key_box(tree, lo, hi));
+    } else if (auto* d = std::get_if<octomap_rt::distance_query_t>(&q)) {
+      distance_regions(tree, *d, out);
     } else {  // a kind of query this file does not know yet: all of the map, to be safe
       out.push_back(query::KeyBox{OcTreeKey(0, 0, 0), OcTreeKey(65535, 65535, 65535)});
     }

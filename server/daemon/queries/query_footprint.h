@@ -1,7 +1,8 @@
 // What a query may read, as key boxes: the memory bound (daemon/map/map_residency.h) brings
 // back every evicted region these meet before the query is answered, so an answer is the one
 // the whole map gives. Conservative: points their voxel, boxes and grids their box, a ray
-// every region its segment passes (to its range, or to the key range's edge without one); a
+// every region its segment passes (to its range, or to the key range's edge without one), a
+// distance query what it reads (its box, points or path grown by its clamp distance); a
 // kind of query not listed in query_footprint.cpp, the whole map.
 #pragma once
 

@@ -5,10 +5,13 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/errors.h"
 #include "daemon/map/map_edit_item.h"
 #include "daemon/map/map_residency.h"
 #include "daemon/queries/edit_audit.h"
 #include "daemon/queries/query_footprint.h"
+#include "distance/squared_edt.h"
+#include "engine/distance_device.h"
 #include "octomap_rt/map_edit_ack_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/occupancy_reply_t.hpp"
@@ -56,7 +59,34 @@ QueryService::QueryService(const QueryServiceConfig& cfg, MapState& map, ScanQue
       audit_(std::move(log)),
       clients_(cfg.per_client_queue, cfg.max_clients, static_cast<int64_t>(cfg.client_idle_expiry_s * 1e6)),
       gate_({cfg.control_token, static_cast<int64_t>(cfg.edit_window_s * 1e6), cfg.max_edit_nonces}),
-      grids_(cfg.grid, cfg.bounds, map, loop, server_id_) {}
+      grids_(cfg.grid, cfg.bounds, map, loop, server_id_) {
+  choose_distance_backend();
+}
+
+// cpu: CPU threads. vulkan: the device, or the server does not start. auto: the device
+// where it is a GPU (not a CPU implementation such as lavapipe), else CPU threads.
+void QueryService::choose_distance_backend() {
+  const DistanceServiceConfig& d = cfg_.distance;
+  if (d.backend != "cpu" && d.backend != "vulkan" && d.backend != "auto")
+    throw std::invalid_argument("--distance-backend must be cpu, vulkan or auto, not '" + d.backend + "'");
+  if (d.backend != "cpu") {
+    try {
+      EdtDevice device = open_edt_device(d.device);
+      if (d.backend == "vulkan" || !device.cpu_implementation) {
+        DeviceEdt run = std::move(device.run);
+        edt_ = [run](std::span<const uint8_t> occ, distance::GridDims g, std::span<uint32_t> out) {
+          run(occ, g.nx, g.ny, g.nz, out);
+        };
+        distance_backend_ = "vulkan (" + device.name + ")";
+        return;
+      }
+    } catch (const Unsupported&) {
+      if (d.backend == "vulkan") throw;
+    }
+  }
+  edt_ = distance::cpu_edt(std::max(1, d.threads));
+  distance_backend_ = "cpu (" + std::to_string(std::max(1, d.threads)) + " threads)";
+}
 
 QueryService::~QueryService() { stop(); }
 
@@ -73,6 +103,9 @@ void QueryService::open() {
   }));
   subs_.push_back(loop_.subscribe(cfg_.grid_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
     on_query<grid_query_t>(rb, protocol::check_grid_query_bytes);
+  }));
+  subs_.push_back(loop_.subscribe(cfg_.distance_channel, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
+    on_query<distance_query_t>(rb, protocol::check_distance_query_bytes);
   }));
   subs_.push_back(loop_.subscribe(
       cfg_.edit_channel, [this](const lcm::ReceiveBuffer& rb, const std::string& channel) { on_edit(rb, channel); }));
@@ -109,8 +142,8 @@ std::string QueryService::check_addressing(const std::string& client, const std:
   if (std::string why = protocol::check_client_id(client); !why.empty()) return why;
   if (std::string why = protocol::check_reply_channel(channel); !why.empty()) return why;
   // Replies must not land on the server's own inputs.
-  for (const std::string* own :
-       {&cfg_.points_channel, &cfg_.rays_channel, &cfg_.boxes_channel, &cfg_.grid_channel, &cfg_.edit_channel})
+  for (const std::string* own : {&cfg_.points_channel, &cfg_.rays_channel, &cfg_.boxes_channel, &cfg_.grid_channel,
+                                 &cfg_.edit_channel, &cfg_.distance_channel})
     if (channel == *own) return "reply_channel is one of the server's request channels";
   if (channel == cfg_.grid.channel) return "reply_channel is the server's grid channel";
   if (channel.rfind(cfg_.scan_prefix, 0) == 0 || channel == cfg_.status_channel)
@@ -133,7 +166,9 @@ void QueryService::on_query(const lcm::ReceiveBuffer& rb, protocol::WireCheck (*
   clients_.received(msg.client_id, msg.reply_channel, now_us());
   PendingQuery q{QueryMessage(std::move(msg)), SteadyClock::now(), {}};
   const QueryHeader h = header_of(q.msg);
-  std::string bad = validate_query(q.msg, resolution_);
+  const auto* distance_query = std::get_if<octomap_rt::distance_query_t>(&q.msg);
+  std::string bad = distance_query ? validate_distance(*distance_query, resolution_, cfg_.distance)
+                                   : validate_query(q.msg, resolution_);
   if (bad.empty() && (h.wait_timeout_ms < 0 || h.wait_timeout_ms > cfg_.max_wait_ms))
     bad = "wait_timeout_ms must be in 0.." + std::to_string(cfg_.max_wait_ms);
   if (!bad.empty()) {
@@ -243,6 +278,11 @@ bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& o
                                        std::chrono::duration<double, std::milli>(cfg_.bounds.lock_ms));
   budget.stop = &cut_now_;
   try {
+    if (const auto* d = std::get_if<octomap_rt::distance_query_t>(&q.msg)) {
+      // Only the grid is read here (bounded in cells); the EDT runs after the lock, counted there.
+      out.push_back(read_distance(*map_.tree, *d, stamp, server_id_, cfg_.distance, edt_));
+      return true;
+    }
     out.push_back(answer_query(*map_.tree, q.msg, stamp, server_id_, cfg_.bounds, budget));
   } catch (const std::exception& e) {  // query::QueryError: a query the map cannot answer
     clients_.count(h.client_id, Count::kBad, e.what());
@@ -309,7 +349,13 @@ void QueryService::run() {
       }
     }
     if (!to_restore_.empty()) answer_restoring(parked, out);
-    for (const EncodedReplies& r : out) publish(r);
+    for (EncodedReplies& r : out) {
+      if (r.finish) {
+        r.finish(r);
+        clients_.count(r.client_id, r.refused.empty() ? Count::kAnswered : Count::kBad, r.refused);
+      }
+      publish(r);
+    }
   }
 }
 

@@ -15,10 +15,13 @@
 // inside its walk), and its replies are published after the lock, each naming
 // the map state (snapshot_id = MapState::version).
 // With --grid-rate, its GridPublisher also publishes the 2D grid on OCTOMAP_RT_GRID.
+// Distance queries read their grid under the lock and run the EDT after it
+// (daemon/queries/distance_answers.h), on CPU threads or the Vulkan device (--distance-backend).
 #pragma once
 
 #include <atomic>
 #include <condition_variable>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -27,6 +30,7 @@
 #include "core/log.h"
 #include "daemon/intake/scan_queue.h"
 #include "daemon/map/map_state.h"
+#include "daemon/queries/distance_answers.h"
 #include "daemon/queries/edit_audit.h"
 #include "daemon/queries/edit_gate.h"
 #include "daemon/queries/grid_publisher.h"
@@ -53,6 +57,8 @@ class QueryService {
   // once (CUT_STOPPING), so that no query holds the map past the drain bound.
   void cut_running();
   std::vector<QueryClientStats> stats() const { return clients_.snapshot(); }
+  // Where distance transforms run: "cpu (N threads)" or "vulkan (DEVICE)".
+  const std::string& distance_backend() const { return distance_backend_; }
   QueryServiceStats service_stats() const;
 
  private:
@@ -67,6 +73,7 @@ class QueryService {
   bool answer_locked(PendingQuery& q, std::vector<EncodedReplies>& out);
   void answer_restoring(std::vector<PendingQuery>& parked, std::vector<EncodedReplies>& out);
   void publish(const EncodedReplies& r);
+  void choose_distance_backend();
 
   QueryServiceConfig cfg_;
   MapState& map_;
@@ -84,6 +91,8 @@ class QueryService {
   std::vector<PendingQuery> to_restore_;
   bool exclusive_turn_ = false;
   GridPublisher grids_;
+  distance::SquaredEdt edt_;  // CPU threads or the device; used by the worker thread only
+  std::string distance_backend_;
   std::mutex wake_mutex_;
   std::condition_variable wake_;
   bool stopping_ = false;

@@ -9,4 +9,5 @@ from .bt_reader import BtFormatError, BtMap, read_bt, read_bt_file  # noqa: F401
 from .map_client import MapClient, ServerTimeout  # noqa: F401
 from .snapshot_fetch import FetchError, Snapshot  # noqa: F401
 from .queries import FREE, OCCUPIED, UNKNOWN, QueryError  # noqa: F401
+from .distance import distance_box, distance_path, distance_points  # noqa: F401
 from .edits import MapEditor, edit_mac, sign_edit  # noqa: F401

@@ -47,6 +47,7 @@ class Channels:
         self.query_rays = fixed(table.QUERY_RAYS_CHANNEL)
         self.query_boxes = fixed(table.QUERY_BOXES_CHANNEL)
         self.query_grid = fixed(table.QUERY_GRID_CHANNEL)
+        self.query_distance = fixed(table.QUERY_DISTANCE_CHANNEL)
         self.map_edit = fixed(table.MAP_EDIT_CHANNEL)
         self.query_reply_prefix = prefix(table.QUERY_REPLY_PREFIX)
         self.grid = fixed(table.GRID_CHANNEL)

@@ -5,7 +5,7 @@ import time
 from typing import Optional, Sequence
 
 from ._types import map_info_t, scan_t, server_status_t
-from . import edits, queries
+from . import distance, edits, queries
 from .bt_reader import BtMap, read_bt
 from .snapshot_fetch import Snapshot, fetch_snapshot, new_client_id
 from .transport import open_transport
@@ -112,6 +112,22 @@ class MapClient:
     def grid(self, z_min: float, z_max: float, cell_size: float = 0.0, window=None, min_snapshot_id: int = 0):
         """The 2D occupancy grid of a z band: (cells [row, column] int8, origin (x, y), cell size)."""
         return queries.grid(self.queries, z_min, z_max, cell_size, window, min_snapshot_id)
+
+    def distance_points(self, points, max_distance: float = 2.0, unknown_occupied: bool = False,
+                        gradient: bool = False, min_snapshot_id: int = 0):
+        """(distance, gradient or None) of (N, 3) points' voxels to the nearest obstacle (octomap_rt.distance)."""
+        return distance.distance_points(self.queries, points, max_distance, unknown_occupied, gradient, min_snapshot_id)
+
+    def distance_box(self, box_min, box_max, max_distance: float = 2.0, unknown_occupied: bool = False,
+                     gradient: bool = False, cell_voxels: int = 1, min_snapshot_id: int = 0):
+        """The dense distance field of a box (octomap_rt.distance.distance_box)."""
+        return distance.distance_box(self.queries, box_min, box_max, max_distance, unknown_occupied, gradient,
+                                     cell_voxels, min_snapshot_id)
+
+    def distance_path(self, vertices, max_distance: float = 2.0, unknown_occupied: bool = False,
+                      min_snapshot_id: int = 0):
+        """The clearance along a polyline: its lowest distance and where (octomap_rt.distance)."""
+        return distance.distance_path(self.queries, vertices, max_distance, unknown_occupied, min_snapshot_id)
 
     def clear_box(self, box, token: str, to: str = "free", include_unknown: bool = False):
         """Clears the box (min x y z, max x y z) [m] on the server: to "free" (its known voxels;

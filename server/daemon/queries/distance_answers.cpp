@@ -1,0 +1,200 @@
+#include "daemon/queries/distance_answers.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+#include "octomap_rt/distance_box_chunk_t.hpp"
+#include "octomap_rt/distance_path_reply_t.hpp"
+#include "octomap_rt/distance_points_reply_t.hpp"
+#include "octomap_rt/occupancy_reply_t.hpp"
+#include "protocol/limits.h"
+#include "protocol/map_protocol.h"
+#include "protocol/zstd_codec.h"
+
+namespace ort::daemon {
+namespace {
+
+using Query = octomap_rt::distance_query_t;
+using Reply = octomap_rt::occupancy_reply_t;
+
+int64_t now_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+template <class M>
+std::vector<uint8_t> encode(const M& m) {
+  std::vector<uint8_t> b(static_cast<size_t>(m.getEncodedSize()));
+  m.encode(b.data(), 0, static_cast<int>(b.size()));
+  return b;
+}
+
+template <class M>
+void stamp(M& m, const Query& q, const MapStamp& s, const std::string& server_id, int8_t status,
+           const std::string& error) {
+  m.utime = now_us();
+  m.request_id = q.request_id;
+  m.map_epoch = s.map_epoch;
+  m.snapshot_id = s.snapshot_id;
+  m.map_utime = s.map_utime;
+  m.status = status;
+  m.max_distance = q.max_distance;
+  m.server_id = server_id;
+  m.client_id = q.client_id;
+  m.error = error;
+}
+
+distance::DistanceOptions options_of(const Query& q) {
+  distance::DistanceOptions o;
+  o.max_distance = q.max_distance;
+  o.cell_voxels = q.mode == Query::MODE_BOX ? q.cell_voxels : 1;
+  o.unknown = q.unknown_as == Query::UNKNOWN_OCCUPIED ? distance::UnknownAs::kOccupied : distance::UnknownAs::kFree;
+  return o;
+}
+
+void points_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id,
+                  const distance::PointsRead& read, const distance::SquaredEdt& edt) {
+  const auto d = distance::answer_points(read, edt);
+  octomap_rt::distance_points_reply_t r{};
+  stamp(r, q, s, id, Reply::REPLY_OK, "");
+  r.cell_size = read.resolution * read.opt.cell_voxels;
+  for (const auto& p : d) {
+    r.distance.push_back(p.distance);
+    if (q.with_gradient) r.gradient.insert(r.gradient.end(), p.gradient.begin(), p.gradient.end());
+  }
+  r.num_points = static_cast<int32_t>(r.distance.size());
+  r.num_gradient = static_cast<int32_t>(r.gradient.size());
+  out.messages.push_back(encode(r));
+}
+
+void path_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id,
+                const distance::PathRead& read, const distance::SquaredEdt& edt) {
+  const auto c = distance::answer_path(read, edt);
+  octomap_rt::distance_path_reply_t r{};
+  stamp(r, q, s, id, Reply::REPLY_OK, "");
+  r.min_distance = c.min_distance;
+  std::copy(c.min_point.begin(), c.min_point.end(), r.min_xyz);
+  r.min_arc_length = c.min_arc_length;
+  r.min_sample = c.min_sample;
+  r.num_samples = c.num_samples;
+  out.messages.push_back(encode(r));
+}
+
+void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id,
+               const distance::BoxRead& read, const distance::SquaredEdt& edt, const DistanceServiceConfig& cfg) {
+  const auto b = distance::answer_box(read, edt, q.with_gradient != 0);
+  std::string raw(b.squared.size() * 4 + b.gradient.size() * 4, '\0');
+  std::memcpy(raw.data(), b.squared.data(), b.squared.size() * 4);  // little-endian hosts only (x86-64, arm64)
+  std::memcpy(raw.data() + b.squared.size() * 4, b.gradient.data(), b.gradient.size() * 4);
+  const std::string blob = cfg.zstd_level > 0 ? protocol::zstd_compress(raw, cfg.zstd_level) : raw;
+  if (int64_t(blob.size()) > cfg.max_reply_bytes) {
+    const std::string why = "the box's field is " + std::to_string(blob.size()) + " bytes compressed (at most " +
+                            std::to_string(cfg.max_reply_bytes) +
+                            "): ask for a smaller box, a coarser cell or no gradient";
+    out.messages.push_back(distance_error_message(q, Reply::REPLY_BAD_REQUEST, why, s, id));
+    out.refused = why;
+    return;
+  }
+  const size_t chunk = protocol::kChunkDataBytes;
+  const int32_t chunks = static_cast<int32_t>(std::max<size_t>(1, (blob.size() + chunk - 1) / chunk));
+  const int64_t hash = protocol::blob_hash(blob.data(), blob.size());
+  for (int32_t c = 0; c < chunks; ++c) {
+    octomap_rt::distance_box_chunk_t m{};
+    stamp(m, q, s, id, Reply::REPLY_OK, "");
+    m.cell_size = b.cell_size;
+    for (int a = 0; a < 3; ++a) m.origin[a] = b.origin[a];
+    m.size[0] = b.cells.dims.nx, m.size[1] = b.cells.dims.ny, m.size[2] = b.cells.dims.nz;
+    m.with_gradient = q.with_gradient ? 1 : 0;
+    m.compression = cfg.zstd_level > 0 ? m.COMPRESSION_ZSTD : m.COMPRESSION_NONE;
+    m.uncompressed_size = static_cast<int64_t>(raw.size());
+    m.total_size = static_cast<int64_t>(blob.size());
+    m.blob_hash = hash;
+    m.num_chunks = chunks, m.chunk_index = c;
+    const size_t first = size_t(c) * chunk, n = std::min(chunk, blob.size() - std::min(blob.size(), first));
+    m.data.assign(blob.begin() + std::ptrdiff_t(first), blob.begin() + std::ptrdiff_t(first + n));
+    m.num_bytes = static_cast<int32_t>(n);
+    out.messages.push_back(encode(m));
+  }
+}
+
+// The deferred part, with anything it throws turned into a BAD_REQUEST reply saying why.
+template <class Body>
+std::function<void(EncodedReplies&)> guarded(std::shared_ptr<const Query> q, const MapStamp& s, const std::string& id,
+                                             Body body) {
+  return [q, s, id, body](EncodedReplies& r) {
+    try {
+      body(r);
+    } catch (const std::exception& e) {
+      r.messages = {distance_error_message(*q, Reply::REPLY_BAD_REQUEST, e.what(), s, id)};
+      r.refused = e.what();
+    }
+  };
+}
+
+}  // namespace
+
+std::string validate_distance(const Query& q, double resolution, const DistanceServiceConfig& cfg) {
+  if (q.mode != Query::MODE_POINTS && q.mode != Query::MODE_BOX && q.mode != Query::MODE_PATH)
+    return "unknown mode " + std::to_string(q.mode);
+  if (q.unknown_as != Query::UNKNOWN_FREE && q.unknown_as != Query::UNKNOWN_OCCUPIED)
+    return "unknown_as " + std::to_string(q.unknown_as) + " is not 0 (free) or 1 (occupied)";
+  if (q.mode == Query::MODE_BOX && (q.cell_voxels < 1 || q.cell_voxels > distance::kMaxCellVoxels))
+    return "cell_voxels " + std::to_string(q.cell_voxels) + " is not in 1.." + std::to_string(distance::kMaxCellVoxels);
+  if (std::string bad = distance::check_options(options_of(q), resolution, cfg.limits); !bad.empty()) return bad;
+  if (q.num_xyz % 3) return "num_xyz is not a multiple of 3";
+  for (float v : q.xyz)
+    if (!std::isfinite(v)) return "a point is not finite";
+  if (q.mode == Query::MODE_PATH && q.num_xyz < 3) return "a path needs at least one vertex";
+  if (q.mode == Query::MODE_BOX)
+    for (int a = 0; a < 3; ++a)
+      if (!std::isfinite(q.box_min[a]) || !std::isfinite(q.box_max[a]) || q.box_min[a] > q.box_max[a])
+        return "box corners must be finite with min <= max";
+  return "";
+}
+
+EncodedReplies read_distance(const octomap::OcTree& tree, const Query& q, const MapStamp& s,
+                             const std::string& server_id, const DistanceServiceConfig& cfg,
+                             const distance::SquaredEdt& edt) {
+  EncodedReplies out;
+  out.channel = q.reply_channel;
+  out.client_id = q.client_id;
+  const distance::DistanceOptions opt = options_of(q);
+  auto query = std::make_shared<const Query>(q);
+  if (q.mode == Query::MODE_POINTS) {
+    auto read = std::make_shared<const distance::PointsRead>(distance::read_points(tree, q.xyz, opt, cfg.limits));
+    out.finish =
+        guarded(query, s, server_id, [=](EncodedReplies& r) { points_reply(r, *query, s, server_id, *read, edt); });
+  } else if (q.mode == Query::MODE_PATH) {
+    const std::vector<double> v(q.xyz.begin(), q.xyz.end());
+    auto read = std::make_shared<const distance::PathRead>(distance::read_path(tree, v, opt, cfg.limits));
+    out.finish =
+        guarded(query, s, server_id, [=](EncodedReplies& r) { path_reply(r, *query, s, server_id, *read, edt); });
+  } else {
+    auto read =
+        std::make_shared<const distance::BoxRead>(distance::read_box(tree, q.box_min, q.box_max, opt, cfg.limits));
+    out.finish = guarded(query, s, server_id,
+                         [=, &cfg](EncodedReplies& r) { box_reply(r, *query, s, server_id, *read, edt, cfg); });
+  }
+  return out;
+}
+
+std::vector<uint8_t> distance_error_message(const Query& q, int8_t status, const std::string& error, const MapStamp& s,
+                                            const std::string& server_id) {
+  if (q.mode == Query::MODE_BOX) {
+    octomap_rt::distance_box_chunk_t m{};
+    stamp(m, q, s, server_id, status, error);
+    return encode(m);
+  }
+  if (q.mode == Query::MODE_PATH) {
+    octomap_rt::distance_path_reply_t m{};
+    stamp(m, q, s, server_id, status, error);
+    return encode(m);
+  }
+  octomap_rt::distance_points_reply_t m{};
+  stamp(m, q, s, server_id, status, error);
+  return encode(m);
+}
+
+}  // namespace ort::daemon

@@ -1,0 +1,18 @@
+#include "daemon/queries/distance_flags.h"
+
+namespace ort::daemon {
+
+void add_distance_flags(CLI::App& app, DistanceServiceConfig& d) {
+  app.add_option("--distance-backend", d.backend,
+                 "where distance queries run their EDT: cpu (threads), vulkan (the device; fails to start without "
+                 "one), auto (the device if it is a GPU, else cpu)")
+      ->check(CLI::IsMember({"cpu", "vulkan", "auto"}))
+      ->capture_default_str();
+  app.add_option("--distance-threads", d.threads, "CPU threads of a distance query's EDT")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  app.add_option("--distance-device", d.device,
+                 "Vulkan device of distance queries (index or name substring; default automatic)");
+}
+
+}  // namespace ort::daemon
