@@ -1,0 +1,107 @@
+#include "reference_timing.h"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+#include <vector>
+
+#include "core/errors.h"
+#include "distance/distance_queries.h"
+#include "distance/squared_edt.h"
+#include "gpu/distance_transform.h"
+
+#ifdef OCTOMAP_RT_HAVE_DYNAMICEDT
+#include <dynamicEDT3D/dynamicEDTOctomap.h>
+#endif
+
+namespace ort::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+template <class F>
+double median_ms(int reps, F&& f) {
+  f();  // untimed: first-touch pages, pipelines
+  std::vector<double> ms;
+  for (int r = 0; r < std::max(1, reps); ++r) {
+    const auto t0 = Clock::now();
+    f();
+    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+  }
+  std::sort(ms.begin(), ms.end());
+  return ms[ms.size() / 2];
+}
+
+#ifdef OCTOMAP_RT_HAVE_DYNAMICEDT
+// DynamicEDTOctomap over our padded grid (corners at its outer voxel centres), as the test does.
+std::unique_ptr<DynamicEDTOctomap> dynamic_edt(octomap::OcTree& tree, const distance::BoxRead& read,
+                                               const distance::DistanceOptions& opt) {
+  const auto& g = read.grid.box;
+  const int n[3] = {g.dims.nx, g.dims.ny, g.dims.nz};
+  octomap::point3d bmin, bmax;
+  for (int a = 0; a < 3; ++a) {
+    bmin(a) = float(tree.keyToCoord(octomap::key_type(g.key_lo[a])));
+    bmax(a) = float(tree.keyToCoord(octomap::key_type(g.key_lo[a] + n[a] - 1)));
+  }
+  auto edt = std::make_unique<DynamicEDTOctomap>(float(opt.max_distance), &tree, bmin, bmax,
+                                                 opt.unknown == distance::UnknownAs::kOccupied);
+  edt->update();
+  return edt;
+}
+
+int64_t count_differences(const octomap::OcTree& tree, DynamicEDTOctomap& edt, const distance::BoxDistances& ours,
+                          const distance::DistanceOptions& opt) {
+  const double res = tree.getResolution();
+  const double clamp_sq = (opt.max_distance / res) * (opt.max_distance / res);
+  const auto& d = ours.cells.dims;
+  int64_t differ = 0;
+  size_t c = 0;
+  for (int k = 0; k < d.nz; ++k)
+    for (int j = 0; j < d.ny; ++j)
+      for (int i = 0; i < d.nx; ++i, ++c) {
+        const octomap::point3d p(float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[0] + i))),
+                                 float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[1] + j))),
+                                 float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[2] + k))));
+        const int64_t theirs = edt.getSquaredDistanceInCells(p);
+        const uint32_t mine = ours.squared[c];
+        if (mine != distance::kNoObstacle && double(mine) <= clamp_sq && theirs != int64_t(mine)) ++differ;
+      }
+  return differ;
+}
+#endif
+
+}  // namespace
+
+ReferenceTimes time_reference(const octomap::OcTree& tree, const double lo[3], const double hi[3],
+                              const distance::DistanceOptions& opt, int threads, int reps, bool vulkan) {
+  ReferenceTimes t;
+  distance::DistanceLimits lim;
+  lim.max_grid_cells = int64_t(1) << 40, lim.max_box_cells = int64_t(1) << 40;  // the bench sizes the box itself
+  t.read_ms = median_ms(reps, [&] { (void)distance::read_box(tree, lo, hi, opt, lim); });
+  const distance::BoxRead read = distance::read_box(tree, lo, hi, opt, lim);
+  t.box_cells = read.cells.dims.cells();
+  t.padded_cells = read.grid.box.dims.cells();
+  t.cpu_threads = std::max(1, threads);
+  const distance::SquaredEdt cpu = distance::cpu_edt(t.cpu_threads);
+  t.cpu_edt_ms = median_ms(reps, [&] { (void)distance::answer_box(read, cpu, false); });
+  if (vulkan) {
+    try {
+      auto gpu = std::make_shared<gpu::DistanceTransform>();
+      t.vulkan_device = gpu->device_name();
+      const distance::SquaredEdt on_gpu = [gpu](std::span<const uint8_t> occ, distance::GridDims d,
+                                                std::span<uint32_t> out) { gpu->run(occ, d.nx, d.ny, d.nz, out); };
+      t.vulkan_edt_ms = median_ms(reps, [&] { (void)distance::answer_box(read, on_gpu, false); });
+    } catch (const Unsupported& e) {
+      t.vulkan_device = std::string("none: ") + e.what();
+    }
+  }
+#ifdef OCTOMAP_RT_HAVE_DYNAMICEDT
+  octomap::OcTree copy(tree);
+  t.dynamic_edt_ms = median_ms(reps, [&] { (void)dynamic_edt(copy, read, opt); });
+  const auto edt = dynamic_edt(copy, read, opt);
+  t.dynamic_edt_differ = count_differences(copy, *edt, distance::answer_box(read, cpu, false), opt);
+#endif
+  return t;
+}
+
+}  // namespace ort::bench
