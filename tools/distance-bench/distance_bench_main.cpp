@@ -6,7 +6,9 @@
 // record, reference_timing.h). Every wait is bounded; scans the server refused or dropped are
 // counted with their reasons.
 //   octomap-rt-distance-bench [--graph G] [--producers 3] [--phase-s 10] ... [octomap-rt-server flags]
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -42,10 +44,16 @@ struct Tally {
   std::string reasons;  // "origin jump 3, queue full 1"
   int64_t ended() const { return applied + rejected + dropped; }
 };
+// The registry names a robot by its channel's suffix as sent (upper case): compared without case.
+bool same_robot(const std::string& a, const std::string& b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+         });
+}
 Tally tally(ort::daemon::MappingServer& s, const std::string& robot) {
   Tally t;
   for (const auto& p : s.producer_stats()) {
-    if (p.robot_id != robot) continue;
+    if (!same_robot(p.robot_id, robot)) continue;
     t.received = p.received, t.applied = p.applied, t.rejected = p.rejected, t.dropped = p.dropped;
     t.in_flight = p.in_flight;
     for (size_t r = 0; r < ort::daemon::kRejectReasonCount; ++r) {
