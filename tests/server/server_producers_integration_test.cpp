@@ -8,9 +8,11 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <optional>
 
 #include "cli/replay/scan_selection.h"
 #include "daemon/map/applied_order.h"
+#include "daemon/persistence/map_identity_file.h"
 #include "integration_harness.h"
 #include "scene/scan_set.h"
 #include "support/octomap_reference.h"
@@ -91,7 +93,13 @@ TEST(ServerProducersIntegration, ThreeProducersSplitRealScansGiveTheMapOfTheAppl
   // The daemon's record of what it applied, mapped back to scans of the set.
   const daemon::AppliedOrderFile order = daemon::read_applied_order(map_path + ".order");
   ASSERT_EQ(order.entries.size(), expected_total);
-  EXPECT_EQ(order.map_bytes, static_cast<int64_t>(std::filesystem::file_size(map_path)));
+  // The order file only grows; the map it belongs to is named by the identity beside it: the
+  // saved map's size and the number of order lines that belong to it.
+  const std::optional<daemon::MapIdentityRecord> identity = daemon::read_map_identity(map_path);
+  ASSERT_TRUE(identity.has_value());
+  EXPECT_EQ(identity->map_bytes, std::filesystem::file_size(map_path));
+  EXPECT_EQ(identity->order_entries, expected_total);
+  EXPECT_TRUE(identity->clean);
   ScanSet in_order;
   in_order.name = "3dtk in the daemon's applied order";
   std::map<std::string, int64_t> next_seq;
