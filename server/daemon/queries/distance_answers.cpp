@@ -86,8 +86,10 @@ void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std
                const distance::BoxRead& read, const distance::SquaredEdt& edt, const DistanceServiceConfig& cfg) {
   const auto b = distance::answer_box(read, edt, q.with_gradient != 0);
   std::string raw(b.squared.size() * 4 + b.gradient.size() * 4, '\0');
-  std::memcpy(raw.data(), b.squared.data(), b.squared.size() * 4);  // little-endian hosts only (x86-64, arm64)
-  std::memcpy(raw.data() + b.squared.size() * 4, b.gradient.data(), b.gradient.size() * 4);
+  // Little-endian hosts only (x86-64, arm64). An empty part (no gradient asked) is not copied:
+  // memcpy from an empty vector's null data() is undefined even for 0 bytes.
+  if (!b.squared.empty()) std::memcpy(raw.data(), b.squared.data(), b.squared.size() * 4);
+  if (!b.gradient.empty()) std::memcpy(raw.data() + b.squared.size() * 4, b.gradient.data(), b.gradient.size() * 4);
   const std::string blob = cfg.zstd_level > 0 ? protocol::zstd_compress(raw, cfg.zstd_level) : raw;
   if (int64_t(blob.size()) > cfg.max_reply_bytes) {
     const std::string why = "the box's field is " + std::to_string(blob.size()) + " bytes compressed (at most " +
