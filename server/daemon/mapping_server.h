@@ -168,6 +168,9 @@ class MappingServer {
   // The last map figures read under the map lock (atomic: read without it when the lock is busy).
   std::atomic<size_t> cached_leaves_{0};
   std::atomic<int64_t> cached_nodes_{0}, cached_memory_{0}, cached_version_{0}, cached_epoch_{0};
+  // The leaf-count cache is written by whichever thread gathers a status (the status loop and
+  // any caller of status()); the map locks they take are shared, so this serializes them.
+  std::mutex leaf_cache_mutex_;
   std::chrono::steady_clock::time_point leaves_time_;
   std::atomic<int64_t> leaves_version_{-1};    // map version of cached_leaves_
   std::atomic<bool> pipeline_drained_{false};  // set by stop() once the pipeline is joined

@@ -41,6 +41,7 @@ StatusInputs MappingServer::gather_status() {
     // still be reported (DEGRADED), so after ~100 ms the last figures are used again.
     // With the read replica the leaves are counted there (the octree stage never waits for
     // the walk), whenever the map changed and at most once a second.
+    std::lock_guard cache_lock(leaf_cache_mutex_);
     if (map_.replica) {
       MapState& r = map_.replica->state();
       std::shared_lock rl(r.mutex, std::defer_lock);
