@@ -27,7 +27,6 @@ namespace ort::cli {
 namespace {
 
 using bench::BenchRow;
-using Clock = SteadyClock;
 
 struct BenchArgs {
   std::vector<std::string> presets = {"fr079", "campus", "skt-corridor"};
@@ -90,7 +89,7 @@ void run_engine(const ScanSet& set, const EngineOptions& opts, const BenchArgs& 
     BenchRow m = r;
     tree = engine.make_tree();
     StageTimes st;
-    const auto t0 = Clock::now();
+    const auto t0 = SteadyClock::now();
     // Stage times are each stage's own sum; with the pipeline they overlap in the total.
     insert_scans(
         engine, set.scans.size(), scan_input, *tree,
@@ -188,7 +187,7 @@ int run_bench(const BenchArgs& a) {
   if (sets.empty()) throw std::runtime_error("nothing to measure: give --preset, --graph or --data");
   for (const auto& [name, source] : sets) {
     std::unique_ptr<ScanSet> set;
-    const auto tg = Clock::now();
+    const auto tg = SteadyClock::now();
     try {
       set = std::make_unique<ScanSet>(source == "preset" ? make_preset(name, popts) : load_scan_graph(source));
     } catch (const std::exception& e) {

@@ -51,7 +51,7 @@ int run_build(const BuildArgs& a) {
   EngineOptions opts = to_engine_options(a.engine);
   opts.shoots_beside_apply = !a.no_pipeline;
   opts.stage1_helpers_yield = true;
-  const auto t_load = std::chrono::steady_clock::now();
+  const auto t_load = SteadyClock::now();
   const ScanSet set = a.input == "synthetic" ? make_synthetic_rooms() : load_scan_graph(a.input);
   const double load_ms = ms_since(t_load);
 
@@ -67,7 +67,7 @@ int run_build(const BuildArgs& a) {
   PrepareReport prep_total;
   uint64_t voxels = 0, windows = 0;
   size_t rejected = 0;
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = SteadyClock::now();
   const auto scan_input = [&set](size_t i) {  // sensor-frame points: transformed on the GPU where it prepares
     const PosedScan& scan = set.scans[i];
     std::span<const octomap::point3d> pts(scan.points.size() ? &scan.points[0] : nullptr, scan.points.size());

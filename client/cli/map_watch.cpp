@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "cli/map_commands.h"
+#include "core/clock.h"
 #include "map_client/map_mirror.h"
 #include "protocol/channels.h"
 #include "protocol/lcm_url.h"
@@ -51,8 +52,8 @@ void run_map_watch(const MapArgs& a) {
   client::MapMirror m(c, o);
   m.sync();
   std::printf("mirror of snapshot %lld\n", (long long)m.version());
-  const auto t0 = std::chrono::steady_clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  const auto t0 = SteadyClock::now();
+  auto elapsed = [&] { return seconds_since(t0); };
   int64_t last_deltas = 0, last_bytes = 0;
   bool reader_gone = false;
   while (!reader_gone && !interrupted(sigs) && (a.seconds <= 0 || elapsed() < a.seconds)) {

@@ -4,6 +4,8 @@
 
 #include <cstdio>
 
+#include "core/clock.h"
+
 namespace ort::cli {
 
 ProgressBar::ProgressBar(std::string label, size_t total, bool enabled)
@@ -14,7 +16,7 @@ void ProgressBar::update(size_t done, const std::string& detail) {
   const double frac = total_ ? static_cast<double>(done) / total_ : 1.0;
   if (tty_) {
     // Redraw at most 20 times a second: stderr writes would otherwise pace the producer.
-    const auto now = std::chrono::steady_clock::now();
+    const auto now = SteadyClock::now();
     if (drawn_ && done != total_ && now - last_draw_ < std::chrono::milliseconds(50)) return;
     last_draw_ = now;
     drawn_ = true;

@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <string>
 
+#include "core/clock.h"
+
 namespace ort::cli {
 
 class ProgressBar {
@@ -21,7 +23,7 @@ class ProgressBar {
   bool enabled_;
   bool tty_;
   int last_decile_ = -1;
-  std::chrono::steady_clock::time_point last_draw_{};
+  SteadyClock::time_point last_draw_{};
   bool drawn_ = false;
 };
 

@@ -42,7 +42,7 @@ render::HeightRange parse_z_range(const std::string& text) {
 
 int run_render(RenderArgs a) {
   if (!a.z_range.empty()) a.options.heights = parse_z_range(a.z_range);
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = SteadyClock::now();
   const auto tree = render::load_map_file(a.input);
   const double load_ms = ms_since(t0);
   const render::MapPicture picture = render::render_map(*tree, a.options);

@@ -30,8 +30,6 @@
 namespace ort::cli {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 struct ReplayArgs {
   std::string input;
   std::string robot;
@@ -60,20 +58,20 @@ class Pacer {
  public:
   explicit Pacer(double period_s) : period_(period_s) {}
   void wait_turn() {
-    const auto now = Clock::now();
+    const auto now = SteadyClock::now();
     if (!started_) {
       started_ = true;
       next_ = now;
     }
     if (next_ > now) std::this_thread::sleep_until(next_);
-    next_ = std::max(next_, Clock::now() - std::chrono::milliseconds(1)) +
-            std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_));
+    next_ = std::max(next_, SteadyClock::now() - std::chrono::milliseconds(1)) +
+            std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(period_));
   }
 
  private:
   double period_;
   bool started_ = false;
-  Clock::time_point next_{};
+  SteadyClock::time_point next_{};
 };
 
 struct ReplayTotals {
@@ -81,11 +79,11 @@ struct ReplayTotals {
   uint64_t points = 0;
   uint64_t bytes = 0;
   size_t publish_errors = 0;
-  Clock::time_point start = Clock::now();
-  Clock::time_point first_publish{};
+  SteadyClock::time_point start = SteadyClock::now();
+  SteadyClock::time_point first_publish{};
   // Rate between the first and the last publication: pacing, not start-up, is what it shows.
   std::string detail() const {
-    const double s = std::chrono::duration<double>(Clock::now() - first_publish).count();
+    const double s = seconds_since(first_publish);
     char buf[96];
     std::snprintf(buf, sizeof buf, "%.1f MB, %.2f scans/s", bytes / 1e6, scans > 1 && s > 0 ? (scans - 1) / s : 0.0);
     return buf;
@@ -93,7 +91,7 @@ struct ReplayTotals {
 };
 
 void print_totals(const char* what, const std::string& channel_desc, const ReplayTotals& t) {
-  const double s = std::chrono::duration<double>(Clock::now() - t.start).count();
+  const double s = seconds_since(t.start);
   std::printf("octomap-rt replay: %s\n", what);
   std::printf("  published:  %zu scans, %llu points, %.1f MB on %s\n", t.scans, (unsigned long long)t.points,
               t.bytes / 1e6, channel_desc.c_str());
@@ -129,7 +127,7 @@ int replay_scan_set(const ReplayArgs& a, lcm::LCM& lc) {
     buf.resize(msg.getEncodedSize());
     msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
     pacer.wait_turn();
-    if (t.scans == 0) t.first_publish = Clock::now();
+    if (t.scans == 0) t.first_publish = SteadyClock::now();
     if (lc.publish(channel, buf.data(), static_cast<unsigned>(buf.size())) != 0) ++t.publish_errors;
     ++t.scans;
     t.points += msg.xyz.size() / 3;
@@ -171,7 +169,7 @@ int replay_log(const ReplayArgs& a, lcm::LCM& lc) {
   std::vector<uint8_t> buf;
   for (size_t r = 0; r < a.sel.repeat; ++r) {
     int64_t first_ts = -1;
-    Clock::time_point pass_start{};
+    SteadyClock::time_point pass_start{};
     skipped = for_each_log_scan(a.input, a.channel_prefix, [&](const LogScanEvent& e) {
       if (!wanted.count(e.index)) return true;
       const void* data = e.data;
@@ -202,13 +200,13 @@ int replay_log(const ReplayArgs& a, lcm::LCM& lc) {
       } else {  // the recorded timing, scaled by --speed
         if (first_ts < 0) {
           first_ts = e.timestamp;
-          pass_start = Clock::now();
+          pass_start = SteadyClock::now();
         }
         const double offset_s = (e.timestamp - first_ts) / 1e6 / a.speed;
         std::this_thread::sleep_until(
-            pass_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(offset_s)));
+            pass_start + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(offset_s)));
       }
-      if (t.scans == 0) t.first_publish = Clock::now();
+      if (t.scans == 0) t.first_publish = SteadyClock::now();
       if (lc.publish(channel, data, size) != 0) ++t.publish_errors;
       ++t.scans;
       t.points += points;

@@ -88,8 +88,8 @@ lcm::LCM& open_lcm(std::optional<lcm::LCM>& slot, const std::string& url) {
 }
 
 int run_once(const StatusArgs& a, lcm::LCM& lc, const std::string& url, Inbox& in) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(a.timeout_s);
-  while (!in.fresh && std::chrono::steady_clock::now() < deadline)
+  const auto deadline = SteadyClock::now() + std::chrono::duration<double>(a.timeout_s);
+  while (!in.fresh && SteadyClock::now() < deadline)
     if (lc.handleTimeout(100) < 0) throw std::runtime_error("LCM receive failed on " + url);
   if (!in.fresh)
     throw std::runtime_error("no status on " + a.channel + " within " + std::to_string(int(a.timeout_s)) + " s at " +
@@ -105,16 +105,16 @@ int run_watch(const StatusArgs& a, lcm::LCM& lc, const std::string& url, Inbox& 
   const bool terminal = !a.json && isatty(STDOUT_FILENO);
   if (terminal) std::cout << "\x1b[2J";
   int64_t shown = 0;
-  auto last_draw = std::chrono::steady_clock::now() - std::chrono::seconds(10);
+  auto last_draw = SteadyClock::now() - std::chrono::seconds(10);
   while (a.count == 0 || shown < a.count) {
     if (lc.handleTimeout(200) < 0) throw std::runtime_error("LCM receive failed on " + url);
     const bool fresh = in.fresh;
     in.fresh = false;
     if (a.json) {
       if (fresh) std::cout << status::status_json(*in.latest) << "\n" << std::flush;
-    } else if (fresh || (terminal && std::chrono::steady_clock::now() - last_draw > std::chrono::seconds(1))) {
+    } else if (fresh || (terminal && SteadyClock::now() - last_draw > std::chrono::seconds(1))) {
       redraw(watch_screen(a, url, in), terminal);  // once a second on a terminal, so ages move
-      last_draw = std::chrono::steady_clock::now();
+      last_draw = SteadyClock::now();
     }
     shown += fresh;
   }

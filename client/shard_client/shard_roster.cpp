@@ -70,10 +70,9 @@ ShardRoster discover_shards(const std::string& url, const std::string& ns, doubl
     void on(const lcm::ReceiveBuffer* rb, const std::string&) { r->take(rb->data, rb->data_size, now_utime()); }
   } sink{&roster};
   lc.subscribe(protocol::channels_in(ns).status, &Sink::on, &sink);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  const auto deadline = SteadyClock::now() + std::chrono::duration<double>(timeout_s);
   while (!roster.complete()) {
-    const auto left =
-        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyClock::now());
     if (left.count() <= 0) break;
     pollfd p{lc.getFileno(), POLLIN, 0};
     if (::poll(&p, 1, static_cast<int>(std::min<int64_t>(left.count(), 100))) > 0) lc.handleTimeout(0);

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdint>
 #include <ctime>
+#include <string>
 
 namespace ort {
 
@@ -28,6 +29,17 @@ inline double seconds_since(SteadyClock::time_point t) {
 inline int64_t now_utime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
+}
+
+// The wall clock's present moment in UTC, as strftime writes it with `format` (file names,
+// lock holders: text a person reads).
+inline std::string utc_text(const char* format) {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[64];
+  const size_t n = std::strftime(buf, sizeof buf, format, &tm);
+  return std::string(buf, n);
 }
 
 // CPU time the calling thread has run, in nanoseconds (0 where the clock is refused).

@@ -10,8 +10,6 @@
 namespace ort {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 class CpuBackend final : public RayBackend {
  public:
   explicit CpuBackend(double resolution) : key_tree_(resolution) {}
@@ -19,7 +17,7 @@ class CpuBackend final : public RayBackend {
   std::string device_name() const override { return "CPU (OctoMap computeRayKeys)"; }
 
   void shoot(const RayBatch& batch, Traversal mode, VoxelList& out, ShootStats& stats) override {
-    const auto t0 = Clock::now();
+    const auto t0 = SteadyClock::now();
     octomap::KeySet free_cells, occupied_cells;
     octomap::KeyRay ray;
     std::vector<octomap::OcTreeKey> exact;

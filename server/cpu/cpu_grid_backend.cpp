@@ -27,8 +27,6 @@
 namespace ort {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 constexpr uint32_t kVoxelsPerWord = BrickLayout::kVoxelsPerWord;
 constexpr uint32_t kNoIndex = std::numeric_limits<uint32_t>::max();
 
@@ -151,14 +149,14 @@ class CpuGridBackend final : public RayBackend {
     const unsigned most = unsigned(std::min<size_t>(threads_, std::max<size_t>(1, batch.ends.size() / 256)));
     std::vector<std::vector<uint32_t>> touched(most);
     for (const KeyBox& w : windows) {
-      const auto t_shoot = Clock::now();
+      const auto t_shoot = SteadyClock::now();
       const BrickLayout layout(w);
       const unsigned n_threads = helpers_yield_ ? std::min(most, choice_.next()) : most;
       const double helper_cpu_ms = walk_window(batch, mode, layout, n_threads, touched);
       const double walk_ms = ms_since(t_shoot);
       stats.times.shoot_ms += walk_ms;
       if (helpers_yield_) choice_.record(n_threads, batch.ends.size(), walk_ms, helper_cpu_ms);
-      const auto t_compact = Clock::now();
+      const auto t_compact = SteadyClock::now();
       compact_window(layout, n_threads, touched, out, stats);
       stats.times.compact_ms += ms_since(t_compact);
     }

@@ -36,7 +36,7 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
       log_(std::move(log)),
       producers_(literal_prefix(cfg.scan_channels), producer_policy(cfg)),
       queue_(queue_budget(cfg), 8 * queue_budget(cfg)) {
-  start_ = std::chrono::steady_clock::now();
+  start_ = SteadyClock::now();
   start_utime_ = now_utime();
   host_ = host_name();
   server_id_ = cfg_.server_id.empty() ? "octomap-rt-server@" + host_ : cfg_.server_id;
@@ -236,9 +236,9 @@ bool MappingServer::stop() {
 // deadline passes; what is still queued then is dropped, counted ("left at shutdown").
 // Scans already in the pipeline (at most two) are finished either way.
 void MappingServer::drain_until_deadline() {
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(std::max(0.0, cfg_.drain_timeout_s)));
-  while (queue_.depth() > 0 && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const auto deadline = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
+                                                 std::chrono::duration<double>(std::max(0.0, cfg_.drain_timeout_s)));
+  while (queue_.depth() > 0 && SteadyClock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   const std::vector<QueuedScan> left = queue_.take_all();
   size_t scans_left = 0;
   for (const QueuedScan& s : left) {

@@ -16,6 +16,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "core/clock.h"
 #include "core/log.h"
 #include "daemon/intake/producer_registry.h"
 #include "daemon/intake/scan_intake.h"
@@ -157,7 +158,7 @@ class MappingServer {
 
   std::string host_, server_id_;
   int64_t start_utime_ = 0;
-  std::chrono::steady_clock::time_point start_;
+  SteadyClock::time_point start_;
 
   mutable std::mutex state_mutex_;  // state, message, status seq, threads' wake-up
   std::condition_variable wake_;
@@ -171,7 +172,7 @@ class MappingServer {
   // The leaf-count cache is written by whichever thread gathers a status (the status loop and
   // any caller of status()); the map locks they take are shared, so this serializes them.
   std::mutex leaf_cache_mutex_;
-  std::chrono::steady_clock::time_point leaves_time_;
+  SteadyClock::time_point leaves_time_;
   std::atomic<int64_t> leaves_version_{-1};    // map version of cached_leaves_
   std::atomic<bool> pipeline_drained_{false};  // set by stop() once the pipeline is joined
   // Maps up to this size have their leaves counted at every status (a short hold of the map

@@ -117,7 +117,7 @@ void MappingServer::save(bool force) { save_map(force, /*clean=*/false); }
 void MappingServer::save_map(bool force, bool clean) {
   if (cfg_.map_path.empty()) return;
   std::lock_guard save_lock(save_mutex_);
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = SteadyClock::now();
   // Copy under the map lock (a state between two whole scans); serialize and write outside it.
   std::optional<MapCopy> copy = force ? std::optional<MapCopy>(copy_map(readable_map(map_)))
                                       : copy_map_if_changed(readable_map(map_), saved_version_);

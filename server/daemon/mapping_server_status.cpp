@@ -19,7 +19,7 @@ StatusInputs MappingServer::gather_status() {
   StatusInputs in;
   in.utime = now_utime();
   in.start_utime = start_utime_;
-  in.uptime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  in.uptime_s = seconds_since(start_);
   in.pid = static_cast<int32_t>(::getpid());
   in.server_id = server_id_;
   in.host = host_;
@@ -46,7 +46,7 @@ StatusInputs MappingServer::gather_status() {
       MapState& r = map_.replica->state();
       std::shared_lock rl(r.mutex, std::defer_lock);
       for (int i = 0; i < 100 && !rl.try_lock(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      const auto now = std::chrono::steady_clock::now();
+      const auto now = SteadyClock::now();
       if (rl.owns_lock() && static_cast<int64_t>(r.version) != leaves_version_ &&
           (leaves_version_ < 0 || pipeline_drained_ || now - leaves_time_ >= std::chrono::seconds(1))) {
         cached_leaves_ = r.tree->getNumLeafNodes();
@@ -58,7 +58,7 @@ StatusInputs MappingServer::gather_status() {
     for (int i = 0; i < 100 && !lock.try_lock(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     if (lock.owns_lock()) {
       const octomap::OcTree& t = *map_.tree;
-      const auto now = std::chrono::steady_clock::now();
+      const auto now = SteadyClock::now();
       const int64_t version = static_cast<int64_t>(map_.version);
       if (!map_.replica && version != leaves_version_ &&
           (t.size() <= kLeafWalkEveryStatus || pipeline_drained_ || now - leaves_time_ > std::chrono::seconds(10))) {

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "core/clock.h"
 #include "shaders/edt_envelope_spv.h"
 #include "shaders/edt_rows_spv.h"
 
@@ -76,7 +77,7 @@ void DistanceTransform::run(std::span<const uint8_t> occupied, int nx, int ny, i
   const uint64_t cells = uint64_t(nx) * ny * nz;
   if (occupied.size() != cells || out.size() != cells)
     throw std::logic_error("distance transform: buffer sizes differ from the grid's");
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = SteadyClock::now();
   ensure_capacity(cells);
   const vk::Buffer& host_in = unified_ ? occupied_ : upload_;
   std::memcpy(host_in.mapped(), occupied.data(), cells);
@@ -110,7 +111,7 @@ void DistanceTransform::run(std::span<const uint8_t> occupied, int nx, int ny, i
   const vk::Buffer& host_out = unified_ ? squared_ : readback_;
   host_out.invalidate();
   std::memcpy(out.data(), host_out.mapped(), cells * 4);
-  last_device_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  last_device_ms_ = ms_since(t0);
 }
 
 }  // namespace ort::gpu

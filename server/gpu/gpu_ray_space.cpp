@@ -14,8 +14,6 @@
 namespace ort::gpu {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 constexpr uint64_t kMinRayCapacity = 1 << 16;
 constexpr VkBufferUsageFlags kStorage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
@@ -147,7 +145,7 @@ void GpuRaySpace::ensure_ray_capacity(uint64_t rays) {
 }
 
 void GpuRaySpace::upload_rays(const RayBatch& batch, ShootStats& stats) {
-  const auto t = Clock::now();
+  const auto t = SteadyClock::now();
   ensure_ray_capacity(batch.ends.size());
   const size_t bytes = batch.ends.size() * sizeof(RayEnd);
   const vk::Buffer& host = unified_ ? rays_ : rays_staging_;
@@ -197,7 +195,7 @@ void GpuRaySpace::shoot_windows(const RayBatch& batch, uint32_t ray_count, std::
 void GpuRaySpace::shoot_window(const RayBatch& batch, uint32_t ray_count, const KeyBox& window,
                                const RecordShoot& record_shoot, VoxelList& out, ShootStats& stats) {
   const CompactPush cp = compact_push(window, opts_.sizing.chunk_words);
-  const auto t_submit = Clock::now();
+  const auto t_submit = SteadyClock::now();
   VkCommandBuffer cmd = runner_.begin();
   record_first_pass(cmd, shoot_push(batch, ray_count, window, opts_.sizing.chunk_words), record_shoot, cp);
   runner_.submit_and_wait();
@@ -214,7 +212,7 @@ void GpuRaySpace::shoot_window(const RayBatch& batch, uint32_t ray_count, const 
   stats.times.compact_gpu_ms += gpu_compact;
   stats.times.shoot_ms += std::max(0.0, wall_ms - gpu_upload - gpu_compact);
 
-  const auto t_read = Clock::now();
+  const auto t_read = SteadyClock::now();
   const Counters first = read_counters();
   stats.walk_overruns += first.walk_overruns;  // reported by the engine's callers; must stay 0
   read_voxels(first.emitted_count, out, stats.times);
@@ -293,7 +291,7 @@ void GpuRaySpace::read_voxels(uint32_t count, VoxelList& out, StageTimes& times)
   if (count == 0) return;
   if (count > opts_.sizing.output_voxels) throw std::logic_error("GPU ray space: the voxel output overflowed");
   const size_t bytes = size_t(count) * sizeof(VoxelUpdate);
-  const auto t_copy = Clock::now();
+  const auto t_copy = SteadyClock::now();
   if (voxels_readback_) {
     VkCommandBuffer cmd = runner_.begin();
     const VkBufferCopy region{0, 0, bytes};
@@ -302,7 +300,7 @@ void GpuRaySpace::read_voxels(uint32_t count, VoxelList& out, StageTimes& times)
                        VK_ACCESS_HOST_READ_BIT);
     runner_.submit_and_wait();
   }
-  const auto t_unpack = Clock::now();
+  const auto t_unpack = SteadyClock::now();
   times.readback_copy_ms += ms_between(t_copy, t_unpack);
   const vk::Buffer& src = voxels_readback_ ? voxels_readback_ : voxels_;
   src.invalidate();

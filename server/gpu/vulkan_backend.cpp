@@ -28,8 +28,6 @@ namespace {
 
 constexpr int kWindowMargin = 2;  // voxels around the key box: the walk may overstep by one
 
-using Clock = std::chrono::steady_clock;
-
 std::shared_ptr<vk::Context> make_context(const BackendOptions& opts) {
   vk::ContextOptions co;
   co.device = opts.device;
@@ -115,10 +113,10 @@ class VulkanBackend final : public RayBackend {
     report.points_in += points;
     RayBatch header;  // origin, origin key, key box; the ends stay on the device
     if (!prepare_origin(scan.origin, resolution_, header, report)) return;
-    const auto t_stage = Clock::now();
+    const auto t_stage = SteadyClock::now();
     prepare_->stage_points(scan.xyz);
     stats.times.upload_ms += ms_since(t_stage);
-    const auto t_prepare = Clock::now();
+    const auto t_prepare = SteadyClock::now();
     const VkBuffer rays = space_.device_rays(points);
     const gpu::DevicePrepared p = prepare_->run({*scan.pose, header.origin, scan.max_range, resolution_}, rays);
     stats.times.prepare_ms += ms_since(t_prepare);

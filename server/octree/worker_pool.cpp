@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "core/clock.h"
+
 namespace ort {
 namespace {
 
@@ -18,11 +20,11 @@ inline void cpu_relax() {
 // Returns once `value` no longer holds `old` (acquire); spins first when `spin`.
 template <class T>
 void wait_for_change(const std::atomic<T>& value, T old, bool spin) {
-  const auto until = std::chrono::steady_clock::now() + kSpin;
+  const auto until = SteadyClock::now() + kSpin;
   for (unsigned i = 1; spin; ++i) {
     if (value.load(std::memory_order_acquire) != old) return;
     cpu_relax();
-    if (i % 64 == 0 && std::chrono::steady_clock::now() >= until) break;
+    if (i % 64 == 0 && SteadyClock::now() >= until) break;
   }
   while (value.load(std::memory_order_acquire) == old) value.wait(old, std::memory_order_acquire);
 }

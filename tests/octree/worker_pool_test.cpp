@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/clock.h"
 #include "octree/worker_pool.h"
 
 namespace ort {
@@ -92,8 +93,8 @@ void run_chunks(WorkerPool& pool, std::vector<int>& chunk_runs, std::vector<int>
     for (size_t k; (k = next.fetch_add(1)) < chunk_runs.size();) {
       ++chunk_runs[k];  // plain: one thread a chunk
       // A few microseconds of work a chunk, so that woken threads join the job.
-      const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(20);
-      while (std::chrono::steady_clock::now() < until) {}
+      const auto until = SteadyClock::now() + std::chrono::microseconds(20);
+      while (SteadyClock::now() < until) {}
     }
   });
 }

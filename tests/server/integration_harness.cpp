@@ -17,6 +17,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/clock.h"
+
 extern char** environ;
 
 namespace ort::test {
@@ -160,9 +162,9 @@ void ChildProcess::signal(int sig) {
 }
 
 std::optional<int> ChildProcess::wait(double timeout_s) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  const auto deadline = SteadyClock::now() + std::chrono::duration<double>(timeout_s);
   while (running()) {
-    if (std::chrono::steady_clock::now() > deadline) return std::nullopt;
+    if (SteadyClock::now() > deadline) return std::nullopt;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return status_;

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/clock.h"
 #include "daemon/mapping_server.h"
 #include "octomap_rt/map_chunk_t.hpp"
 #include "octomap_rt/map_info_t.hpp"
@@ -122,9 +123,9 @@ TEST(MapRequestBounds, AFloodOfFreshRequestsCopiesTheMapOncePerInterval) {
   server.start();
   // The map changes all the time (a scan every 20 ms) while 40 clients ask for fresh
   // snapshots every 25 ms, for 2.5 s.
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = SteadyClock::now();
   int64_t seq = 0, id = 0;
-  while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(2500)) {
+  while (SteadyClock::now() - t0 < std::chrono::milliseconds(2500)) {
     const auto scan = small_scan("alpha", seq++, 50);
     lc.publish("OCTOMAP_RT_SCAN_ALPHA", &scan);
     for (int i = 0; i < 40; ++i) {

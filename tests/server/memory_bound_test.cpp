@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/clock.h"
 #include "daemon/map/applied_order.h"
 #include "daemon/persistence/region_store.h"
 #include "octomap_rt/box_reply_t.hpp"
@@ -193,8 +194,8 @@ TEST(MemoryBound, KillDuringEvictionKeepsTheSavedMap) {
       if (!wait_until_done(server, ++sent)) ::_exit(2);
     }
     // Wait for a save holding every scan of the first pass, then go on and die mid-pass.
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (std::chrono::steady_clock::now() < deadline) {
+    const auto deadline = SteadyClock::now() + std::chrono::seconds(60);
+    while (SteadyClock::now() < deadline) {
       try {
         if (daemon::read_applied_order(cfg.map_path + ".order").entries.size() == n) break;
       } catch (const std::exception&) {}

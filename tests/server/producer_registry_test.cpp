@@ -5,12 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include "core/clock.h"
 #include "daemon/intake/producer_registry.h"
 
 namespace ort::daemon {
 namespace {
-
-using Clock = ProducerRegistry::Clock;
 
 bool admit(ProducerRegistry& r, size_t p, int64_t seq) {
   return r.admit(p, seq, 0, [] { return true; });
@@ -78,7 +77,7 @@ TEST(ProducerRegistry, IdleProducersAreLetGoSoNewRobotsCanJoin) {
   policy.max_producers = 2;
   policy.idle_release = std::chrono::seconds(10);
   ProducerRegistry r("OCTOMAP_RT_SCAN_", policy);
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   const size_t junk1 = r.producer_for("OCTOMAP_RT_SCAN_JUNK1", t0);
   const size_t junk2 = r.producer_for("OCTOMAP_RT_SCAN_JUNK2", t0);
   ASSERT_FALSE(r.is_overflow(junk1));

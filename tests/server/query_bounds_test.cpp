@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/clock.h"
 #include "daemon/queries/query_clients.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/box_reply_t.hpp"
@@ -28,7 +29,6 @@ namespace ort::test {
 namespace {
 
 namespace wire = ort::protocol;
-using SteadyClock = std::chrono::steady_clock;
 
 // As many rays as a query may have (2000), each through unknown space as far as the wire
 // allows: without a bound one such query holds the read lock for tens of seconds.
@@ -51,10 +51,6 @@ void map_walls(daemon::MappingServer& server, lcm::LCM& lc, int scans) {
     lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);
   }
   ASSERT_TRUE(wait_until_done(server, scans));
-}
-
-double seconds_since(SteadyClock::time_point t) {
-  return std::chrono::duration<double>(SteadyClock::now() - t).count();
 }
 
 TEST(QueryBounds, RaysThroughUnknownSpaceAreCutAndTheReplySaysWhere) {

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/clock.h"
 #include "daemon/queries/edit_gate.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/box_reply_t.hpp"
@@ -292,11 +293,11 @@ TEST(QueryService, EditsLeftAtShutdownAreRefusedNotDropped) {
     for (const auto& p : server.producer_stats()) n += p.received;
     return n;
   };
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-  while ((op_stats().received < kSent || scans_received() < kSent) && std::chrono::steady_clock::now() < until)
+  const auto until = SteadyClock::now() + std::chrono::seconds(20);
+  while ((op_stats().received < kSent || scans_received() < kSent) && SteadyClock::now() < until)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   std::thread stopper([&] { server.stop(); });
-  while (op_stats().edits_refused == 0 && std::chrono::steady_clock::now() < until)
+  while (op_stats().edits_refused == 0 && SteadyClock::now() < until)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   {
     std::lock_guard lock(m);

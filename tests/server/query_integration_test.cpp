@@ -11,6 +11,7 @@
 #include <chrono>
 
 #include "cli/replay/scan_message.h"
+#include "core/clock.h"
 #include "integration_harness.h"
 #include "octomap_rt/occupancy_reply_t.hpp"
 #include "query/point_query.h"
@@ -22,11 +23,6 @@ namespace ort::test {
 namespace {
 
 using Reply = octomap_rt::occupancy_reply_t;
-
-int64_t now_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 // At most `most` of the scan's end points in the map frame (every n-th), as x, y, z floats.
 std::vector<float> end_points(const PosedScan& scan, size_t most) {
@@ -60,7 +56,7 @@ TEST(QueryIntegration, ARobotSeesItsOwnScanRightAfterSendingIt) {
     PosedScan scan = scans.scans[k % scans.scans.size()];
     scan.pose.trans().x() += 100.0f * static_cast<float>(k);  // space no earlier scan saw
     cli::ScanMessageFields fields;
-    fields.robot_id = "rover", fields.seq = k, fields.utime = now_us();
+    fields.robot_id = "rover", fields.seq = k, fields.utime = now_utime();
     const octomap_rt::scan_t msg = cli::make_scan_message(scan, fields);
     robot.publish(cli::scan_channel(ort::protocol::kScanChannelPrefix, "rover"), &msg);
     const std::vector<float> xyz = end_points(scan, 5000);

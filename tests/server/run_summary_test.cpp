@@ -5,15 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include "core/clock.h"
 #include "daemon/pipeline/slowest_scans.h"
 #include "daemon/status/run_summary.h"
 
 namespace ort::daemon {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-AppliedTiming timing(const Clock::time_point start, double received_ms, double e2e_ms, int64_t seq) {
+AppliedTiming timing(const SteadyClock::time_point start, double received_ms, double e2e_ms, int64_t seq) {
   AppliedTiming t;
   t.end_to_end_ms = e2e_ms;
   t.robot_id = "robot" + std::to_string(seq % 3);
@@ -23,7 +22,7 @@ AppliedTiming timing(const Clock::time_point start, double received_ms, double e
 }
 
 TEST(SlowestScans, KeepsTheSlowestEndToEndSlowestFirstWithTheirPlaceInTheRun) {
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   SlowestScans kept(3);
   const double e2e[] = {9.0, 2.0, 7.0, 1.0, 12.0, 7.5, 3.0, 8.0};
   for (int k = 0; k < 8; ++k) kept.add(timing(start, 10.0 * k, e2e[k], k));
@@ -41,7 +40,7 @@ TEST(SlowestScans, KeepsTheSlowestEndToEndSlowestFirstWithTheirPlaceInTheRun) {
 }
 
 TEST(SlowestScans, FewerScansThanKeptAreAllListed) {
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   SlowestScans kept(5);
   kept.add(timing(start, 0, 1.0, 0));
   kept.add(timing(start, 5, 3.0, 1));
@@ -55,7 +54,7 @@ TEST(SlowestScans, FewerScansThanKeptAreAllListed) {
 
 TEST(SlowestScans, PipelineMetricsHandThemToTheSnapshot) {
   PipelineMetrics metrics;
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   for (int k = 0; k < 7; ++k) metrics.record(timing(start, k, 1.0 + k, k));
   const MetricsSnapshot s = metrics.snapshot();
   ASSERT_EQ(s.slowest.size(), 5u);

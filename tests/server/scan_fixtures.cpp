@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/clock.h"
 #include "engine/map_engine.h"
 
 namespace ort::test {
@@ -74,8 +75,8 @@ daemon::ServerConfig test_config(double res, bool pipelined) {
 }
 
 bool wait_until_done(daemon::MappingServer& server, int64_t messages, std::chrono::seconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
+  const auto deadline = SteadyClock::now() + timeout;
+  while (SteadyClock::now() < deadline) {
     int64_t received = 0, in_flight = 0;
     for (const auto& p : server.producer_stats()) {
       received += p.received;

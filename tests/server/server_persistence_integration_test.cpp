@@ -13,6 +13,7 @@
 #include <random>
 #include <thread>
 
+#include "core/clock.h"
 #include "daemon/map/applied_order.h"
 #include "integration_harness.h"
 #include "scene/scan_set.h"
@@ -151,8 +152,8 @@ TEST(ServerPersistenceIntegration, KillNineDuringSavesAlwaysLeavesALoadableMap) 
     // the others at a random moment.
     bool mid_save = false;
     if (round % 3 != 2) {
-      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-      while (!exists(tmp) && std::chrono::steady_clock::now() < deadline) {
+      const auto deadline = SteadyClock::now() + std::chrono::seconds(20);
+      while (!exists(tmp) && SteadyClock::now() < deadline) {
         std::this_thread::sleep_for(std::chrono::microseconds(200));
       }
       mid_save = exists(tmp);

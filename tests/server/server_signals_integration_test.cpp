@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/clock.h"
 #include "integration_harness.h"
 #include "support/small_filesystem.h"
 
@@ -25,8 +26,8 @@ std::vector<std::string> server_args(const std::string& map) {
 }
 
 bool wait_for_log(const ChildProcess& p, const std::string& text, double timeout_s) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (std::chrono::steady_clock::now() < end) {
+  const auto end = SteadyClock::now() + std::chrono::duration<double>(timeout_s);
+  while (SteadyClock::now() < end) {
     if (p.log().find(text) != std::string::npos) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }

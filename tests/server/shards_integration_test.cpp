@@ -10,6 +10,7 @@
 #include <chrono>
 
 #include "cli/replay/scan_message.h"
+#include "core/clock.h"
 #include "integration_harness.h"
 #include "protocol/shards/shard_set.h"
 #include "query/point_query.h"
@@ -27,11 +28,6 @@ namespace {
 constexpr double kRes = 0.2;
 constexpr int kShards = 3;
 const char* kNs = "fleet";
-
-int64_t now_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 // Every n-th end point of the scans, as x y z floats.
 std::vector<float> end_points(const ScanSet& set, size_t stride) {
@@ -66,7 +62,7 @@ TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
   ASSERT_TRUE(robot.good());
   for (size_t k = 0; k < scans.scans.size(); ++k) {
     cli::ScanMessageFields fields;
-    fields.robot_id = "rover", fields.seq = static_cast<int64_t>(k), fields.utime = now_us();
+    fields.robot_id = "rover", fields.seq = static_cast<int64_t>(k), fields.utime = now_utime();
     const octomap_rt::scan_t msg = cli::make_scan_message(scans.scans[k], fields);
     robot.publish(cli::scan_channel(protocol::channels_in(kNs).scan_prefix, "rover"), &msg);
   }
@@ -102,7 +98,7 @@ TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
 
   // Points and rays routed by region: OctoMap's answers.
   const client::ShardRoster roster = client::discover_shards(client_url, kNs, 5);
-  ASSERT_TRUE(roster.complete()) << roster.shortfall(now_us(), 3);
+  ASSERT_TRUE(roster.complete()) << roster.shortfall(now_utime(), 3);
   client::ShardQueries q(client_url, "planner", std::chrono::seconds(3), kNs, *roster.set(), roster.resolution());
   const std::vector<float> xyz = end_points(scans, 50);
   const auto points = q.points(xyz, 0);

@@ -26,6 +26,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bigmap_readers.h"
+#include "core/clock.h"
 #include "daemon/mapping_server.h"
 #include "engine/engine_flags.h"
 #include "scene/scan_set.h"
@@ -34,7 +35,6 @@
 namespace {
 
 using namespace ort;
-using Clock = std::chrono::steady_clock;
 
 octomap_rt::scan_t to_message(const PosedScan& scan, const std::string& robot, int64_t seq) {
   octomap_rt::scan_t m;
@@ -118,7 +118,7 @@ int grow(const Args& a) {
   std::ostringstream log;
   daemon::MappingServer server(cfg, lc, log);
   server.start();
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   int64_t seq = 0, nodes = 0;
   while (nodes < a.target_nodes && seq < 100'000) {
     const auto m = to_message(set.scans[static_cast<size_t>(seq) % set.scans.size()], "grow", seq);
@@ -126,8 +126,7 @@ int grow(const Args& a) {
     ++seq;
     while (finished(server) < seq) std::this_thread::sleep_for(std::chrono::milliseconds(5));
     nodes = server.status().num_nodes;
-    std::printf("grow: scan %lld, %lld nodes, %.0f s\n", (long long)seq, (long long)nodes,
-                std::chrono::duration<double>(Clock::now() - t0).count());
+    std::printf("grow: scan %lld, %lld nodes, %.0f s\n", (long long)seq, (long long)nodes, seconds_since(t0));
     std::fflush(stdout);
     if (static_cast<size_t>(seq) == set.scans.size() && nodes < a.target_nodes)
       std::printf("grow: every scan applied once; going round again (more scans: --scan-scale)\n");
@@ -154,9 +153,9 @@ int run(const Args& a) {
   const double rss_before = rss_mib("VmRSS:");
   lcm::LCM lc("memq://");
   std::ostringstream log;
-  const auto load0 = Clock::now();
+  const auto load0 = SteadyClock::now();
   daemon::MappingServer server(cfg, lc, log);
-  const double load_s = std::chrono::duration<double>(Clock::now() - load0).count();
+  const double load_s = seconds_since(load0);
   const auto loaded = server.status();
   const double rss_loaded = rss_mib("VmRSS:");
   // Queries go where the map is: its bounding box.
@@ -173,14 +172,14 @@ int run(const Args& a) {
   for (size_t k = 0; k < set.scans.size(); ++k) msgs.push_back(to_message(set.scans[k], "p", 0));
   std::vector<std::thread> producers;
   std::atomic<int64_t> published{0};
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   for (int p = 0; p < a.producers; ++p)
     producers.emplace_back([&, p] {
       const std::string robot = "bench" + std::to_string(p);
       const std::string channel = "OCTOMAP_RT_SCAN_BENCH" + std::to_string(p);
       const auto period = std::chrono::duration<double>(1.0 / a.rate);
-      auto next = t0 + std::chrono::duration_cast<Clock::duration>(period * p / a.producers);
-      for (int64_t seq = 0; Clock::now() - t0 < std::chrono::duration<double>(a.duration); ++seq) {
+      auto next = t0 + std::chrono::duration_cast<SteadyClock::duration>(period * p / a.producers);
+      for (int64_t seq = 0; SteadyClock::now() - t0 < std::chrono::duration<double>(a.duration); ++seq) {
         std::this_thread::sleep_until(next);
         octomap_rt::scan_t m = msgs[static_cast<size_t>(seq * a.producers + p) % msgs.size()];
         m.robot_id = robot;
@@ -188,13 +187,13 @@ int run(const Args& a) {
         m.utime = seq + 1;
         lc.publish(channel, &m);
         published++;
-        next += std::chrono::duration_cast<Clock::duration>(period);
+        next += std::chrono::duration_cast<SteadyClock::duration>(period);
       }
     });
   for (auto& t : producers) t.join();
-  while (finished(server) < published && Clock::now() - t0 < std::chrono::duration<double>(a.duration + 300))
+  while (finished(server) < published && SteadyClock::now() - t0 < std::chrono::duration<double>(a.duration + 300))
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  const double seconds = seconds_since(t0);
   r.stop();
   const auto st = server.status();
   const double rss_end = rss_mib("VmRSS:"), hwm = rss_mib("VmHWM:");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <random>
 
+#include "core/clock.h"
 #include "octomap_rt/map_chunk_t.hpp"
 #include "octomap_rt/map_request_t.hpp"
 #include "octomap_rt/occupancy_query_t.hpp"
@@ -12,12 +13,11 @@
 namespace ort::bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 // A map request's reply channel must carry the protocol's prefix (else it is refused unanswered).
 const std::string kMapReply = std::string(ort::protocol::kMapReplyPrefix) + "BENCH";
 constexpr const char* kQueryReply = "BENCH_QUERY_REPLY";
 
-double seconds_between(Clock::time_point a, Clock::time_point b) {
+double seconds_between(SteadyClock::time_point a, SteadyClock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
 }
 
@@ -41,7 +41,7 @@ BenchReaders::BenchReaders(daemon::MappingServer& server, lcm::LCM& lc, double s
   server_.lcm_loop().subscribe(kQueryReply, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
     octomap_rt::occupancy_reply_t r;
     if (r.decode(rb.data, 0, static_cast<int>(rb.data_size)) < 0) return;
-    const auto now = Clock::now();
+    const auto now = SteadyClock::now();
     std::lock_guard lock(mutex_);
     auto it =
         std::find_if(in_flight_.begin(), in_flight_.end(), [&](const auto& q) { return q.first == r.request_id; });
@@ -77,7 +77,7 @@ ReaderStats BenchReaders::stats() {
 void BenchReaders::pull_snapshots() {
   int64_t id = 0;
   while (!stop_) {
-    const auto t0 = Clock::now();
+    const auto t0 = SteadyClock::now();
     octomap_rt::map_request_t r{};
     r.request_id = ++id;
     r.snapshot_id = -1;
@@ -92,13 +92,13 @@ void BenchReaders::pull_snapshots() {
     }
     lc_.publish(ort::protocol::kMapRequestChannel, &r);
     bool done = false;
-    while (!stop_ && !done && seconds_between(t0, Clock::now()) < 120) {
+    while (!stop_ && !done && seconds_between(t0, SteadyClock::now()) < 120) {
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
       std::lock_guard lock(mutex_);
       done = chunks_expected_ > 0 && chunks_got_ >= chunks_expected_;
       if (chunks_expected_ == 0) break;  // refused: counted below, asked again next period
     }
-    const double s = seconds_between(t0, Clock::now());
+    const double s = seconds_between(t0, SteadyClock::now());
     {
       std::lock_guard lock(mutex_);
       if (done) {
@@ -109,7 +109,7 @@ void BenchReaders::pull_snapshots() {
         stats_.snapshot_timeouts++;
       }
     }
-    while (!stop_ && seconds_between(t0, Clock::now()) < snapshot_period_s_)
+    while (!stop_ && seconds_between(t0, SteadyClock::now()) < snapshot_period_s_)
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
 }
@@ -119,7 +119,7 @@ void BenchReaders::send_queries() {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> u(0.f, 1.f);
   const auto period = std::chrono::duration<double>(1.0 / query_rate_hz_);
-  auto next = Clock::now();
+  auto next = SteadyClock::now();
   int64_t id = 0;
   while (!stop_) {
     octomap_rt::occupancy_query_t q{};
@@ -133,11 +133,11 @@ void BenchReaders::send_queries() {
     q.num_xyz = static_cast<int32_t>(q.xyz.size());
     {
       std::lock_guard lock(mutex_);
-      in_flight_.emplace_back(id, Clock::now());
+      in_flight_.emplace_back(id, SteadyClock::now());
       stats_.queries_sent++;
     }
     lc_.publish(ort::protocol::kQueryChannel, &q);
-    next += std::chrono::duration_cast<Clock::duration>(period);
+    next += std::chrono::duration_cast<SteadyClock::duration>(period);
     std::this_thread::sleep_until(next);
   }
 }

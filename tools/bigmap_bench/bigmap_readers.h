@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/clock.h"
 #include "daemon/mapping_server.h"
 
 namespace ort::bench {
@@ -48,7 +49,7 @@ class BenchReaders {
   ReaderStats stats_;
   int64_t chunk_request_ = -1;
   int32_t chunks_expected_ = -1, chunks_got_ = 0;
-  std::vector<std::pair<int64_t, std::chrono::steady_clock::time_point>> in_flight_;  // query id, sent
+  std::vector<std::pair<int64_t, SteadyClock::time_point>> in_flight_;  // query id, sent
 };
 
 }  // namespace ort::bench

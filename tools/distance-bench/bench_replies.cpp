@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/clock.h"
 #include "octomap_rt/distance_box_chunk_t.hpp"
 #include "octomap_rt/distance_points_reply_t.hpp"
 
@@ -15,7 +16,7 @@ DistanceReplies::DistanceReplies(daemon::MappingServer& server, const std::strin
 }
 
 void DistanceReplies::on(const uint8_t* data, size_t size) {
-  const auto now = BenchClock::now();
+  const auto now = SteadyClock::now();
   octomap_rt::distance_box_chunk_t box;
   octomap_rt::distance_points_reply_t points;
   int64_t id = 0;
@@ -35,7 +36,7 @@ void DistanceReplies::on(const uint8_t* data, size_t size) {
   if (--it->second == 0) done_[id] = now, cv_.notify_all();
 }
 
-double DistanceReplies::wait(int64_t id, BenchClock::time_point sent, double timeout_s) {
+double DistanceReplies::wait(int64_t id, SteadyClock::time_point sent, double timeout_s) {
   std::unique_lock lock(m_);
   if (!cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return done_.count(id) > 0; })) {
     ++failures_["no answer within " + std::to_string(static_cast<int>(timeout_s)) + " s"];

@@ -10,18 +10,17 @@
 #include <string>
 #include <vector>
 
+#include "core/clock.h"
 #include "daemon/mapping_server.h"
 
 namespace ort::bench {
-
-using BenchClock = std::chrono::steady_clock;
 
 class DistanceReplies {
  public:
   DistanceReplies(daemon::MappingServer& server, const std::string& channel);
   // Seconds from `sent` to the last message of `id`; < 0 when it was refused (the reason is
   // kept for the phase's report) or did not come within `timeout_s`.
-  double wait(int64_t id, BenchClock::time_point sent, double timeout_s);
+  double wait(int64_t id, SteadyClock::time_point sent, double timeout_s);
   // Refusals and time-outs so far, by text ("timed out after 30 s", the server's error).
   std::map<std::string, int64_t> failures() const;
 
@@ -31,7 +30,7 @@ class DistanceReplies {
   mutable std::mutex m_;
   std::condition_variable cv_;
   std::map<int64_t, int> remaining_;  // messages still expected (box: num_chunks)
-  std::map<int64_t, BenchClock::time_point> done_;
+  std::map<int64_t, SteadyClock::time_point> done_;
   std::map<int64_t, std::string> errors_;
   std::map<std::string, int64_t> failures_;
 };

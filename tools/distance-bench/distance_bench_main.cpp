@@ -21,6 +21,7 @@
 
 #include "bench_replies.h"
 #include "cli/replay/scan_message.h"
+#include "core/clock.h"
 #include "daemon/intake/reject_reason.h"
 #include "daemon/mapping_server.h"
 #include "daemon/server_cli.h"
@@ -31,12 +32,13 @@
 
 namespace {
 
-using ort::bench::BenchClock;
+using ort::seconds_since;
+using ort::SteadyClock;
 using ort::bench::LatencyStats;
 using DQ = octomap_rt::distance_query_t;
 const std::string kReply = "DISTANCE_BENCH_REPLY";
 
-double since(BenchClock::time_point t0) { return std::chrono::duration<double>(BenchClock::now() - t0).count(); }
+double since(SteadyClock::time_point t0) { return seconds_since(t0); }
 
 // One robot's scans as the server counted them: every scan ends applied, rejected or dropped.
 struct Tally {
@@ -124,7 +126,7 @@ int main(int argc, char** argv) {
 
   // Preload: at most 2 scans in flight; then wait until every scan ended (applied, refused or
   // dropped), within --wait-s.
-  const auto preload_t0 = BenchClock::now();
+  const auto preload_t0 = SteadyClock::now();
   for (size_t i = 0; i < scans.scans.size(); ++i) {
     while (tally(server, "map").in_flight > 2 && since(preload_t0) < wait_s)
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -188,7 +190,7 @@ int main(int argc, char** argv) {
   auto send = [&](DQ& q, const std::string& client) {
     q.request_id = next_id++, q.wait_seq = -1, q.client_id = client, q.reply_channel = kReply;
     q.max_distance = max_distance, q.cell_voxels = 1;
-    const auto t = BenchClock::now();
+    const auto t = SteadyClock::now();
     lc.publish(ort::protocol::kQueryDistanceChannel, &q);
     return std::make_pair(q.request_id, t);
   };
@@ -251,7 +253,7 @@ int main(int argc, char** argv) {
         }
       });
     const int64_t before = applied_total(server);
-    const auto t0 = BenchClock::now();
+    const auto t0 = SteadyClock::now();
     queries(stop);
     while (since(t0) < phase_s) std::this_thread::sleep_for(std::chrono::milliseconds(10));
     const double scans_per_s = double(applied_total(server) - before) / since(t0);
@@ -266,12 +268,12 @@ int main(int argc, char** argv) {
   report("mapping alone", LatencyStats{}, stream([](const std::atomic<bool>&) {}));
   LatencyStats loaded_box;
   const double with_boxes = stream([&](const std::atomic<bool>&) {
-    const auto t0 = BenchClock::now();
-    std::vector<std::pair<int64_t, BenchClock::time_point>> sent;
+    const auto t0 = SteadyClock::now();
+    std::vector<std::pair<int64_t, SteadyClock::time_point>> sent;
     for (int i = 0; since(t0) < phase_s; ++i) {
       sent.push_back(box_query());
       std::this_thread::sleep_until(
-          t0 + std::chrono::duration_cast<BenchClock::duration>(std::chrono::duration<double>((i + 1) / box_rate)));
+          t0 + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>((i + 1) / box_rate)));
     }
     for (const auto& [id, t] : sent) loaded_box.add(replies.wait(id, t, answer_timeout_s));
   });

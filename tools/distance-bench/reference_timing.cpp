@@ -5,6 +5,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/clock.h"
 #include "core/errors.h"
 #include "distance/distance_queries.h"
 #include "distance/squared_edt.h"
@@ -17,16 +18,14 @@
 namespace ort::bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 template <class F>
 double median_ms(int reps, F&& f) {
   f();  // untimed: first-touch pages, pipelines
   std::vector<double> ms;
   for (int r = 0; r < std::max(1, reps); ++r) {
-    const auto t0 = Clock::now();
+    const auto t0 = SteadyClock::now();
     f();
-    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    ms.push_back(ms_since(t0));
   }
   std::sort(ms.begin(), ms.end());
   return ms[ms.size() / 2];

@@ -28,7 +28,6 @@
 namespace {
 
 using namespace ort;
-using Clock = std::chrono::steady_clock;
 
 std::vector<uint8_t> encode_scan(const PosedScan& scan) {
   octomap_rt::scan_t m{};
@@ -79,7 +78,7 @@ int main(int argc, char** argv) {
   int rejected = 0;
   for (int r = 0; r < rounds; ++r) {
     for (const auto& bytes : messages) {
-      auto t = Clock::now();
+      auto t = SteadyClock::now();
       {
         octomap_rt::scan_t m;
         m.decode(bytes.data(), 0, static_cast<int>(bytes.size()));
@@ -89,16 +88,16 @@ int main(int argc, char** argv) {
         lcm_decode.push_back(ms_since(t));
       }
       octomap_rt::scan_t m;
-      t = Clock::now();
+      t = SteadyClock::now();
       rejected += daemon::validate_scan(bytes.data(), bytes.size(), "bench0", limits, m) != daemon::Reject::kNone;
       ours.push_back(ms_since(t));
-      t = Clock::now();
+      t = SteadyClock::now();
       {
         const daemon::PosedMessageScan s = daemon::to_posed_scan(m);
         to_pointcloud.push_back(ms_since(t));
       }
       upload.resize(m.xyz.size());
-      t = Clock::now();
+      t = SteadyClock::now();
       std::memcpy(upload.data(), m.xyz.data(), m.xyz.size() * sizeof(float));
       one_copy.push_back(ms_since(t));
     }

@@ -21,6 +21,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "cli/replay/scan_message.h"
+#include "core/clock.h"
 #include "octomap_rt/server_status_t.hpp"
 #include "protocol/channels.h"
 #include "scene/scan_set.h"
@@ -29,13 +30,6 @@
 
 namespace ort::cli {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-int64_t now_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 bool write_text(const std::string& path, const std::string& text) {
   std::ofstream out(path);
@@ -171,10 +165,11 @@ void publish_for(const std::string& url, int index, const LoadTestConfig& cfg, c
   lcm::LCM lc(url);
   const std::string robot = "load" + std::to_string(index);
   const std::string channel = scan_channel(ort::protocol::kScanChannelPrefix, robot);
-  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / cfg.rate_hz));
-  const auto end =
-      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.duration_s));
-  auto next = Clock::now() + period * index / std::max(1, cfg.producers);  // spread the producers over one period
+  const auto period =
+      std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(1.0 / cfg.rate_hz));
+  const auto end = SteadyClock::now() +
+                   std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(cfg.duration_s));
+  auto next = SteadyClock::now() + period * index / std::max(1, cfg.producers);  // spread the producers over one period
   std::vector<uint8_t> buf;
   for (int64_t seq = 0; next < end; ++seq) {
     std::this_thread::sleep_until(next);
@@ -240,7 +235,7 @@ LoadReport run_load_test(const LoadTestConfig& cfg) {
     throw std::runtime_error("the server sent no status within 60 s; see " + cfg.log_path);
   }
   std::atomic<int64_t> published{0}, errors{0};
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   std::atomic<bool> series_stop{false};
   std::jthread series;
   if (!cfg.series_path.empty()) {
@@ -256,9 +251,9 @@ LoadReport run_load_test(const LoadTestConfig& cfg) {
         last_seq = st.seq;
         char line[384];
         std::snprintf(line, sizeof line, "%.2f,%.1f,%.1f,%.2f,%lld,%.2f,%lld,%.2f,%.2f,%.2f,%lld,%lld,%lld\n",
-                      std::chrono::duration<double>(Clock::now() - t0).count(), rss_mib(server), peak_rss_mib(server),
-                      double(st.memory_bytes) / 1048576.0, (long long)st.num_nodes, double(st.end_to_end_ms_p99),
-                      (long long)st.scans_applied, double(st.octree_ms_p99), double(st.map_memory_bound) / 1048576.0,
+                      seconds_since(t0), rss_mib(server), peak_rss_mib(server), double(st.memory_bytes) / 1048576.0,
+                      (long long)st.num_nodes, double(st.end_to_end_ms_p99), (long long)st.scans_applied,
+                      double(st.octree_ms_p99), double(st.map_memory_bound) / 1048576.0,
                       double(st.evicted_bytes) / 1048576.0, (long long)st.evicted_regions,
                       (long long)st.region_evictions, (long long)st.region_restores);
         out << line << std::flush;
@@ -270,16 +265,16 @@ LoadReport run_load_test(const LoadTestConfig& cfg) {
     for (int i = 0; i < cfg.producers; ++i)
       producers.emplace_back([&, i] { publish_for(url, i, cfg, scans, published, errors); });
   }
-  const double publish_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  const double publish_s = seconds_since(t0);
   r.published = published;
   r.publish_errors = errors;
   // Settle: until every received scan is applied, rejected or dropped (or the time is up).
-  const auto settle_end =
-      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.settle_s));
+  const auto settle_end = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
+                                                   std::chrono::duration<double>(cfg.settle_s));
   do {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     count_totals(status.latest(), r);
-  } while ((r.in_flight > 0 || r.received < r.published - r.missed) && Clock::now() < settle_end);
+  } while ((r.in_flight > 0 || r.received < r.published - r.missed) && SteadyClock::now() < settle_end);
   std::this_thread::sleep_for(std::chrono::milliseconds(700));  // one more status period
   count_totals(status.latest(), r);
   status.fill(r);

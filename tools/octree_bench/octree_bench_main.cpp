@@ -31,8 +31,8 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using ort::ms_since;
+using ort::SteadyClock;
 
 struct DataSet {
   std::string name;
@@ -132,10 +132,10 @@ int main(int argc, char** argv) {
     if (t < 2) continue;
     ort::WorkerPool pool(t);
     constexpr int kJobs = 2000;
-    auto start = Clock::now();
+    auto start = SteadyClock::now();
     for (int j = 0; j < kJobs; ++j) pool.run([](unsigned) {});
     const double all_us = ms_since(start) * 1e3 / kJobs;
-    start = Clock::now();
+    start = SteadyClock::now();
     for (int j = 0; j < kJobs; ++j) pool.run_shared([](unsigned) {});
     std::printf("worker pool, %2u threads: %.1f us per empty job (start and join), %.1f us shared\n", t, all_us,
                 ms_since(start) * 1e3 / kJobs);
@@ -156,16 +156,16 @@ int main(int argc, char** argv) {
       ort::WorkerPool pool(hw);
       double one = 1e300, standard = 1e300, bucket_all = 1e300;
       for (int r = 0; r < repeat; ++r) {
-        auto t = Clock::now();
+        auto t = SteadyClock::now();
         for (const auto& l : d.lists) {
           ort::bucket_voxels(l, ort::BucketOptions{}, nullptr, buckets, scratch);
           for (size_t b = 0; b < buckets.count(); ++b) ort::sort_bucket(buckets.bucket(b), tmp);
         }
         one = std::min(one, ms_since(t));
-        t = Clock::now();
+        t = SteadyClock::now();
         for (const auto& l : d.lists) ort::bucket_voxels(l, ort::BucketOptions{}, &pool, buckets, scratch);
         bucket_all = std::min(bucket_all, ms_since(t));
-        t = Clock::now();
+        t = SteadyClock::now();
         for (const auto& l : d.lists) {
           codes.clear();
           for (const ort::VoxelUpdate& u : l) codes.push_back(ort::make_sorted_voxel(u));
@@ -190,7 +190,7 @@ int main(int argc, char** argv) {
     size_t nodes = 0;
     for (int r = 0; r < repeat; ++r) {
       octomap::OcTree reference(resolution);
-      auto t = Clock::now();
+      auto t = SteadyClock::now();
       if (!batched_only) {
         for (int p = 0; p < passes; ++p)
           for (const auto& l : d.lists) ort::apply_updates_sequential(reference, l);
@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
         octomap::OcTree tree(resolution);
         ort::BatchedUpdateStats sum, one;
         const ProcessTimes before = process_times();
-        t = Clock::now();
+        t = SteadyClock::now();
         for (int p = 0; p < passes; ++p)
           for (const auto& l : d.lists) {
             batched[i]->apply(tree, l, &one);

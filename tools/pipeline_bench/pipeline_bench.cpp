@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/clock.h"
 #include "daemon/mapping_server.h"
 #include "engine/engine_flags.h"
 #include "protocol/channels.h"
@@ -67,7 +68,7 @@ RunResult run(const daemon::ServerConfig& base, bool pipelined, const ScanSet& s
     res.scans += static_cast<int64_t>(m.size());
     for (const auto& s : m) res.points += s.num_xyz / 3;
   }
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = SteadyClock::now();
   std::vector<std::thread> threads;
   for (int p = 0; p < producers; ++p)
     threads.emplace_back([&, p] {
@@ -81,7 +82,7 @@ RunResult run(const daemon::ServerConfig& base, bool pipelined, const ScanSet& s
     if (done >= res.scans) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
-  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  res.seconds = seconds_since(t0);
   res.status = server.status();
   server.stop();
   return res;

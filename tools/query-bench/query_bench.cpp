@@ -24,6 +24,7 @@
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
 
+#include "core/clock.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/box_reply_t.hpp"
 #include "octomap_rt/occupancy_query_t.hpp"
@@ -37,7 +38,9 @@
 
 namespace {
 
-using SteadyClock = std::chrono::steady_clock;
+using ort::seconds_since;
+using ort::SteadyClock;
+
 using Reply = octomap_rt::occupancy_reply_t;
 struct Options {
   std::string graph, lcm_url = ort::protocol::kDefaultLcmUrl, until_file, client_id = "query-bench";
@@ -72,8 +75,7 @@ const char* const kKindSuffix[3] = {"-points", "-rays", "-boxes"};
 
 template <class Q>
 void address(Q& q, int64_t id, int kind, const Options& o, const std::string& reply_channel) {
-  q.utime = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-                .count();
+  q.utime = ort::now_utime();
   q.request_id = id;
   q.min_snapshot_id = 0;
   q.wait_seq = -1;
@@ -237,7 +239,7 @@ int64_t send_all(lcm::LCM& lc, Queries& make, Ledger& ledger, const Options& o) 
   auto next = start;
   int64_t sent = 0;
   for (;; ++sent) {
-    if (std::chrono::duration<double>(SteadyClock::now() - start).count() >= o.duration_s) break;
+    if (seconds_since(start) >= o.duration_s) break;
     if (!o.until_file.empty() && std::filesystem::exists(o.until_file)) break;
     const int kind = static_cast<int>(sent % 3);
     ledger.sent(sent + 1, kind, SteadyClock::now());
@@ -299,7 +301,7 @@ int main(int argc, char** argv) {
     Queries make(scene, o, reply_channel);
     const auto start = SteadyClock::now();
     const int64_t sent = send_all(lc, make, ledger, o);
-    const double seconds = std::chrono::duration<double>(SteadyClock::now() - start).count();
+    const double seconds = seconds_since(start);
     for (int i = 0; i < 100 && ledger.open() > 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
     stop = true;
     receiver.join();

@@ -33,8 +33,8 @@ std::string one_line(std::string s) {
   return s;
 }
 
-using Clock = std::chrono::steady_clock;
 using ort::ms_since;
+using ort::SteadyClock;
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -154,7 +154,7 @@ int main(int argc, char** argv) {
           double total = 0;
           for (const Scan& s : scans) {
             octomap::KeySet free_cells, occupied_cells;
-            const auto t0 = Clock::now();
+            const auto t0 = SteadyClock::now();
             tree.computeUpdate(s.world, s.origin, free_cells, occupied_cells, max_range);
             total += ms_since(t0);
           }

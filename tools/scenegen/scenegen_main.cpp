@@ -7,8 +7,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/clock.h"
 #include "scene/scan_set.h"
 #include "scene/scene_presets.h"
+
+using ort::seconds_since;
+using ort::SteadyClock;
 
 int main(int argc, char** argv) {
   CLI::App app{"octomap-rt-scenegen: deterministic procedural scan sets at the scale of the OctoMap-RT paper"};
@@ -37,9 +41,9 @@ int main(int argc, char** argv) {
     opts.scan_scale = opts.point_scale = ort::parse_scale(scale);
     if (!scan_scale.empty()) opts.scan_scale = ort::parse_scale(scan_scale);
     if (!point_scale.empty()) opts.point_scale = ort::parse_scale(point_scale);
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = SteadyClock::now();
     const ort::ScanSet set = ort::make_preset(preset, opts);
-    const double gen_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double gen_s = seconds_since(t0);
     ort::save_scan_graph(set, output);
     std::printf("%s: %zu scans, %zu points (%.0f a scan), generated in %.2f s, written to %s\n", preset.c_str(),
                 set.scans.size(), set.total_points(), double(set.total_points()) / set.scans.size(), gen_s,

@@ -18,6 +18,7 @@
 
 #include "cli/replay/scan_message.h"
 #include "core/backend_kind.h"
+#include "core/clock.h"
 #include "daemon/intake/scan_to_map.h"
 #include "daemon/pipeline/shard_filter.h"
 #include "engine/map_engine.h"
@@ -27,8 +28,8 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+using ort::ms_since;
+using ort::SteadyClock;
 
 std::vector<int> parse_list(const std::string& s) {
   std::vector<int> out;
@@ -92,22 +93,22 @@ int main(int argc, char** argv) {
       msg.encode(wire.data(), 0, static_cast<int>(wire.size()));
       bytes += wire.size();
       octomap_rt::scan_t got;
-      auto t = Clock::now();
+      auto t = SteadyClock::now();
       ort::protocol::decode_scan(wire.data(), wire.size(), got);
       decode_ms += ms_since(t);
       const octomap::pose6d pose = ort::daemon::scan_pose(got);
       const std::span<const float> xyz(got.xyz.data(), got.xyz.size());
-      t = Clock::now();
+      t = SteadyClock::now();
       engine.shoot_posed_xyz(pose, pose.trans(), xyz, max_range, shot);
       walk_ms += ms_since(t);
       for (PerSize& run : runs)
         for (size_t i = 0; i < run.trees.size(); ++i) {
           ort::ShotScan mine = shot;
-          t = Clock::now();
+          t = SteadyClock::now();
           run.filters[i].keep_owned(mine);
           run.cut_ms[i] += ms_since(t);
           run.voxels[i] += mine.voxels.size();
-          t = Clock::now();
+          t = SteadyClock::now();
           engine.apply(mine, *run.trees[i]);
           run.apply_ms[i] += ms_since(t);
         }

@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "core/clock.h"
+
 namespace ort::cli {
 namespace {
 
@@ -13,8 +15,8 @@ bool wait_for_server_status(lcm::LCM& lcm, const std::string& status_channel, do
   bool seen = false;
   // Untyped: we only need to know that the server is there, not what it says.
   lcm::Subscription* sub = lcm.subscribeFunction(status_channel, &note_status, &seen);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (!seen && std::chrono::steady_clock::now() < deadline) {
+  const auto deadline = SteadyClock::now() + std::chrono::duration<double>(timeout_s);
+  while (!seen && SteadyClock::now() < deadline) {
     if (lcm.handleTimeout(100) < 0) break;
   }
   lcm.unsubscribe(sub);

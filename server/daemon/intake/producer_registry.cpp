@@ -2,6 +2,7 @@
 
 #include <cstring>
 
+#include "core/clock.h"
 #include "protocol/ids.h"
 
 namespace ort::daemon {
@@ -49,7 +50,7 @@ bool ProducerRegistry::allowed(const std::string& robot_id) const {
   return false;
 }
 
-size_t ProducerRegistry::idle_slot(Clock::time_point now) const {
+size_t ProducerRegistry::idle_slot(SteadyClock::time_point now) const {
   if (policy_.idle_release.count() <= 0) return SIZE_MAX;
   size_t best = SIZE_MAX;
   for (const auto& [channel, i] : by_channel_) {
@@ -83,7 +84,7 @@ void ProducerRegistry::release(size_t slot) {
   p = ProducerStats{};
 }
 
-size_t ProducerRegistry::producer_for(const std::string& channel, Clock::time_point now) {
+size_t ProducerRegistry::producer_for(const std::string& channel, SteadyClock::time_point now) {
   std::lock_guard lock(mutex_);
   if (auto it = by_channel_.find(channel); it != by_channel_.end()) {
     last_arrival_[it->second] = now;

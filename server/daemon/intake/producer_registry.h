@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "core/clock.h"
 #include "daemon/intake/reject_reason.h"
 
 namespace ort::daemon {
@@ -57,8 +58,6 @@ struct ProducerPolicy {
 
 class ProducerRegistry {
  public:
-  using Clock = std::chrono::steady_clock;
-
   // `scan_prefix`: the literal start of every scan channel; the rest is the robot id.
   ProducerRegistry(std::string scan_prefix, ProducerPolicy policy);
   ProducerRegistry(std::string scan_prefix, size_t max_producers);
@@ -66,7 +65,7 @@ class ProducerRegistry {
   // Index of the producer on `channel`, made on first sight (or in an idle slot). Channels
   // that get no slot share one of two refused entries: robots not on the allow-list
   // (channel "!"), and channels beyond max_producers (channel "*").
-  size_t producer_for(const std::string& channel, Clock::time_point now = Clock::now());
+  size_t producer_for(const std::string& channel, SteadyClock::time_point now = SteadyClock::now());
   // True for the two refused entries; refusal() says which reason their scans get.
   bool is_overflow(size_t producer) const;
   Reject refusal(size_t producer) const;
@@ -92,7 +91,7 @@ class ProducerRegistry {
   size_t special_entry(size_t& index, const char* channel, const char* robot_id);
   bool allowed(const std::string& robot_id) const;
   // A slot idle since before `now - idle_release`, or SIZE_MAX.
-  size_t idle_slot(Clock::time_point now) const;
+  size_t idle_slot(SteadyClock::time_point now) const;
   void release(size_t slot);
   void note_seq(ProducerStats& p, int64_t seq) const;
 
@@ -102,7 +101,7 @@ class ProducerRegistry {
   size_t overflow_index_ = SIZE_MAX, refused_index_ = SIZE_MAX, released_index_ = SIZE_MAX;
   size_t slots_used_ = 0;
   std::vector<ProducerStats> producers_;
-  std::vector<Clock::time_point> last_arrival_;  // parallel to producers_
+  std::vector<SteadyClock::time_point> last_arrival_;  // parallel to producers_
   std::map<std::string, size_t> by_channel_;
 };
 

@@ -1,5 +1,7 @@
 #include "daemon/intake/scan_intake.h"
 
+#include "core/clock.h"
+
 namespace ort::daemon {
 
 ScanIntake::ScanIntake(LcmLoop& loop, std::string channel_regex, const ScanLimits& limits, ProducerRegistry& producers,
@@ -38,7 +40,7 @@ void ScanIntake::on_message(const lcm::ReceiveBuffer& rbuf, const std::string& c
     producers_.count_rejected_arrival(producer, producers_.refusal(producer));
     return;
   }
-  const auto received = Clock::now();
+  const auto received = SteadyClock::now();
   QueuedScan item;
   const Reject why = validate_scan(static_cast<const uint8_t*>(rbuf.data), rbuf.data_size,
                                    producers_.expected_robot_id(producer), limits_, item.msg);
@@ -48,7 +50,7 @@ void ScanIntake::on_message(const lcm::ReceiveBuffer& rbuf, const std::string& c
   }
   item.producer = producer;
   item.received = received;
-  item.decoded = Clock::now();
+  item.decoded = SteadyClock::now();
   item.bytes = queued_bytes(item.msg);
   const int64_t seq = item.msg.seq, utime = item.msg.utime;
   producers_.admit(producer, seq, utime, [&] { return queue_.try_push(std::move(item)); });

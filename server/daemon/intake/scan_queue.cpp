@@ -4,6 +4,8 @@
 #include <iterator>
 #include <string>
 
+#include "core/clock.h"
+
 namespace ort::daemon {
 
 size_t queued_bytes(const octomap_rt::scan_t& msg) {
@@ -39,7 +41,7 @@ bool ScanQueue::push_edit(std::shared_ptr<MapEditItem> edit) {
     if (closed_) return false;
     QueuedScan s;
     s.edit = std::move(edit);
-    s.received = Clock::now();
+    s.received = SteadyClock::now();
     s.arrival = next_arrival_++;
     fifo_.push_back(std::move(s));
   }
@@ -70,9 +72,9 @@ std::vector<QueuedScan> ScanQueue::take_all() {
   return out;
 }
 
-Clock::duration ScanQueue::oldest_age(Clock::time_point now) const {
+SteadyClock::duration ScanQueue::oldest_age(SteadyClock::time_point now) const {
   std::lock_guard lock(mutex_);
-  return fifo_.empty() ? Clock::duration::zero() : now - fifo_.front().received;
+  return fifo_.empty() ? SteadyClock::duration::zero() : now - fifo_.front().received;
 }
 
 void ScanQueue::close() {

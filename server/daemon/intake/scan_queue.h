@@ -16,11 +16,10 @@
 #include <optional>
 #include <vector>
 
+#include "core/clock.h"
 #include "octomap_rt/scan_t.hpp"
 
 namespace ort::daemon {
-
-using Clock = std::chrono::steady_clock;
 
 // A map edit rides the queue to keep its place among the scans; what it is and how it is
 // applied are the map's (daemon/map/map_edit_item.h): the queue only holds it.
@@ -28,10 +27,10 @@ struct MapEditItem;
 
 struct QueuedScan {
   size_t producer = 0;
-  uint64_t arrival = 0;        // global arrival number, set by the queue
-  Clock::time_point received;  // when the LCM thread got it
-  Clock::time_point decoded;   // when the LCM thread had decoded and checked it (unset: = received)
-  size_t bytes = 0;            // what it holds against the budget
+  uint64_t arrival = 0;              // global arrival number, set by the queue
+  SteadyClock::time_point received;  // when the LCM thread got it
+  SteadyClock::time_point decoded;   // when the LCM thread had decoded and checked it (unset: = received)
+  size_t bytes = 0;                  // what it holds against the budget
   octomap_rt::scan_t msg;
   std::shared_ptr<MapEditItem> edit;  // set: a map edit, not a scan (msg is empty)
 };
@@ -56,7 +55,7 @@ class ScanQueue {
   // them as dropped). pop() then returns nullopt once closed.
   std::vector<QueuedScan> take_all();
   // How long the oldest queued scan has waited (zero when empty).
-  Clock::duration oldest_age(Clock::time_point now = Clock::now()) const;
+  SteadyClock::duration oldest_age(SteadyClock::time_point now = SteadyClock::now()) const;
   uint64_t total_budget() const { return total_budget_; }
 
   size_t depth() const;

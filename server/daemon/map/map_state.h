@@ -14,6 +14,7 @@
 
 #include <octomap/OcTree.h>
 
+#include "core/clock.h"
 #include "core/voxel_update.h"
 #include "daemon/map/applied_order.h"
 #include "octree/leaf_changes.h"
@@ -69,7 +70,7 @@ struct MapState {
   // (daemon/map/map_upkeep.h). At most kMaxRobotsSeen entries (the stalest goes first).
   struct RobotSeen {
     octomap::point3d origin;
-    std::chrono::steady_clock::time_point applied;
+    SteadyClock::time_point applied;
   };
   static constexpr size_t kMaxRobotsSeen = 256;
   std::map<std::string, RobotSeen> robots_seen;

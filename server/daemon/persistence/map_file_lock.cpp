@@ -8,6 +8,7 @@
 #include <cstring>
 #include <ctime>
 
+#include "core/clock.h"
 #include "daemon/persistence/map_store.h"
 
 namespace ort::daemon {
@@ -24,11 +25,7 @@ std::string read_small_file(int fd) {
 }  // namespace
 
 std::string map_lock_holder(const std::string& server_id, const std::string& host) {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char since[32];
-  std::strftime(since, sizeof since, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  const std::string since = utc_text("%Y-%m-%dT%H:%M:%SZ");
   return "pid " + std::to_string(::getpid()) + " on host " + host + " (" + server_id + "), since " + since;
 }
 

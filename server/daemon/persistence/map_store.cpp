@@ -13,6 +13,7 @@
 #include <iterator>
 #include <sstream>
 
+#include "core/clock.h"
 #include "core/file_checks/octree_file_check.h"
 #include "daemon/persistence/map_identity_file.h"
 
@@ -86,14 +87,7 @@ void require_resolution(octomap::OcTree& tree, double resolution, const std::str
   if (file_res != resolution) tree.setResolution(resolution);
 }
 
-std::string utc_stamp() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y%m%dT%H%M%SZ", &tm);
-  return buf;
-}
+std::string utc_stamp() { return utc_text("%Y%m%dT%H%M%SZ"); }
 
 }  // namespace
 

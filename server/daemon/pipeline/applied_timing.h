@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 
+#include "core/clock.h"
 #include "core/ray_backend.h"
 
 namespace ort::daemon {
@@ -37,9 +38,9 @@ struct AppliedTiming {
   Stage2Parts stage2;
   std::string robot_id;
   int64_t seq = 0;
-  std::chrono::steady_clock::time_point received;  // by the LCM thread
-  uint64_t voxels = 0;                             // voxel updates stage 2 applied (free + occupied)
-  int64_t new_nodes = 0;                           // octree nodes the scan added (negative: pruned more than added)
+  SteadyClock::time_point received;  // by the LCM thread
+  uint64_t voxels = 0;               // voxel updates stage 2 applied (free + occupied)
+  int64_t new_nodes = 0;             // octree nodes the scan added (negative: pruned more than added)
 };
 
 }  // namespace ort::daemon

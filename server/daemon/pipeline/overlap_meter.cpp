@@ -1,8 +1,10 @@
 #include "daemon/pipeline/overlap_meter.h"
 
+#include "core/clock.h"
+
 namespace ort::daemon {
 
-void OverlapMeter::advance(Clock::time_point now) {
+void OverlapMeter::advance(SteadyClock::time_point now) {
   const double dt = std::chrono::duration<double>(now - last_).count();
   last_ = now;
   if (busy_[0]) t_.busy_s[0] += dt;
@@ -12,21 +14,21 @@ void OverlapMeter::advance(Clock::time_point now) {
 
 double OverlapMeter::begin(int stage) {
   std::lock_guard lock(mutex_);
-  advance(Clock::now());
+  advance(SteadyClock::now());
   busy_[stage] = true;
   return t_.both_s;
 }
 
 double OverlapMeter::end(int stage, double begin_token) {
   std::lock_guard lock(mutex_);
-  advance(Clock::now());
+  advance(SteadyClock::now());
   busy_[stage] = false;
   return t_.both_s - begin_token;
 }
 
 OverlapTotals OverlapMeter::totals() {
   std::lock_guard lock(mutex_);
-  advance(Clock::now());
+  advance(SteadyClock::now());
   return t_;
 }
 

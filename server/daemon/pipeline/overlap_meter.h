@@ -7,6 +7,8 @@
 #include <chrono>
 #include <mutex>
 
+#include "core/clock.h"
+
 namespace ort::daemon {
 
 struct OverlapTotals {
@@ -16,7 +18,6 @@ struct OverlapTotals {
 
 class OverlapMeter {
  public:
-  using Clock = std::chrono::steady_clock;
   // stage: 0 = stage 1, 1 = stage 2. begin() returns the both-busy total so far; end()
   // returns how much both-busy time accrued since `begin_token` (> 0: this stage's work
   // overlapped the other stage's).
@@ -25,10 +26,10 @@ class OverlapMeter {
   OverlapTotals totals();
 
  private:
-  void advance(Clock::time_point now);
+  void advance(SteadyClock::time_point now);
   std::mutex mutex_;
   bool busy_[2] = {false, false};
-  Clock::time_point last_ = Clock::now();
+  SteadyClock::time_point last_ = SteadyClock::now();
   OverlapTotals t_;
 };
 

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 
+#include "core/clock.h"
+
 namespace ort::daemon {
 
 void PipelineMetrics::record(const AppliedTiming& t) {
-  const auto now = Clock::now();
+  const auto now = SteadyClock::now();
   std::lock_guard lock(mutex_);
   shoot_.add(t.shoot_ms);
   octree_.add(t.octree_ms);
@@ -30,7 +32,7 @@ void PipelineMetrics::record(const AppliedTiming& t) {
 MetricsSnapshot PipelineMetrics::snapshot() {
   MetricsSnapshot s;
   s.overlap = overlap_.totals();
-  const auto now = Clock::now();
+  const auto now = SteadyClock::now();
   std::lock_guard lock(mutex_);
   s.shoot_p50 = shoot_.percentile(0.5);
   s.shoot_p99 = shoot_.percentile(0.99);

@@ -8,6 +8,7 @@
 #include <mutex>
 #include <vector>
 
+#include "core/clock.h"
 #include "core/ray_backend.h"
 #include "daemon/pipeline/applied_timing.h"
 #include "daemon/pipeline/latency_window.h"
@@ -38,7 +39,6 @@ struct MetricsSnapshot {
 
 class PipelineMetrics {
  public:
-  using Clock = std::chrono::steady_clock;
   void record(const AppliedTiming& t);
   MetricsSnapshot snapshot();
   OverlapMeter& overlap() { return overlap_; }
@@ -50,8 +50,8 @@ class PipelineMetrics {
   double lock_wait_max_ = 0;
   StageTimes stage1_total_;
   SlowestScans slowest_;
-  std::deque<std::pair<Clock::time_point, int64_t>> recent_;  // applied scans: time, points
-  Clock::time_point start_ = Clock::now();
+  std::deque<std::pair<SteadyClock::time_point, int64_t>> recent_;  // applied scans: time, points
+  SteadyClock::time_point start_ = SteadyClock::now();
   int64_t scans_ = 0, points_ = 0, overlapped_ = 0;
   double shoot_total_ms_ = 0, octree_total_ms_ = 0;
   OverlapMeter overlap_;

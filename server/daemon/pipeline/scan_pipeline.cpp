@@ -14,7 +14,7 @@ namespace ort::daemon {
 namespace {
 // Keeps the robots_seen table within its bound: the stalest robot goes first.
 void note_robot_seen(MapState& map, const std::string& robot, const octomap::point3d& origin) {
-  map.robots_seen[robot] = MapState::RobotSeen{origin, Clock::now()};
+  map.robots_seen[robot] = MapState::RobotSeen{origin, SteadyClock::now()};
   if (map.robots_seen.size() <= MapState::kMaxRobotsSeen) return;
   auto stalest = map.robots_seen.begin();
   for (auto it = map.robots_seen.begin(); it != map.robots_seen.end(); ++it)
@@ -37,14 +37,14 @@ ScanPipeline::ScanPipeline(MapEngine& engine, MapState& map, ScanQueue& queue, P
       filters_(filters) {}
 
 void ScanPipeline::set_busy(int stage, bool busy) {
-  busy_since_ns_[stage] = busy ? std::max<int64_t>(1, Clock::now().time_since_epoch().count()) : 0;
+  busy_since_ns_[stage] = busy ? std::max<int64_t>(1, SteadyClock::now().time_since_epoch().count()) : 0;
 }
 
-Clock::duration ScanPipeline::longest_busy(Clock::time_point now) const {
-  Clock::duration longest = Clock::duration::zero();
+SteadyClock::duration ScanPipeline::longest_busy(SteadyClock::time_point now) const {
+  SteadyClock::duration longest = SteadyClock::duration::zero();
   for (const auto& since : busy_since_ns_) {
     const int64_t t = since;
-    if (t) longest = std::max(longest, now - Clock::time_point(Clock::duration(t)));
+    if (t) longest = std::max(longest, now - SteadyClock::time_point(SteadyClock::duration(t)));
   }
   return longest;
 }
@@ -52,7 +52,7 @@ Clock::duration ScanPipeline::longest_busy(Clock::time_point now) const {
 bool ScanPipeline::shed_if_stale(const QueuedScan& item) {
   // An edit is never shed for age: its sender waits for the ack, and it belongs to no producer.
   if (item.edit) return false;
-  if (max_queue_age_.count() <= 0 || Clock::now() - item.received <= max_queue_age_) return false;
+  if (max_queue_age_.count() <= 0 || SteadyClock::now() - item.received <= max_queue_age_) return false;
   producers_.count_dropped_in_flight(item.producer, Reject::kOverLatencyBound);
   shed_++;
   return true;
@@ -94,8 +94,8 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
   }
   set_busy(0, true);
   const double token = metrics_.overlap().begin(0);
-  const auto t0 = Clock::now();
-  const Clock::time_point decoded = item.decoded == Clock::time_point{} ? item.received : item.decoded;
+  const auto t0 = SteadyClock::now();
+  const SteadyClock::time_point decoded = item.decoded == SteadyClock::time_point{} ? item.received : item.decoded;
   job.waits.decode_ms = ms_between(item.received, decoded);
   job.waits.queue_ms = ms_between(decoded, t0);
   bool ok = true;
@@ -156,7 +156,7 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
   job.utime = item.msg.utime;
   job.points = item.msg.num_xyz / 3;
   job.received = item.received;
-  job.shot_at = Clock::now();
+  job.shot_at = SteadyClock::now();
   job.shoot_ms = ms_between(t0, job.shot_at);
   return ok;
 }
@@ -169,7 +169,7 @@ void ScanPipeline::apply_edit(MapEditItem& edit) {
   MapEditResult r;
   try {
     std::unique_lock lock(map_.mutex);
-    const auto locked = Clock::now();
+    const auto locked = SteadyClock::now();
     r = apply_map_edit(map_, edit);
     r.locked_ms = ms_since(locked);
   } catch (const std::exception& e) {
@@ -201,7 +201,7 @@ PointDropCounts point_drops(const PrepareReport& r, const FilterCounts& f) {
 void ScanPipeline::apply(ShotJob& job) {
   if (job.edit) return apply_edit(*job.edit);
   const double token = metrics_.overlap().begin(1);
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   job.waits.handoff_ms = ms_between(job.shot_at, t0);
   set_busy(1, true);
   std::string detail;
@@ -214,7 +214,7 @@ void ScanPipeline::apply(ShotJob& job) {
   int64_t new_nodes = 0;
   try {
     std::lock_guard lock(map_.mutex);
-    const auto locked = Clock::now();
+    const auto locked = SteadyClock::now();
     // Spilled regions the scan updates come back first (daemon/map/map_residency.h).
     if (std::string why; map_.residency && !map_.residency->touch_scan(*map_.tree, job.shot.voxels, why))
       throw std::runtime_error(why);
@@ -230,14 +230,14 @@ void ScanPipeline::apply(ShotJob& job) {
     count_map_change(map_);
     map_.last_scan_utime = std::max(map_.last_scan_utime, utime);
     map_.last_scan_origin = job.origin;
-    const auto updated = Clock::now();
+    const auto updated = SteadyClock::now();
     if (map_.observer) map_.observer->applied(changes_, *map_.tree, map_.version);
     const std::string robot = robot_key(job.robot_id);
     map_.newest_scan[robot] = MapState::NewestScan{job.robot_id, job.seq, map_.scans};
     note_robot_seen(map_, robot, job.origin);
     if (map_.residency) map_.residency->enforce(*map_.tree);
     if (map_.replica) map_.replica->scan_applied(job.shot.voxels, map_, robot);
-    parts = {ms_between(t0, locked), ms_between(locked, updated), ms_between(updated, Clock::now())};
+    parts = {ms_between(t0, locked), ms_between(locked, updated), ms_between(updated, SteadyClock::now())};
   } catch (const std::exception& e) {
     set_busy(1, false);
     metrics_.overlap().end(1, token);
@@ -246,7 +246,7 @@ void ScanPipeline::apply(ShotJob& job) {
   }
   set_busy(1, false);
   map_.changed.notify_all();
-  const auto t1 = Clock::now();
+  const auto t1 = SteadyClock::now();
   const double overlap_s = metrics_.overlap().end(1, token);
   AppliedTiming t;
   t.shoot_ms = job.shoot_ms;

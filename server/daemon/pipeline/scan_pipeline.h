@@ -9,6 +9,7 @@
 #include <iosfwd>
 #include <thread>
 
+#include "core/clock.h"
 #include "core/log.h"
 #include "daemon/intake/producer_registry.h"
 #include "daemon/intake/scan_queue.h"
@@ -27,9 +28,9 @@ struct ShotJob {
   size_t producer = 0;
   std::string robot_id;
   int64_t seq = 0, utime = 0, points = 0;
-  Clock::time_point received;
-  Clock::time_point shot_at;  // when stage 1 finished it
-  ScanWaits waits;            // decode and queue wait so far; stage 2 adds its hand-off wait
+  SteadyClock::time_point received;
+  SteadyClock::time_point shot_at;  // when stage 1 finished it
+  ScanWaits waits;                  // decode and queue wait so far; stage 2 adds its hand-off wait
   double shoot_ms = 0;
   octomap::point3d origin;  // the sensor's, in the map frame
   ShotScan shot;
@@ -60,7 +61,7 @@ class ScanPipeline {
   int64_t shed() const { return shed_; }
   // How long the stage busiest on one scan has been on it (zero when both are idle): a
   // stage stuck on one scan shows here.
-  Clock::duration longest_busy(Clock::time_point now = Clock::now()) const;
+  SteadyClock::duration longest_busy(SteadyClock::time_point now = SteadyClock::now()) const;
 
  private:
   // Stage 1 on one scan; false when it ended as a rejection.

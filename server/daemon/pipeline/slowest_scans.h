@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/clock.h"
 #include "daemon/pipeline/applied_timing.h"
 
 namespace ort::daemon {
@@ -31,7 +32,7 @@ class SlowestScans {
   size_t kept_;
   int64_t applied_ = 0;
   bool have_first_ = false;
-  std::chrono::steady_clock::time_point first_received_;
+  SteadyClock::time_point first_received_;
   std::vector<SlowScan> slowest_;
 };
 

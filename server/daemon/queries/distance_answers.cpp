@@ -5,6 +5,7 @@
 #include <cstring>
 #include <memory>
 
+#include "core/clock.h"
 #include "octomap_rt/distance_box_chunk_t.hpp"
 #include "octomap_rt/distance_path_reply_t.hpp"
 #include "octomap_rt/distance_points_reply_t.hpp"
@@ -19,11 +20,6 @@ namespace {
 using Query = octomap_rt::distance_query_t;
 using Reply = octomap_rt::occupancy_reply_t;
 
-int64_t now_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 template <class M>
 std::vector<uint8_t> encode(const M& m) {
   std::vector<uint8_t> b(static_cast<size_t>(m.getEncodedSize()));
@@ -34,7 +30,7 @@ std::vector<uint8_t> encode(const M& m) {
 template <class M>
 void stamp(M& m, const Query& q, const MapStamp& s, const std::string& server_id, int8_t status,
            const std::string& error) {
-  m.utime = now_us();
+  m.utime = now_utime();
   m.request_id = q.request_id;
   m.map_epoch = s.map_epoch;
   m.snapshot_id = s.snapshot_id;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/clock.h"
 #include "octomap_rt/grid_query_t.hpp"
 #include "octomap_rt/grid_t.hpp"
 #include "octomap_rt/occupancy_reply_t.hpp"
@@ -86,7 +87,7 @@ EncodedReplies GridPublisher::clipped_grid(octomap_rt::grid_query_t q, const Map
 
 void GridPublisher::run() {
   const auto period = std::chrono::duration<double>(1.0 / cfg_.rate_hz);
-  auto next = std::chrono::steady_clock::now();
+  auto next = SteadyClock::now();
   for (;;) {
     compute_if_changed();
     for (size_t i = 0; i < grid_.messages.size(); ++i) {
@@ -95,8 +96,8 @@ void GridPublisher::run() {
       loop_.publish(grid_.channel, grid_.messages[i].data(), grid_.messages[i].size());
     }
     published_++;
-    next = std::max(next + std::chrono::duration_cast<std::chrono::steady_clock::duration>(period),
-                    std::chrono::steady_clock::now());  // behind (a slow grid): no catch-up burst
+    next = std::max(next + std::chrono::duration_cast<SteadyClock::duration>(period),
+                    SteadyClock::now());  // behind (a slow grid): no catch-up burst
     std::unique_lock lock(mutex_);
     if (wake_.wait_until(lock, next, [&] { return stop_; })) return;
   }

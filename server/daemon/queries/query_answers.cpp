@@ -4,6 +4,7 @@
 #include <cmath>
 #include <span>
 
+#include "core/clock.h"
 #include "daemon/queries/distance_answers.h"
 #include "octomap_rt/box_reply_t.hpp"
 #include "octomap_rt/grid_t.hpp"
@@ -28,11 +29,6 @@ constexpr int kRegionChunk = protocol::kRegionChunkVoxels, kGridChunkCells = pro
 constexpr size_t kRegionVoxelBytes = 1 + 1 + 12;
 constexpr int64_t kMaxGridCells = 4'000'000;
 
-int64_t now_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 EncodedReplies replies_on(const std::string& channel) {
   EncodedReplies out;
   out.channel = channel;
@@ -49,7 +45,7 @@ std::vector<uint8_t> encode(const M& m) {
 template <class M>
 void stamp_reply(M& m, const QueryHeader& h, const MapStamp& s, const std::string& server_id, int8_t status,
                  const std::string& error) {
-  m.utime = now_us();
+  m.utime = now_utime();
   m.request_id = h.request_id;
   m.snapshot_id = s.snapshot_id;
   m.map_epoch = s.map_epoch;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/clock.h"
 #include "core/errors.h"
 #include "daemon/map/map_edit_item.h"
 #include "daemon/map/map_residency.h"
@@ -39,11 +40,6 @@ int8_t ack_status(const MapEditResult& r) {
     case EditRefusal::kNotApplied: return Reply::REPLY_NOT_READY;
   }
   return Reply::REPLY_BAD_REQUEST;
-}
-
-int64_t now_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
 }
 
 }  // namespace
@@ -163,7 +159,7 @@ void QueryService::on_query(const lcm::ReceiveBuffer& rb, protocol::WireCheck (*
     clients_.count(kNoClient, Count::kDropped, bad);
     return;
   }
-  clients_.received(msg.client_id, msg.reply_channel, now_us());
+  clients_.received(msg.client_id, msg.reply_channel, now_utime());
   PendingQuery q{QueryMessage(std::move(msg)), SteadyClock::now(), {}};
   const QueryHeader h = header_of(q.msg);
   const auto* distance_query = std::get_if<octomap_rt::distance_query_t>(&q.msg);
@@ -197,11 +193,11 @@ void QueryService::on_edit(const lcm::ReceiveBuffer& rb, const std::string& chan
     clients_.count(kNoClient, Count::kDropped, "map edit: " + why);
     return;
   }
-  clients_.received(msg.client_id, msg.reply_channel, now_us());
+  clients_.received(msg.client_id, msg.reply_channel, now_utime());
   // proven: the sender showed the control token (its audit line is never rate-limited).
   auto ack = [this, msg](const MapEditResult& r, int8_t status, const std::string& error, bool proven) {
     octomap_rt::map_edit_ack_t a;
-    a.utime = now_us();
+    a.utime = now_utime();
     a.request_id = msg.request_id;
     a.snapshot_id = static_cast<int64_t>(r.version);
     a.map_epoch = static_cast<int64_t>(r.epoch);
@@ -216,7 +212,7 @@ void QueryService::on_edit(const lcm::ReceiveBuffer& rb, const std::string& chan
     audit_.record(msg, r, status, error, proven);
     loop_.publish(msg.reply_channel, a);
   };
-  const EditAdmission admission = gate_.admit(msg, channel, now_us());
+  const EditAdmission admission = gate_.admit(msg, channel, now_utime());
   if (!admission.admitted())
     return ack(MapEditResult{},
                admission.refusal == EditGateRefusal::kTooMany ? Reply::REPLY_BUSY : Reply::REPLY_REFUSED, admission.why,
@@ -274,8 +270,8 @@ bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& o
   // Its own bounds, checked inside the walk: work, time under the lock, the server stopping.
   query::WorkBudget budget;
   budget.max_work = cfg_.bounds.max_work;
-  budget.deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                       std::chrono::duration<double, std::milli>(cfg_.bounds.lock_ms));
+  budget.deadline = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
+                                             std::chrono::duration<double, std::milli>(cfg_.bounds.lock_ms));
   budget.stop = &cut_now_;
   try {
     if (const auto* d = std::get_if<octomap_rt::distance_query_t>(&q.msg)) {

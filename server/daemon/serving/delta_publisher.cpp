@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/clock.h"
 #include "daemon/map/delta_changes.h"
 #include "octomap_rt/map_chunk_t.hpp"
 #include "octomap_rt/map_delta_t.hpp"
@@ -17,11 +18,6 @@ namespace {
 
 using Delta = octomap_rt::map_delta_t;
 using protocol::VoxelChange;
-
-int64_t utime_now() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 }  // namespace
 
@@ -154,7 +150,7 @@ void DeltaPublisher::flush() {
   int64_t bytes = 0;
   for (size_t i = 0; i < parts.size(); ++i) {
     if (i > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(cfg_.part_interval_ms));
-    d.utime = utime_now();
+    d.utime = now_utime();
     d.delta_seq = next_seq_++;
     d.part_index = static_cast<int32_t>(i);
     d.num_voxels = parts[i].num_voxels;

@@ -1,4 +1,5 @@
 #include "daemon/serving/map_service.h"
+#include "core/clock.h"
 #include "protocol/shards/shard_wire.h"
 
 #include <algorithm>
@@ -26,12 +27,6 @@ using protocol::RequestRefusal;
 using protocol::SnapshotClock;
 
 using Chunk = octomap_rt::map_chunk_t;
-using Clock = std::chrono::steady_clock;
-
-int64_t utime_now() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 }  // namespace
 
@@ -99,7 +94,7 @@ void MapService::on_request(const lcm::ReceiveBuffer& rbuf) {
     else if (queued_of(queue_, req.client_id) >= cfg_.requests_per_client)
       busy = RequestRefusal::kClientBusy;
     if (busy == RequestRefusal::kNone) {
-      queue_.push_back({std::move(req), Clock::now()});
+      queue_.push_back({std::move(req), SteadyClock::now()});
       cv_.notify_all();
       return;
     }
@@ -112,9 +107,9 @@ void MapService::on_request(const lcm::ReceiveBuffer& rbuf) {
 
 protocol::SnapshotClock MapService::snapshot_clock() {
   protocol::SnapshotClock c;
-  c.now = Clock::now();
+  c.now = SteadyClock::now();
   c.newest_taken = store_.taken_at();
-  c.fresh_interval = std::chrono::duration_cast<Clock::duration>(
+  c.fresh_interval = std::chrono::duration_cast<SteadyClock::duration>(
       std::chrono::duration<double>(std::max(cfg_.fresh_interval_s, cfg_.snapshots.min_interval_s)));
   if (store_.latest_id() >= 0) {
     std::shared_lock lock(map_.mutex);
@@ -124,7 +119,7 @@ protocol::SnapshotClock MapService::snapshot_clock() {
 }
 
 void MapService::run() {
-  auto next_info = Clock::now();
+  auto next_info = SteadyClock::now();
   std::unique_lock lock(mutex_);
   while (!stop_) {
     // The store is only touched on this thread: its clock may be read without the lock.
@@ -150,12 +145,12 @@ void MapService::run() {
       }
       lock.lock();
     }
-    if (Clock::now() >= next_info) {
+    if (SteadyClock::now() >= next_info) {
       lock.unlock();
       publish_info();
       lock.lock();
-      next_info =
-          Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg_.info_period_s));
+      next_info = SteadyClock::now() +
+                  std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(cfg_.info_period_s));
     }
   }
 }
@@ -209,7 +204,7 @@ void MapService::refuse(const octomap_rt::map_request_t* req, protocol::RequestR
   }
   if (!req || !protocol::can_reply(*req, cfg_.reply_prefix)) return;  // nowhere safe to answer: ignored (counted)
   Chunk c{};
-  c.utime = utime_now();
+  c.utime = now_utime();
   c.request_id = req->request_id;
   c.snapshot_id = req->snapshot_id;
   c.format = req->format;
@@ -223,9 +218,9 @@ void MapService::send_chunks(const octomap_rt::map_request_t& req, const Snapsho
   const size_t chunk = protocol::kChunkDataBytes;
   const int32_t n = blob.num_chunks(chunk);
   const std::vector<int32_t> indices = chunks_to_send(req.chunk_indices, n);
-  const auto interval =
-      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::milli>(cfg_.chunk_interval_ms));
-  auto next = Clock::now();
+  const auto interval = std::chrono::duration_cast<SteadyClock::duration>(
+      std::chrono::duration<double, std::milli>(cfg_.chunk_interval_ms));
+  auto next = SteadyClock::now();
   Chunk c{};
   c.request_id = req.request_id;
   c.snapshot_id = static_cast<int64_t>(blob.contents.snapshot_id);
@@ -242,14 +237,14 @@ void MapService::send_chunks(const octomap_rt::map_request_t& req, const Snapsho
   c.client_id = req.client_id;
   for (int32_t i : indices) {
     std::this_thread::sleep_until(next);
-    c.utime = utime_now();
+    c.utime = now_utime();
     c.chunk_index = i;
     c.offset = static_cast<int64_t>(i) * static_cast<int64_t>(chunk);
     const size_t len = std::min(chunk, blob.bytes.size() - static_cast<size_t>(c.offset));
     c.data.assign(blob.bytes.begin() + c.offset, blob.bytes.begin() + c.offset + static_cast<int64_t>(len));
     c.data_size = static_cast<int32_t>(len);
     loop_.publish(req.reply_channel, c);
-    next = Clock::now() + interval;
+    next = SteadyClock::now() + interval;
     std::lock_guard lock(mutex_);
     stats_.chunks_sent++;
   }
@@ -259,7 +254,7 @@ void MapService::publish_info() {
   octomap_rt::map_info_t m{};
   m.protocol_version = protocol::kProtocolVersion;
   protocol::put_shard_set(cfg_.shard, m);
-  m.utime = utime_now();
+  m.utime = now_utime();
   {
     std::shared_lock lock(map_.mutex);
     m.map_version = static_cast<int64_t>(map_.version);

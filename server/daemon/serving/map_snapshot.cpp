@@ -10,7 +10,7 @@ namespace ort::daemon {
 namespace {
 
 // Under map.mutex.
-MapCopy copy_locked(const MapState& map, std::chrono::steady_clock::time_point t0) {
+MapCopy copy_locked(const MapState& map, SteadyClock::time_point t0) {
   MapCopy c;
   c.tree = std::make_unique<octomap::OcTree>(*map.tree);
   // With a memory bound the copy is the whole map: its stand-ins get their regions back.
@@ -27,13 +27,13 @@ MapCopy copy_locked(const MapState& map, std::chrono::steady_clock::time_point t
 }  // namespace
 
 MapCopy copy_map(MapState& map) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = SteadyClock::now();
   std::shared_lock lock(map.mutex);  // a reader: queries may read at the same time
   return copy_locked(map, t0);
 }
 
 std::optional<MapCopy> copy_map_if_changed(MapState& map, uint64_t unchanged_since) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = SteadyClock::now();
   std::shared_lock lock(map.mutex);  // a reader: queries may read at the same time
   if (map.version == unchanged_since) return std::nullopt;
   return copy_locked(map, t0);

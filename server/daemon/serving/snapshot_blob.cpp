@@ -56,11 +56,11 @@ SnapshotBlob make_snapshot_blob(const octomap::OcTree& tree, const SnapshotConte
   SnapshotBlob b;
   b.contents = contents;
   b.format = format;
-  auto t0 = std::chrono::steady_clock::now();
+  auto t0 = SteadyClock::now();
   std::string raw = serialize(tree, format);
   b.serialize_ms = ms_since(t0);
   b.raw_size = static_cast<int64_t>(raw.size());
-  t0 = std::chrono::steady_clock::now();
+  t0 = SteadyClock::now();
   if (zstd_level > 0) {
     b.bytes = protocol::zstd_compress(raw, zstd_level);
     b.compression = Chunk::COMPRESSION_ZSTD;

@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "core/clock.h"
 #include "daemon/map/map_replica.h"
 #include "daemon/serving/map_snapshot.h"
 
@@ -10,10 +11,10 @@ namespace ort::daemon {
 
 std::shared_ptr<const SnapshotBlob> SnapshotStore::latest(MapState& map, int8_t format, bool fresh, bool& took_new) {
   took_new = false;
-  const auto min_interval = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-      std::chrono::duration<double>(policy_.min_interval_s));
+  const auto min_interval =
+      std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(policy_.min_interval_s));
   if (fresh && !kept_.empty()) std::this_thread::sleep_until(taken_at_ + min_interval);
-  const auto now = std::chrono::steady_clock::now();
+  const auto now = SteadyClock::now();
   const bool old_enough = kept_.empty() || now - taken_at_ >= min_interval;
   if (old_enough) {
     uint64_t version;
@@ -50,7 +51,7 @@ void SnapshotStore::take(MapState& map) {
   if (!kept_.empty()) kept_.back().tree.reset();
   kept_.push_back(std::move(e));
   while (kept_.size() > std::max<size_t>(policy_.kept, 1)) kept_.pop_front();
-  taken_at_ = std::chrono::steady_clock::now();
+  taken_at_ = SteadyClock::now();
   latest_id_ = static_cast<int64_t>(kept_.back().contents.snapshot_id);
   taken_++;
 }

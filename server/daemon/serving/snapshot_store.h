@@ -10,6 +10,7 @@
 #include <deque>
 #include <memory>
 
+#include "core/clock.h"
 #include "daemon/map/map_state.h"
 #include "daemon/serving/snapshot_blob.h"
 
@@ -43,7 +44,7 @@ class SnapshotStore {
 
   int64_t latest_id() const { return latest_id_; }
   // When the newest snapshot was copied from the map ({} before the first).
-  std::chrono::steady_clock::time_point taken_at() const { return taken_at_; }
+  SteadyClock::time_point taken_at() const { return taken_at_; }
   int64_t taken() const { return taken_; }
 
  private:
@@ -57,7 +58,7 @@ class SnapshotStore {
 
   SnapshotPolicy policy_;
   std::deque<Entry> kept_;  // oldest first
-  std::chrono::steady_clock::time_point taken_at_;
+  SteadyClock::time_point taken_at_;
   std::shared_ptr<const SnapshotBlob> last_made_;
   std::atomic<int64_t> latest_id_{-1}, taken_{0};
 };

@@ -181,7 +181,7 @@ double run_builds(const vk::Context& ctx, const RtFunctions& fn, vk::CommandRunn
 
 SharedBvh build_shared_bvh(const vk::Context& ctx, const RtFunctions& fn, const BlockGrid& grid,
                            vk::CommandRunner& runner, float aabb_margin) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = SteadyClock::now();
   SharedBvh bvh;
   const VkDeviceSize scratch_align = scratch_alignment(ctx);
   const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;

@@ -13,8 +13,6 @@
 namespace ort {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 // Buckets larger than a thread's fair share / 4 first, so the last to finish are small;
 // the rest in Morton order (neighbours share the nodes above them in cache).
 std::vector<size_t> work_order(const std::vector<PlannedSubtree>& subtrees, const VoxelBuckets& buckets,
@@ -65,9 +63,9 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
   }
   const bool parallel = pool_.size() > 1 && updates.size() >= opts_.min_parallel_voxels;
 
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   bucket_voxels(updates, opts_.buckets, parallel ? &pool_ : nullptr, buckets_, bucket_scratch_);
-  const auto t1 = Clock::now();
+  const auto t1 = SteadyClock::now();
   st.bucket_ms = ms_between(t0, t1);
   st.bucket_depth = buckets_.depth;
 
@@ -75,7 +73,7 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
   const unsigned workers = parallel ? pool_.size() : 1;
   const std::vector<size_t> order = work_order(top.subtrees(), buckets_, workers);
   st.subtrees = order.size();
-  const auto t2 = Clock::now();
+  const auto t2 = SteadyClock::now();
   st.top_ms = ms_between(t1, t2);
 
   std::atomic<size_t> next{0};
@@ -87,9 +85,9 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
       const PlannedSubtree& s = top.subtrees()[order[k]];
       const std::span<SortedVoxel> voxels = buckets_.bucket(s.bucket);
       if (stats) {
-        const auto ts = Clock::now();
+        const auto ts = SteadyClock::now();
         sort_bucket(voxels, sort_tmp_[worker], node_bits);
-        sort_ms[worker] += ms_between(ts, Clock::now());
+        sort_ms[worker] += ms_between(ts, SteadyClock::now());
       } else {
         sort_bucket(voxels, sort_tmp_[worker], node_bits);
       }
@@ -102,7 +100,7 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
     pool_.run_shared(work);
   else
     work(0);
-  const auto t3 = Clock::now();
+  const auto t3 = SteadyClock::now();
   st.subtrees_ms = ms_between(t2, t3);
   for (double ms : sort_ms) st.sort_cpu_ms += ms;
   if (changes) changes->finish();
