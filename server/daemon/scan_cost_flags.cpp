@@ -34,6 +34,12 @@ void add_scan_cost_flags(CLI::App& app, ScanCostBounds& c) {
   app.add_option("--max-scan-voxels", c.max_scan_voxels,
                  "most voxels one scan may update; more: rejected as 'too many voxels'; 0: no limit")
       ->capture_default_str();
+  app.add_option("--max-mean-ray-voxels", c.max_mean_ray_voxels,
+                 "longest a scan's rays may be on average, in voxels (each cut at the max range); longer: "
+                 "rejected as 'rays too long on average' before any ray is shot (a few points far out cost what "
+                 "a real scan's thousands do); 0: no limit")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e9));
   app.add_option("--max-new-nodes-per-s", c.max_new_nodes_per_s,
                  "new octree nodes a second one robot may add, on average (allowance up to --new-node-burst); "
                  "past it its scans are rejected as 'new-node rate' until the allowance refills; 0: no limit")

@@ -5,6 +5,7 @@
 // a scan stamped years ahead does not pin the map's utime.
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <random>
 #include <sstream>
 
@@ -73,6 +74,48 @@ TEST(ScanCosts, AScanFarFromWhereItsRobotHasBeenIsRefused) {
   server.stop();
   expect_counts_balance(server.producer_stats());
   EXPECT_NE(log.str().find("origin jump"), std::string::npos) << log.str();
+}
+
+int64_t rejected_as(const daemon::ProducerStats& p, const std::string& reason) {
+  for (size_t k = 0; k < daemon::kRejectReasonCount; ++k)
+    if (reason == daemon::to_string(static_cast<Reject>(k))) return p.rejects[k];
+  return 0;
+}
+
+TEST(ScanCosts, AFarScanFromANewRobotIdIsRefusedBeforeItAddsMillionsOfNodes) {
+  // A robot id costs nothing to make, and its first scan has no history to be checked
+  // against: 100 points 1 km out walk ~1 M voxels and add ~2 M nodes (the hostile-mix
+  // bench's far scans: the robot streaming beside them lost most of its scans). What the
+  // scan costs per point is what tells it from a real one (docs/RELIABILITY.md, "Bounded
+  // cost"): it is refused before it is shot, the reason counted for that robot; the robot
+  // mapping beside it keeps its scans.
+  lcm::LCM lc("memq://");
+  daemon::MappingServer server(test_config(0.1, true), lc, std::cerr);
+  server.start();
+  const auto near = reaching_scan(0, {1, 2, 0.5f}, 5, 100);
+  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &near);
+  ASSERT_TRUE(wait_until_done(server, 1));
+  const int64_t before = nodes(server);
+  auto far = reaching_scan(0, {1, 2, 0.5f}, 1000, 100);
+  far.robot_id = "EVIL0";
+  lc.publish("OCTOMAP_RT_SCAN_EVIL0", &far);
+  ASSERT_TRUE(wait_until_done(server, 2, std::chrono::seconds(120)));
+  EXPECT_EQ(nodes(server), before);
+  // A long-range scan's rays (300 m: ~3000 voxels each) stay legitimate.
+  auto ranged = reaching_scan(1, {1, 2, 0.5f}, 300, 20);
+  ranged.robot_id = "EVIL1";
+  lc.publish("OCTOMAP_RT_SCAN_EVIL1", &ranged);
+  const auto next = reaching_scan(1, {1.2f, 2, 0.5f}, 5, 100);
+  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &next);
+  ASSERT_TRUE(wait_until_done(server, 4, std::chrono::seconds(120)));
+  server.stop();
+  std::map<std::string, daemon::ProducerStats> by_robot;
+  for (const auto& p : server.producer_stats()) by_robot[p.robot_id] = p;
+  EXPECT_EQ(by_robot["ALPHA"].applied, 2);
+  EXPECT_EQ(by_robot["EVIL0"].applied, 0);
+  EXPECT_EQ(rejected_as(by_robot["EVIL0"], "rays too long on average"), 1);
+  EXPECT_EQ(by_robot["EVIL1"].applied, 1);
+  expect_counts_balance(server.producer_stats());
 }
 
 TEST(ScanCosts, RepeatedFarReachingScansStopAtTheRobotsNewNodeAllowance) {

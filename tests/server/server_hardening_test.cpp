@@ -39,7 +39,8 @@ TEST(ServerHardening, FarFlungScansDoNotWedgeTheServer) {
   auto cfg = test_config(0.1, true);
   cfg.engine.backend.kind = BackendKind::kCpuGrid;
   cfg.engine.backend.threads = 2;
-  cfg.scan_costs.max_origin_jump_m = 0;  // the corner scan's origin jumps: this test is about its rays
+  cfg.scan_costs.max_origin_jump_m = 0;    // the corner scan's origin jumps: this test is about its rays,
+  cfg.scan_costs.max_mean_ray_voxels = 0;  // which are kilometres long (the engine's bounds, not the daemon's)
   std::ostringstream log;
   daemon::MappingServer server(cfg, lc, log);
   server.start();

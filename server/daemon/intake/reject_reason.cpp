@@ -30,6 +30,7 @@ const char* to_string(Reject r) {
     case Reject::kRayTooLong: return "ray too long";
     case Reject::kTooMuchWork: return "too much work";
     case Reject::kTooManyVoxels: return "too many voxels";
+    case Reject::kMeanRayTooLong: return "rays too long on average";
     case Reject::kOriginJump: return "origin jump";
     case Reject::kNewNodeRate: return "new-node rate";
     case Reject::kMapNewNodeRate: return "map new-node rate";

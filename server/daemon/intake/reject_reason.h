@@ -39,6 +39,7 @@ enum class Reject {
   kRayTooLong,        // a ray's walk is longer than OctoMap's KeyRay holds (points km away at fine -r)
   kTooMuchWork,       // the scan's ray walks exceed the per-scan work bound (--max-scan-work)
   kTooManyVoxels,     // the shot scan updates more voxels than --max-scan-voxels
+  kMeanRayTooLong,    // its rays are longer on average than --max-mean-ray-voxels (few points, far out)
   kOriginJump,        // the origin is farther from the robot's last scan than it could have moved
   kNewNodeRate,       // the robot's new nodes passed --max-new-nodes-per-s (its allowance is spent)
   kMapNewNodeRate,    // all robots' new nodes passed --max-map-new-nodes-per-s (the map's allowance is spent)

@@ -4,6 +4,8 @@
 // through octomap::Pointcloud::transform.
 #pragma once
 
+#include <cstddef>
+
 #include <octomap/Pointcloud.h>
 #include <octomap/octomap_types.h>
 
@@ -34,5 +36,16 @@ PosedMessageScan to_posed_scan(const octomap_rt::scan_t& msg);
 
 // Max range for this scan: the message's when > 0, else the server's; the smaller when both.
 double effective_max_range(float scan_max_range, double server_max_range);
+
+// The lengths of the scan's rays in voxels of `resolution`, each cut at `max_range` (< 0:
+// none) as the ray walk cuts it; non-finite points (no-returns) and points certainly outside
+// the key range (they give no ray) do not count. The mean is
+// what a scan costs per point it sends (docs/RELIABILITY.md, "Bounded cost").
+struct RayLengths {
+  double total_voxels = 0;
+  size_t rays = 0;
+  double mean_voxels() const { return rays ? total_voxels / static_cast<double>(rays) : 0.0; }
+};
+RayLengths ray_lengths(const octomap_rt::scan_t& m, double max_range, double resolution);
 
 }  // namespace ort::daemon

@@ -78,6 +78,15 @@ Reject ScanCostGate::admit_origin(size_t producer, const octomap::point3d& origi
   return Reject::kNone;
 }
 
+Reject ScanCostGate::admit_rays(double mean_ray_voxels, std::string& detail) const {
+  if (bounds_.max_mean_ray_voxels <= 0 || mean_ray_voxels <= bounds_.max_mean_ray_voxels) return Reject::kNone;
+  // As whole voxels; a mean of points 1e38 m out does not fit an integer (the fuzzer's find).
+  auto whole = [](double v) { return std::to_string(static_cast<int64_t>(std::min(v, 1e18))); };
+  detail = "the scan's rays are " + whole(mean_ray_voxels) + " voxels long on average, above " +
+           whole(bounds_.max_mean_ray_voxels) + " (--max-mean-ray-voxels; a max range cuts them)";
+  return Reject::kMeanRayTooLong;
+}
+
 Reject ScanCostGate::admit_voxels(uint64_t voxels, std::string& detail) const {
   if (bounds_.max_scan_voxels == 0 || voxels <= bounds_.max_scan_voxels) return Reject::kNone;
   detail = "the scan updates " + std::to_string(voxels) + " voxels, above " + std::to_string(bounds_.max_scan_voxels) +

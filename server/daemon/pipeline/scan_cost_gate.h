@@ -4,6 +4,10 @@
 //    (max_origin_jump_m plus max_speed_mps for every second since): one 100-point scan far
 //    away adds millions of nodes, and origins that move do not stay within a range limit;
 //  - it would update more voxels than max_scan_voxels (a campus LiDAR scan updates ~8 M);
+//  - its rays are longer on average than max_mean_ray_voxels: a scan's cost is its rays'
+//    walks, so a few points far out cost what a real scan's ten thousand do (100 points 1 km
+//    out at 0.1 m add ~2-3 M nodes), from the first scan of a robot id without history on.
+//    Decided from the message before any ray is shot;
 //  - the producer's new-node allowance is spent: each applied scan's new nodes are taken
 //    from a bucket refilled at max_new_nodes_per_s up to new_node_burst, and while the
 //    bucket is below zero the producer's scans are refused;
@@ -27,9 +31,12 @@
 namespace ort::daemon {
 
 struct ScanCostBounds {
-  double max_origin_jump_m = 100;               // <= 0: origins unchecked
-  double max_speed_mps = 50;                    // added to the jump for each second since the last scan
-  uint64_t max_scan_voxels = 64'000'000;        // 0: no limit
+  double max_origin_jump_m = 100;         // <= 0: origins unchecked
+  double max_speed_mps = 50;              // added to the jump for each second since the last scan
+  uint64_t max_scan_voxels = 64'000'000;  // 0: no limit
+  // Far above real scan sets' mean rays (docs/RELIABILITY.md, "Bounded cost"); 4096 is a
+  // 410 m mean at 0.1 m. 0: no limit.
+  double max_mean_ray_voxels = 4096;
   double max_new_nodes_per_s = 4'000'000;       // <= 0: no limit
   double new_node_burst = 32'000'000;           // a campus LiDAR scan's ~8 M new voxels fit
   double max_map_new_nodes_per_s = 16'000'000;  // all producers together; <= 0: no limit
@@ -58,6 +65,9 @@ class ScanCostGate {
   // spent (asked again by stage 2 right before it applies: stage 1 may have admitted the scan
   // while the one before was being applied).
   Reject admit_allowance(size_t producer, SteadyClock::time_point now, std::string& detail);
+  // kNone, or kMeanRayTooLong when the scan's rays are longer on average (in voxels, cut at
+  // its max range: intake/scan_to_map.h's ray_lengths) than the bound.
+  Reject admit_rays(double mean_ray_voxels, std::string& detail) const;
   // kNone, or kTooManyVoxels when the shot scan updates more voxels than the bound.
   Reject admit_voxels(uint64_t voxels, std::string& detail) const;
   // Stage 2 applied the producer's scan: its new nodes are taken from its allowance and the map's.

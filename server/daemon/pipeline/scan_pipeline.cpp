@@ -102,13 +102,18 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
   try {
     std::string detail;
     job.origin = scan_pose(item.msg).trans();
-    if (const Reject why = gate_.admit_origin(item.producer, job.origin, t0, detail); why != Reject::kNone) {
-      refuse_cost(item.producer, why, detail);
+    const double max_range = effective_max_range(item.msg.max_range, engine_.options().max_range);
+    // What the scan may cost is decided before any ray is shot: per point first (the rays'
+    // mean length), then where the robot has been and its allowance.
+    Reject refusal =
+        gate_.admit_rays(ray_lengths(item.msg, max_range, engine_.options().resolution).mean_voxels(), detail);
+    if (refusal == Reject::kNone) refusal = gate_.admit_origin(item.producer, job.origin, t0, detail);
+    if (refusal != Reject::kNone) {
+      refuse_cost(item.producer, refusal, detail);
       metrics_.overlap().end(0, token);
       set_busy(0, false);
       return false;
     }
-    const double max_range = effective_max_range(item.msg.max_range, engine_.options().max_range);
     if (filters_.active()) {
       job.filtered = shoot_filtered(engine_, item.msg, filters_, max_range, filter_scratch_, job.shot);
     } else if (item.msg.points_frame == octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME) {
