@@ -83,6 +83,28 @@ class EditsTest(ServerTestCase):
         self.assertEqual(c.edits_refused, 3)
         self.assertEqual(c.received, c.answered + c.edits_applied + c.edits_refused)
 
+    def test_read_your_writes(self):
+        """A client with read_your_writes sees its own scan and edit in the next query, without
+        waiting by hand (no status polling, no min_snapshot_id), and is told when the map's
+        history forked since its edit."""
+        import numpy as np
+
+        with octomap_rt.MapClient(self.url, read_your_writes=True) as c:
+            wall = np.array([[7.0, y, z] for y in np.linspace(-1, 1, 21) for z in np.linspace(0, 1, 11)])
+            c.publish_scan(wall, robot_id="pyrw", origin=(0.0, 0.0, 0.5))
+            occ, _ = c.query_points(wall + [0.0, 0.0, 0.5])  # at once: the server waits for the scan
+            self.assertTrue((occ == octomap_rt.OCCUPIED).all())
+            box = [6.95, -1.05, 0.45, 7.05, 1.05, 1.55]
+            ack = c.clear_box(box, TOKEN)
+            self.assertEqual((c.written.min_snapshot_id, c.written.epoch), (ack.snapshot_id, ack.map_epoch))
+            self.assertEqual(int(c.box([box])["occupied"][0]), 0)
+            # A reply from another history than the edit's (here: the epoch the client holds is not
+            # the server's) is refused, not taken for a map that holds the edit.
+            c.written.epoch ^= 1
+            with self.assertRaises(octomap_rt.QueryError) as forked:
+                c.box([box])
+            self.assertIn("history forked", str(forked.exception))
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -27,15 +27,28 @@ class MapClient:
     `url`: LCM URL (default $LCM_DEFAULT_URL, else the host-local udpm URL); add
     `recv_buf_size=` to receive multi-MB messages. `transport`: any object with publish,
     subscribe, unsubscribe and handle (default: open_transport(url)). `namespace`: the server's
-    (its --namespace; default $OCTOMAP_RT_NAMESPACE, else none): every channel is NS_ + its name."""
+    (its --namespace; default $OCTOMAP_RT_NAMESPACE, else none): every channel is NS_ + its name.
+    `read_your_writes`: every query waits (up to `wait_timeout_s` on the server) until the map
+    holds this client's latest scan (publish_scan) and its latest edit (clear_box, reset_map),
+    and refuses an answer from another map history than the edit's (queries.Wait)."""
 
     def __init__(self, url: Optional[str] = None, transport=None, client_id: str = "",
-                 namespace: Optional[str] = None):
+                 namespace: Optional[str] = None, read_your_writes: bool = False, wait_timeout_s: float = 5.0):
         self.channels = Channels(namespace)
         self.transport = transport or open_transport(url)
         self.client_id = client_id or new_client_id()
         self.queries = queries.QueryChannel(self.transport, self.client_id, channels=self.channels)
         self._scan_seq = {}
+        self.written = queries.Wait(timeout_s=wait_timeout_s)  # this client's latest scan and edit
+        if read_your_writes:
+            self.queries.wait = self.written
+
+    def _edited(self, ack):
+        """Notes an applied edit's map state (and its epoch) as the latest write."""
+        self.written.min_snapshot_id, self.written.epoch = ack.snapshot_id, ack.map_epoch
+        if ack.op == edits.map_edit_t.OP_RESET:
+            self.written.robot_id, self.written.seq = "", -1  # the reset's state holds no earlier scan
+        return ack
 
     def close(self) -> None:
         self.transport.close()
@@ -138,11 +151,11 @@ class MapClient:
             raise ValueError("to must be 'free' or 'unknown'")
         op = edits.map_edit_t.OP_CLEAR_TO_FREE if to == "free" else edits.map_edit_t.OP_CLEAR_TO_UNKNOWN
         flags = edits.map_edit_t.FLAG_INCLUDE_UNKNOWN if include_unknown else 0
-        return self.editor(token).edit(op, [float(v) for v in box], flags)
+        return self._edited(self.editor(token).edit(op, [float(v) for v in box], flags))
 
     def reset_map(self, token: str):
         """Empties the server's map (signed with `token`, as clear_box)."""
-        return self.editor(token).edit(edits.map_edit_t.OP_RESET)
+        return self._edited(self.editor(token).edit(edits.map_edit_t.OP_RESET))
 
     def editor(self, token: str) -> edits.MapEditor:
         """A MapEditor on this client's transport and id (for edits one by one, or raw bytes)."""
@@ -172,4 +185,5 @@ class MapClient:
         msg.robot_id = robot_id
         msg.map_frame = map_frame
         self.transport.publish(self.channels.scan_prefix + robot_id.upper(), msg.encode())
+        self.written.robot_id, self.written.seq = robot_id, msg.seq
         return msg.seq

@@ -22,8 +22,27 @@ class QueryError(RuntimeError):
     """The server refused or did not answer (status and its reason in the message)."""
 
 
+class Wait:
+    """What a query waits for on the server before it is answered (docs/PROTOCOL.md, "Waiting
+    for a map state"): the map state `min_snapshot_id` (an edit's ack.snapshot_id) and/or the
+    scan `seq` of robot `robot_id` applied, for at most `timeout_s` there (0..30 s; then the
+    reply is NOT_READY, raised as QueryError). `epoch` (an ack's map_epoch; 0: any): a state id
+    counts only in its epoch, so a reply of another epoch means the map's history forked since
+    (a reset, a restart after a crash) and is raised as QueryError: the write may be gone."""
+
+    def __init__(self, min_snapshot_id: int = 0, robot_id: str = "", seq: int = -1, epoch: int = 0,
+                 timeout_s: float = 5.0):
+        self.min_snapshot_id, self.robot_id, self.seq, self.epoch = min_snapshot_id, robot_id, seq, epoch
+        self.timeout_s = timeout_s
+
+    def waits(self) -> bool:
+        return self.min_snapshot_id > 0 or bool(self.robot_id)
+
+
 class QueryChannel:
-    """Sends a query and collects the reply messages with its request_id."""
+    """Sends a query and collects the reply messages with its request_id. `wait`, when set,
+    is what every query waits for (read-your-writes: MapClient keeps it at the client's own
+    latest scan and edit)."""
 
     def __init__(self, transport, client_id: str, timeout_s: float = 10.0, retry_after_s: float = 1.0,
                  channels: Optional[Channels] = None):
@@ -34,18 +53,22 @@ class QueryChannel:
         self.timeout_s = timeout_s
         self.retry_after_s = retry_after_s
         self._next_id = int(time.time() * 1000) * 1000
+        self.wait: Optional[Wait] = None
 
     def _stamp(self, msg, min_snapshot_id: int) -> None:
         msg.utime = int(time.time() * 1e6)
         self._next_id += 1
         msg.request_id = self._next_id
+        w = self.wait if self.wait is not None and self.wait.waits() else None
+        if w is not None:
+            min_snapshot_id = max(min_snapshot_id, w.min_snapshot_id)
         # The map version to wait for; the field is named min_snapshot_id (or min_map_version).
         for name in ("min_snapshot_id", "min_map_version"):
             if name in msg.__slots__:
                 setattr(msg, name, min_snapshot_id)
-        msg.wait_seq = -1
-        msg.wait_timeout_ms = 0
-        msg.wait_robot_id = ""
+        msg.wait_robot_id = w.robot_id if w is not None else ""
+        msg.wait_seq = w.seq if w is not None and w.robot_id else -1
+        msg.wait_timeout_ms = int(min(30.0, max(0.0, w.timeout_s)) * 1000) if w is not None else 0
         msg.client_id = self.client_id
         msg.reply_channel = self.reply_channel
 
@@ -62,14 +85,17 @@ class QueryChannel:
                 replies.append(r)
 
         sub = self.transport.subscribe(self.reply_channel, take)
+        w = self.wait if self.wait is not None and self.wait.waits() else None
+        # A query that waits on the server is answered when its condition holds: not resent before.
+        retry_after_s = self.retry_after_s + (min(30.0, w.timeout_s) if w is not None else 0.0)
         try:
             start = time.monotonic()
-            while time.monotonic() - start < self.timeout_s:
+            while time.monotonic() - start < max(self.timeout_s, retry_after_s):
                 self._stamp(msg, min_snapshot_id)
                 wanted.add(msg.request_id)
                 self.transport.publish(channel, msg.encode())
                 sent = time.monotonic()
-                while time.monotonic() - sent < self.retry_after_s and not (replies and complete(replies)):
+                while time.monotonic() - sent < retry_after_s and not (replies and complete(replies)):
                     self.transport.handle(0.05)
                 if replies and complete(replies):
                     break
@@ -82,6 +108,10 @@ class QueryChannel:
         first = replies[0]
         if first.status != occupancy_reply_t.REPLY_OK:
             raise QueryError(f"query refused (status {first.status}): {first.error}")
+        epoch = getattr(first, "map_epoch", 0)
+        if w is not None and w.epoch and epoch and epoch != w.epoch:
+            raise QueryError(f"the map's history forked since the write waited for (epoch {w.epoch:#x}, now "
+                             f"{epoch:#x}: a reset, or a restart after a crash): the map may not hold it")
         return replies
 
 
