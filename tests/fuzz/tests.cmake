@@ -32,7 +32,9 @@ octomap_rt_add_fuzz_target(fuzz_scan_message
           ${CMAKE_SOURCE_DIR}/server/daemon/intake/reject_reason.cpp
           ${CMAKE_SOURCE_DIR}/protocol/wire_layout.cpp ${CMAKE_SOURCE_DIR}/protocol/inbound_checks.cpp
           ${CMAKE_SOURCE_DIR}/protocol/ids.cpp
-          ${CMAKE_SOURCE_DIR}/server/core/prepare_scan.cpp
+          ${CMAKE_SOURCE_DIR}/server/core/prepare_scan.cpp ${CMAKE_SOURCE_DIR}/server/core/ray_tiles.cpp
+          ${CMAKE_SOURCE_DIR}/server/core/map_frame.cpp ${CMAKE_SOURCE_DIR}/server/daemon/intake/scan_to_map.cpp
+          ${CMAKE_SOURCE_DIR}/server/daemon/pipeline/scan_cost_gate.cpp
   LIBS octomap_rt_lcmtypes octomap_rt_lcm)
 octomap_rt_add_fuzz_target(fuzz_scan_graph
   SOURCES ${CMAKE_SOURCE_DIR}/server/core/file_checks/scan_graph_check.cpp ${CMAKE_SOURCE_DIR}/client/scene/scan_set.cpp
