@@ -43,6 +43,7 @@ octomap_rt::server_status_t example_status() {
   r.point_drop_reason = {"non-finite", "below min range"};
   r.point_drop_count = {12000, 7};
   r.num_point_drop_reasons = 2;
+  r.points_read_as_zero = 1500;
   s.robots = {r};
   s.num_robots = 1;
   return s;
@@ -57,6 +58,7 @@ TEST(StatusText, LaysOutStateRatesLatenciesAndRobotsWithReasons) {
   EXPECT_NE(text.find("vulkan on NVIDIA H100, pipelined"), std::string::npos) << text;
   EXPECT_NE(text.find("400,844 nodes"), std::string::npos) << text;
   EXPECT_NE(text.find("10.0 MiB"), std::string::npos) << text;
+  EXPECT_NE(text.find("points read as 0 (a coordinate below 1e-20 m): 1,500"), std::string::npos) << text;
   EXPECT_NE(text.find("last 14 s ago"), std::string::npos) << text;
   EXPECT_NE(text.find("12.5 scans/s, 1.50 M points/s"), std::string::npos) << text;
   EXPECT_NE(text.find("shoot 4.2 / 0.0"), std::string::npos) << text;
@@ -194,6 +196,7 @@ TEST(StatusJson, EveryFieldAndEscapedStrings) {
   EXPECT_NE(json.find("\"reject_reasons\":{\"non-finite pose\":3,\"truncated \\\"x\\\"\":2}"), std::string::npos)
       << json;
   EXPECT_NE(json.find("\"point_drops\":{\"non-finite\":12000,\"below min range\":7}"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"points_read_as_zero\":1500"), std::string::npos) << json;
   EXPECT_EQ(json_string("a\nb\\"), "\"a\\u000ab\\\\\"");
 }
 

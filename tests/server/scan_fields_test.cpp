@@ -125,6 +125,10 @@ TEST_P(ScanFields, EveryDegenerateFieldIsRefusedWithItsReasonOrWalkedSafely) {
   EXPECT_GE(stats[0].seq_restarts, 1);
   EXPECT_LT(stats[0].missed, 1000);
   EXPECT_EQ(stats[0].point_drops[static_cast<size_t>(daemon::PointDrop::kDegenerateRay)], 4);  // 2 a scan
+  // The tiny coordinates read as 0 are in the status the operator reads (3 points a scan).
+  const auto status = server->status();
+  ASSERT_EQ(status.robots.size(), 1u);
+  EXPECT_EQ(status.robots[0].points_read_as_zero, 6);
 
   // OctoMap's map of the applied scans, without the points it cannot walk (and without those
   // outside the key range, which it skips, saying so on stderr).

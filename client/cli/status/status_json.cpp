@@ -71,6 +71,7 @@ std::string robot_json(const octomap_rt::robot_stats_t& r) {
       .raw("reject_reasons", counts_json(r.reject_reason, r.reject_count))
       .raw("drop_reasons", counts_json(r.drop_reason, r.drop_count))
       .raw("point_drops", counts_json(r.point_drop_reason, r.point_drop_count))
+      .num("points_read_as_zero", r.points_read_as_zero)
       .close();
 }
 

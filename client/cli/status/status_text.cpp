@@ -106,6 +106,10 @@ void robots(std::ostringstream& o, const Status& s, int64_t now) {
     reasons(o, "rejected", r.reject_reason, r.reject_count);
     reasons(o, "dropped", r.drop_reason, r.drop_count);
     reasons(o, "points without a ray", r.point_drop_reason, r.point_drop_count);
+    // Subnormal or tiny coordinates are read as 0 (docs/PROTOCOL.md, "Coordinates near 0"):
+    // rays all the same, but a producer that sends them is worth a look.
+    if (r.points_read_as_zero > 0)
+      o << "    points read as 0 (a coordinate below 1e-20 m): " << with_commas(r.points_read_as_zero) << "\n";
   }
 }
 

@@ -73,6 +73,7 @@ void add_counts(ProducerStats& into, const ProducerStats& from) {
     into.drop_reasons[k] += from.drop_reasons[k];
   }
   for (size_t k = 0; k < kPointDropReasonCount; ++k) into.point_drops[k] += from.point_drops[k];
+  into.points_read_as_zero += from.points_read_as_zero;
 }
 
 void ProducerRegistry::release(size_t slot) {
@@ -171,13 +172,14 @@ bool ProducerRegistry::admit(size_t producer, int64_t seq, int64_t utime, const 
 }
 
 void ProducerRegistry::count_applied(size_t producer, int64_t points, double end_to_end_ms,
-                                     const PointDropCounts& dropped) {
+                                     const PointDropCounts& dropped, int64_t read_as_zero) {
   std::lock_guard lock(mutex_);
   ProducerStats& p = producers_[producer];
   p.in_flight--;
   p.applied++;
   p.points_applied += points;
   for (size_t k = 0; k < kPointDropReasonCount; ++k) p.point_drops[k] += dropped[k];
+  p.points_read_as_zero += read_as_zero;
   p.last_end_to_end_ms = end_to_end_ms;
 }
 

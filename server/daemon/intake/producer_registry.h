@@ -38,7 +38,8 @@ struct ProducerStats {
   double last_end_to_end_ms = 0;
   std::array<int64_t, kRejectReasonCount> rejects{};
   std::array<int64_t, kRejectReasonCount> drop_reasons{};  // why dropped (queue full, shed, ...)
-  PointDropCounts point_drops{};  // points of applied scans that gave no ray, by reason (NaN no-returns, ...)
+  PointDropCounts point_drops{};    // points of applied scans that gave no ray, by reason (NaN no-returns, ...)
+  int64_t points_read_as_zero = 0;  // points of applied scans with a coordinate below 1e-20 m, read as 0
 };
 
 // The counters of `from` (received ... point drops, not the ids, in-flight or last-scan
@@ -79,8 +80,10 @@ class ProducerRegistry {
   // whether it was queued.
   bool admit(size_t producer, int64_t seq, int64_t utime, const std::function<bool()>& enqueue);
 
-  // A scan was applied: `points` of its points became rays, `dropped` gave none (by reason).
-  void count_applied(size_t producer, int64_t points, double end_to_end_ms, const PointDropCounts& dropped = {});
+  // A scan was applied: `points` of its points became rays, `dropped` gave none (by reason),
+  // `read_as_zero` had a coordinate below 1e-20 m (core/prepare_scan.h).
+  void count_applied(size_t producer, int64_t points, double end_to_end_ms, const PointDropCounts& dropped = {},
+                     int64_t read_as_zero = 0);
   void count_rejected_in_flight(size_t producer, Reject why);
   // An accepted scan left the queue without being applied (shed, or left at stop).
   void count_dropped_in_flight(size_t producer, Reject why);

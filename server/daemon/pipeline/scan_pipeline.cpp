@@ -271,7 +271,8 @@ void ScanPipeline::apply(ShotJob& job) {
   metrics_.record(t);
   gate_.applied(job.producer, new_nodes, t1);
   producers_.count_applied(job.producer, static_cast<int64_t>(job.shot.prepare.rays), t.end_to_end_ms,
-                           point_drops(job.shot.prepare, job.filtered));
+                           point_drops(job.shot.prepare, job.filtered),
+                           static_cast<int64_t>(job.shot.prepare.read_as_zero));
 }
 
 void ScanPipeline::run_stage1() {

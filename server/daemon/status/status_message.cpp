@@ -56,6 +56,7 @@ octomap_rt::robot_stats_t robot_message(const ProducerStats& p, int64_t queue_by
   r.num_reject_reasons = add_reasons<Reject>(p.rejects, r.reject_reason, r.reject_count);
   r.num_drop_reasons = add_reasons<Reject>(p.drop_reasons, r.drop_reason, r.drop_count);
   r.num_point_drop_reasons = add_reasons<PointDrop>(p.point_drops, r.point_drop_reason, r.point_drop_count);
+  r.points_read_as_zero = p.points_read_as_zero;
   r.seq_restarts = p.seq_restarts;
   r.robot_id = p.robot_id;
   r.channel = p.channel;
