@@ -94,9 +94,14 @@ std::vector<Reply> QueryClient::exchange(const std::string& channel, Request& re
 }
 
 namespace {
+// When an exchange is complete: one reply, or every chunk (or a refusal, which comes alone).
 template <class Reply>
 bool one(const std::vector<Reply>& r) {
   return !r.empty();
+}
+template <class Reply>
+bool all_chunks(const std::vector<Reply>& r) {
+  return !r.empty() && (r[0].status != 0 || static_cast<int>(r.size()) >= r[0].num_chunks);
 }
 }  // namespace
 
@@ -140,9 +145,7 @@ std::vector<octomap_rt::region_chunk_t> QueryClient::region(const Box& b, int de
   q.include_free = include_free;
   q.boxes = {b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]};
   q.num_values = 6;
-  auto chunks = exchange<octomap_rt::region_chunk_t>(channels_.query_boxes, q, [](const auto& r) {
-    return !r.empty() && (r[0].status != 0 || static_cast<int>(r.size()) >= r[0].num_chunks);
-  });
+  auto chunks = exchange<octomap_rt::region_chunk_t>(channels_.query_boxes, q, all_chunks<octomap_rt::region_chunk_t>);
   std::sort(chunks.begin(), chunks.end(), [](const auto& a, const auto& b) { return a.chunk_index < b.chunk_index; });
   return chunks;
 }
@@ -156,9 +159,7 @@ Grid QueryClient::grid(double z_min, double z_max, double cell_size, const Box* 
     q.window_min[0] = window->min[0], q.window_min[1] = window->min[1];
     q.window_max[0] = window->max[0], q.window_max[1] = window->max[1];
   }
-  auto rows = exchange<octomap_rt::grid_t>(channels_.query_grid, q, [](const auto& r) {
-    return !r.empty() && (r[0].status != 0 || static_cast<int>(r.size()) >= r[0].num_chunks);
-  });
+  auto rows = exchange<octomap_rt::grid_t>(channels_.query_grid, q, all_chunks<octomap_rt::grid_t>);
   Grid g;
   g.header = rows.front();
   g.header.cells.clear();
@@ -182,15 +183,19 @@ octomap_rt::distance_query_t distance_query(int8_t mode, const DistanceRequest& 
 }
 }  // namespace
 
-octomap_rt::distance_points_reply_t QueryClient::distance_points(const std::vector<float>& xyz,
-                                                                 const DistanceRequest& d, const WaitFor& w) {
-  auto q = distance_query(octomap_rt::distance_query_t::MODE_POINTS, d);
+template <class Reply>
+Reply QueryClient::distance_xyz(int8_t mode, const std::vector<float>& xyz, const DistanceRequest& d,
+                                const WaitFor& w) {
+  auto q = distance_query(mode, d);
   address(q, w);
   q.xyz = xyz;
   q.num_xyz = static_cast<int32_t>(xyz.size());
-  return exchange<octomap_rt::distance_points_reply_t>(channels_.query_distance, q,
-                                                       one<octomap_rt::distance_points_reply_t>)
-      .front();
+  return exchange<Reply>(channels_.query_distance, q, one<Reply>).front();
+}
+
+octomap_rt::distance_points_reply_t QueryClient::distance_points(const std::vector<float>& xyz,
+                                                                 const DistanceRequest& d, const WaitFor& w) {
+  return distance_xyz<octomap_rt::distance_points_reply_t>(octomap_rt::distance_query_t::MODE_POINTS, xyz, d, w);
 }
 
 DistanceBox QueryClient::distance_box(const Box& b, const DistanceRequest& d, const WaitFor& w) {
@@ -198,21 +203,14 @@ DistanceBox QueryClient::distance_box(const Box& b, const DistanceRequest& d, co
   address(q, w);
   std::copy(b.min, b.min + 3, q.box_min);
   std::copy(b.max, b.max + 3, q.box_max);
-  const auto chunks = exchange<octomap_rt::distance_box_chunk_t>(channels_.query_distance, q, [](const auto& r) {
-    return !r.empty() && (r[0].status != 0 || static_cast<int>(r.size()) >= r[0].num_chunks);
-  });
+  const auto chunks = exchange<octomap_rt::distance_box_chunk_t>(channels_.query_distance, q,
+                                                                 all_chunks<octomap_rt::distance_box_chunk_t>);
   return assemble_distance_box(chunks);
 }
 
 octomap_rt::distance_path_reply_t QueryClient::distance_path(const std::vector<float>& vertices,
                                                              const DistanceRequest& d, const WaitFor& w) {
-  auto q = distance_query(octomap_rt::distance_query_t::MODE_PATH, d);
-  address(q, w);
-  q.xyz = vertices;
-  q.num_xyz = static_cast<int32_t>(vertices.size());
-  return exchange<octomap_rt::distance_path_reply_t>(channels_.query_distance, q,
-                                                     one<octomap_rt::distance_path_reply_t>)
-      .front();
+  return distance_xyz<octomap_rt::distance_path_reply_t>(octomap_rt::distance_query_t::MODE_PATH, vertices, d, w);
 }
 
 octomap_rt::map_edit_ack_t QueryClient::edit(int8_t op, const Box& b, const std::string& token, int8_t flags) {

@@ -89,6 +89,9 @@ class QueryClient {
   std::vector<Reply> exchange(const std::string& channel, Request& request, Done&& done);
   template <class Request>
   void address(Request& r, const WaitFor& w);
+  // A distance query of points or a path's vertices (one reply of type Reply).
+  template <class Reply>
+  Reply distance_xyz(int8_t mode, const std::vector<float>& xyz, const DistanceRequest& d, const WaitFor& w);
 
   std::unique_ptr<lcm::LCM> lcm_;
   protocol::Channels channels_;

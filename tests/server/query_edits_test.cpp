@@ -3,7 +3,6 @@
 // refused before it starts, every edit audited, acked and never shed or dropped.
 #include <algorithm>
 #include <atomic>
-#include <condition_variable>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -254,22 +253,7 @@ TEST(QueryService, EditsLeftAtShutdownAreRefusedNotDropped) {
   daemon::MappingServer server(cfg, lc, std::cerr);
   Replies replies(server);
   server.start();
-  std::mutex m;
-  std::condition_variable cv;
-  bool holding = false, release = false;
-  std::thread holder([&] {
-    server.with_map([&](const octomap::OcTree&) {
-      std::unique_lock lock(m);
-      holding = true;
-      cv.notify_all();
-      cv.wait(lock, [&] { return release; });
-      return 0;
-    });
-  });
-  {
-    std::unique_lock lock(m);
-    cv.wait(lock, [&] { return holding; });
-  }
+  MapHold hold(server);
   octomap_rt::map_edit_t e{};
   e.client_id = "op", e.reply_channel = kReply;
   e.op = octomap_rt::map_edit_t::OP_CLEAR_TO_UNKNOWN;
@@ -299,12 +283,7 @@ TEST(QueryService, EditsLeftAtShutdownAreRefusedNotDropped) {
   std::thread stopper([&] { server.stop(); });
   while (op_stats().edits_refused == 0 && SteadyClock::now() < until)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  {
-    std::lock_guard lock(m);
-    release = true;
-  }
-  cv.notify_all();
-  holder.join();
+  hold.release();
   stopper.join();
   int64_t scans = 0, dropped = 0;
   for (const auto& p : server.producer_stats()) scans += p.applied + p.dropped + p.rejected, dropped += p.dropped;

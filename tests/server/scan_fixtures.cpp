@@ -120,4 +120,27 @@ std::string temp_dir(const std::string& tag) {
   return dir.string();
 }
 
+MapHold::MapHold(daemon::MappingServer& server) {
+  holder_ = std::thread([this, &server] {
+    server.with_map([this](const octomap::OcTree&) {
+      std::unique_lock lock(m_);
+      holding_ = true;
+      cv_.notify_all();
+      cv_.wait(lock, [this] { return release_; });
+      return 0;
+    });
+  });
+  std::unique_lock lock(m_);
+  cv_.wait(lock, [this] { return holding_; });
+}
+
+void MapHold::release() {
+  {
+    std::lock_guard lock(m_);
+    release_ = true;
+  }
+  cv_.notify_all();
+  if (holder_.joinable()) holder_.join();
+}
+
 }  // namespace ort::test

@@ -4,10 +4,13 @@
 #pragma once
 
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <octomap/OcTree.h>
@@ -45,5 +48,24 @@ std::unique_ptr<octomap::OcTree> engine_reference(
     const std::function<const PosedScan&(const std::string&, int64_t)>& by_robot_seq);
 
 std::string temp_dir(const std::string& tag);
+
+// Holds the server's map lock (a reader in with_map) on a thread of its own from construction
+// until release() or destruction: stage 2 cannot apply, so scans and edits stay queued.
+// Construct it after server.start(); it returns once the lock is held.
+class MapHold {
+ public:
+  explicit MapHold(daemon::MappingServer& server);
+  ~MapHold() { release(); }
+  MapHold(const MapHold&) = delete;
+  MapHold& operator=(const MapHold&) = delete;
+  // Lets the map go and joins the holding thread. Idempotent.
+  void release();
+
+ private:
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool holding_ = false, release_ = false;
+  std::thread holder_;
+};
 
 }  // namespace ort::test

@@ -3,8 +3,6 @@
 // shed under overload with a reason (overload policy), and --allow-robot keeps other
 // channels out (finding 10).
 #include <atomic>
-#include <condition_variable>
-#include <mutex>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -71,34 +69,14 @@ TEST(ServerHardening, StaleScansAreShedWithAReasonUnderOverload) {
   server.start();
   // Hold the map lock: stage 2 cannot apply, stage 1 stops after one shot, the queue fills
   // and its scans grow old.
-  std::mutex m;
-  std::condition_variable cv;
-  bool release = false, holding = false;
-  std::thread blocker([&] {
-    server.with_map([&](const octomap::OcTree&) {
-      std::unique_lock lock(m);
-      holding = true;
-      cv.notify_all();
-      cv.wait(lock, [&] { return release; });
-      return 0;
-    });
-  });
-  {
-    std::unique_lock lock(m);
-    cv.wait(lock, [&] { return holding; });
-  }
+  MapHold hold(server);
   const int n = 12;
   for (int k = 0; k < n; ++k)
     lc.publish("OCTOMAP_RT_SCAN_BUSY", &static_cast<const octomap_rt::scan_t&>(small_scan("busy", k, 30)));
   while (server.producer_stats().empty() || server.producer_stats()[0].received < n)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   std::this_thread::sleep_for(std::chrono::milliseconds(50));  // every queued scan is now older than the bound
-  {
-    std::lock_guard lock(m);
-    release = true;
-  }
-  cv.notify_all();
-  blocker.join();
+  hold.release();
   ASSERT_TRUE(wait_until_done(server, n));
   const auto stats = server.producer_stats();
   expect_counts_balance(stats);

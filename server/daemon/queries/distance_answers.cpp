@@ -1,11 +1,9 @@
 #include "daemon/queries/distance_answers.h"
 
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <memory>
 
-#include "core/clock.h"
 #include "octomap_rt/distance_box_chunk_t.hpp"
 #include "octomap_rt/distance_path_reply_t.hpp"
 #include "octomap_rt/distance_points_reply_t.hpp"
@@ -20,26 +18,12 @@ namespace {
 using Query = octomap_rt::distance_query_t;
 using Reply = octomap_rt::occupancy_reply_t;
 
-template <class M>
-std::vector<uint8_t> encode(const M& m) {
-  std::vector<uint8_t> b(static_cast<size_t>(m.getEncodedSize()));
-  m.encode(b.data(), 0, static_cast<int>(b.size()));
-  return b;
-}
-
+// The common stamp and the distance the reply's values are capped at.
 template <class M>
 void stamp(M& m, const Query& q, const MapStamp& s, const std::string& server_id, int8_t status,
            const std::string& error) {
-  m.utime = now_utime();
-  m.request_id = q.request_id;
-  m.map_epoch = s.map_epoch;
-  m.snapshot_id = s.snapshot_id;
-  m.map_utime = s.map_utime;
-  m.status = status;
+  stamp_reply(m, q, s, server_id, status, error);
   m.max_distance = q.max_distance;
-  m.server_id = server_id;
-  m.client_id = q.client_id;
-  m.error = error;
 }
 
 distance::DistanceOptions options_of(const Query& q) {
@@ -62,7 +46,7 @@ void points_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const 
   }
   r.num_points = static_cast<int32_t>(r.distance.size());
   r.num_gradient = static_cast<int32_t>(r.gradient.size());
-  out.messages.push_back(encode(r));
+  out.messages.push_back(encode_message(r));
 }
 
 void path_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id,
@@ -75,7 +59,7 @@ void path_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const st
   r.min_arc_length = c.min_arc_length;
   r.min_sample = c.min_sample;
   r.num_samples = c.num_samples;
-  out.messages.push_back(encode(r));
+  out.messages.push_back(encode_message(r));
 }
 
 void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id,
@@ -113,7 +97,7 @@ void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std
     const size_t first = size_t(c) * chunk, n = std::min(chunk, blob.size() - std::min(blob.size(), first));
     m.data.assign(blob.begin() + std::ptrdiff_t(first), blob.begin() + std::ptrdiff_t(first + n));
     m.num_bytes = static_cast<int32_t>(n);
-    out.messages.push_back(encode(m));
+    out.messages.push_back(encode_message(m));
   }
 }
 
@@ -183,16 +167,16 @@ std::vector<uint8_t> distance_error_message(const Query& q, int8_t status, const
   if (q.mode == Query::MODE_BOX) {
     octomap_rt::distance_box_chunk_t m{};
     stamp(m, q, s, server_id, status, error);
-    return encode(m);
+    return encode_message(m);
   }
   if (q.mode == Query::MODE_PATH) {
     octomap_rt::distance_path_reply_t m{};
     stamp(m, q, s, server_id, status, error);
-    return encode(m);
+    return encode_message(m);
   }
   octomap_rt::distance_points_reply_t m{};
   stamp(m, q, s, server_id, status, error);
-  return encode(m);
+  return encode_message(m);
 }
 
 }  // namespace ort::daemon

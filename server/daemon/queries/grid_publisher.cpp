@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/clock.h"
+#include "daemon/queries/reply_stamp.h"
 #include "octomap_rt/grid_query_t.hpp"
 #include "octomap_rt/grid_t.hpp"
 #include "octomap_rt/occupancy_reply_t.hpp"
@@ -75,8 +76,7 @@ EncodedReplies GridPublisher::clipped_grid(octomap_rt::grid_query_t q, const Map
       octomap_rt::grid_t g;
       if (g.decode(m.data(), 0, static_cast<int>(m.size())) < 0) continue;
       g.error = note;
-      m.resize(static_cast<size_t>(g.getEncodedSize()));
-      g.encode(m.data(), 0, static_cast<int>(m.size()));
+      m = encode_message(g);
     }
     clipped_++;
     return out;

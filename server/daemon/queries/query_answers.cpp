@@ -4,7 +4,6 @@
 #include <cmath>
 #include <span>
 
-#include "core/clock.h"
 #include "daemon/queries/distance_answers.h"
 #include "octomap_rt/box_reply_t.hpp"
 #include "octomap_rt/grid_t.hpp"
@@ -33,28 +32,6 @@ EncodedReplies replies_on(const std::string& channel) {
   EncodedReplies out;
   out.channel = channel;
   return out;
-}
-
-template <class M>
-std::vector<uint8_t> encode(const M& m) {
-  std::vector<uint8_t> b(static_cast<size_t>(m.getEncodedSize()));
-  m.encode(b.data(), 0, static_cast<int>(b.size()));
-  return b;
-}
-
-template <class M>
-void stamp_reply(M& m, const QueryHeader& h, const MapStamp& s, const std::string& server_id, int8_t status,
-                 const std::string& error) {
-  m.utime = now_utime();
-  m.request_id = h.request_id;
-  m.snapshot_id = s.snapshot_id;
-  m.map_epoch = s.map_epoch;
-  m.map_utime = s.map_utime;
-  m.status = status;
-  m.server_id = server_id;
-  m.client_id = h.client_id;
-  m.error = error;
-  if constexpr (requires { m.cut_at; }) m.cut = Reply::CUT_NONE, m.cut_at = -1;
 }
 
 template <class V>
@@ -120,7 +97,7 @@ EncodedReplies points(const octomap::OcTree& t, const octomap_rt::occupancy_quer
     r.probability.push_back(a.probability);
   }
   EncodedReplies out = replies_on(h.reply_channel);
-  out.messages.push_back(encode(r));
+  out.messages.push_back(encode_message(r));
   return out;
 }
 
@@ -171,7 +148,7 @@ EncodedReplies rays(const octomap::OcTree& t, const octomap_rt::ray_query_t& q, 
     r.end_xyz.insert(r.end_xyz.end(), {a.end.x(), a.end.y(), a.end.z()});
   }
   r.num_xyz = static_cast<int32_t>(r.end_xyz.size());
-  out.messages.push_back(encode(r));
+  out.messages.push_back(encode_message(r));
   return out;
 }
 
@@ -205,7 +182,7 @@ EncodedReplies box_counts(const octomap::OcTree& t, const octomap_rt::box_query_
   }
   mark_cut(r, out, r.occupied.size(), asked, "box", budget, bounds);
   r.num_boxes = static_cast<int32_t>(r.occupied.size());
-  out.messages.push_back(encode(r));
+  out.messages.push_back(encode_message(r));
   return out;
 }
 
@@ -232,7 +209,7 @@ EncodedReplies region(const octomap::OcTree& t, const octomap_rt::box_query_t& q
     }
     m.num_voxels = static_cast<int32_t>(m.state.size());
     m.num_xyz = static_cast<int32_t>(m.center_xyz.size());
-    out.messages.push_back(encode(m));
+    out.messages.push_back(encode_message(m));
   }
   return out;
 }
@@ -262,7 +239,7 @@ EncodedReplies grid(const octomap::OcTree& t, const octomap_rt::grid_query_t& q,
     const size_t first = size_t(m.row_start) * g.width, n = size_t(m.num_rows) * g.width;
     for (size_t i = first; i < first + n; ++i) m.cells.push_back(static_cast<int8_t>(g.cells[i]));
     m.num_cells = static_cast<int32_t>(n);
-    out.messages.push_back(encode(m));
+    out.messages.push_back(encode_message(m));
   }
   return out;
 }
@@ -317,7 +294,7 @@ EncodedReplies error_reply(const QueryMessage& q, int8_t status, const std::stri
   EncodedReplies out = replies_on(h.reply_channel);
   auto one = [&](auto m) {
     stamp_reply(m, h, s, id, status, error);
-    out.messages.push_back(encode(m));
+    out.messages.push_back(encode_message(m));
   };
   if (std::holds_alternative<octomap_rt::occupancy_query_t>(q))
     one(octomap_rt::occupancy_reply_t{});

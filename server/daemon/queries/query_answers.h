@@ -12,6 +12,7 @@
 
 #include "daemon/queries/query_clients.h"
 #include "daemon/queries/query_config.h"
+#include "daemon/queries/reply_stamp.h"
 #include "query/work_budget.h"
 
 namespace ort::daemon {
@@ -26,11 +27,6 @@ QueryHeader header_of(const QueryMessage& q);
 
 // "" when the query can be answered; else why not (non-finite numbers, counts, depth, ...).
 std::string validate_query(const QueryMessage& q, double resolution);
-
-struct MapStamp {
-  int64_t snapshot_id = 0, map_utime = 0;
-  int64_t map_epoch = 0;  // the history snapshot_id counts in
-};
 
 struct EncodedReplies {
   std::string channel;
