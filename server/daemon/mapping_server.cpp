@@ -49,6 +49,7 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
 
   // First: a wrong or busy map file fails before any device is opened.
   if (!cfg_.map_path.empty()) map_lock_ = MapFileLock(cfg_.map_path, map_lock_holder(server_id_, host_));
+  saver_ = std::make_unique<MapSaver>(cfg_.map_path, cfg_.save_interval_s, map_, log_);
   if (cfg_.resolution_from_file) take_resolution_from_file();
   load_or_create_map();
   open_memory_bound();
@@ -75,6 +76,14 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
     if (!c.warning.empty()) log_.warning(c.warning);
     loop_ = std::make_unique<LcmLoop>(url_, log_);
   }
+  StatusSources sources;
+  sources.gather = [this] { return gather_status(); };
+  sources.signals = [this](const StatusInputs& in) { return degraded_signals(in); };
+  // The viewers' map cut or skipped for its size: said in every status.
+  sources.note = [this] { return raw_publisher_ ? raw_publisher_->note() : std::string(); };
+  status_ = std::make_unique<StatusReporter>(
+      StatusReporterConfig{cfg_.status_channel, cfg_.status_period_s, "serving " + cfg_.scan_channels}, *loop_,
+      std::move(sources), log_);
 }
 
 MappingServer::~MappingServer() {
@@ -90,7 +99,7 @@ void MappingServer::start() {
   started_ = true;
   // From now until the last save of an orderly stop the identity says "unclean": a crash of
   // this run forks the history at the next start.
-  if (loaded_identity_) write_identity(*loaded_identity_);
+  if (loaded_identity_) saver_->write_identity(*loaded_identity_);
   ScanLimits limits;
   limits.max_points = cfg_.max_points;
   limits.resolution = cfg_.engine.resolution;
@@ -119,9 +128,9 @@ void MappingServer::start() {
   raw_publisher_->start();
   map_service_->start();
   queries_->start();
-  status_thread_ = std::thread([this] { run_status_loop(); });
-  if (!cfg_.map_path.empty() && cfg_.save_interval_s > 0) save_thread_ = std::thread([this] { run_save_loop(); });
-  set_state(Status::STATE_RUNNING, "serving " + cfg_.scan_channels);
+  status_->start();
+  saver_->start();
+  status_->set_state(Status::STATE_RUNNING, "serving " + cfg_.scan_channels);
 }
 
 void MappingServer::warm_up_engine() {
@@ -189,7 +198,7 @@ void MappingServer::open_map_serving() {
 bool MappingServer::stop() {
   if (!started_ || stopped_) return final_save_error_.empty();
   stopped_ = true;
-  set_state(Status::STATE_STOPPING, "stopping: intake closed, draining queued scans");
+  status_->set_state(Status::STATE_STOPPING, "stopping: intake closed, draining queued scans");
   if (queries_) queries_->cut_running();  // no query holds the map past the drain bound
   intake_->close();
   queue_.close();
@@ -199,31 +208,16 @@ bool MappingServer::stop() {
   if (upkeep_) upkeep_->stop();  // ends a sweep at its current slice (the map stays whole)
   if (deltas_) deltas_->stop();  // sends the last change set
   map_.observer = nullptr;
-  {
-    std::lock_guard lock(state_mutex_);
-    stopping_ = true;
-  }
-  wake_.notify_all();
-  if (save_thread_.joinable()) save_thread_.join();
+  saver_->stop();
   if (!cfg_.map_path.empty()) {
-    set_state(Status::STATE_STOPPING, "stopping: saving the map");
+    status_->set_state(Status::STATE_STOPPING, "stopping: saving the map");
     // Nothing may throw before the threads below are joined: a failed final save is
     // reported (log, summary, status, exit status), not thrown.
-    try {
-      save_map(/*force=*/true, /*clean=*/true);
-    } catch (const std::exception& e) {
-      final_save_error_ = e.what();
-      log_.error(text("the final save failed (the previous map file is intact): ", e.what()));
-    }
+    final_save_error_ = saver_->save_final();
   }
-  set_state(Status::STATE_STOPPING,
-            final_save_error_.empty() ? "stopped" : "stopped; the final save failed: " + final_save_error_);
-  {
-    std::lock_guard lock(state_mutex_);
-    status_exit_ = true;
-  }
-  wake_.notify_all();
-  if (status_thread_.joinable()) status_thread_.join();
+  status_->set_state(Status::STATE_STOPPING,
+                     final_save_error_.empty() ? "stopped" : "stopped; the final save failed: " + final_save_error_);
+  status_->stop();
   raw_publisher_->stop();
   map_service_->stop();
   if (queries_) queries_->stop();
@@ -255,59 +249,14 @@ void MappingServer::drain_until_deadline() {
                       " map edits refused; saving the map as applied"));
 }
 
-void MappingServer::set_state(int8_t state, std::string message) {
-  {
-    std::lock_guard lock(state_mutex_);
-    state_ = state;
-    message_ = std::move(message);
-    state_changed_ = true;
-  }
-  wake_.notify_all();
-}
-
-void MappingServer::run_save_loop() {
-  const auto period = std::chrono::duration<double>(cfg_.save_interval_s);
-  std::unique_lock lock(state_mutex_);
-  while (!stopping_) {
-    if (wake_.wait_for(lock, period, [&] { return stopping_; })) break;
-    lock.unlock();
-    std::string error;
-    try {
-      save(false);
-    } catch (const std::exception& e) {
-      error = e.what();
-      log_.error(text("save failed (the previous map file is intact): ", error));
-    }
-    lock.lock();
-    last_save_error_ = error;  // the status is DEGRADED while it is set
-  }
-}
-
-void MappingServer::run_status_loop() {
-  const auto period = std::chrono::duration<double>(cfg_.status_period_s);
-  std::unique_lock lock(state_mutex_);
-  for (;;) {
-    wake_.wait_for(lock, period, [&] { return state_changed_ || status_exit_; });
-    const bool exit = status_exit_;
-    state_changed_ = false;
-    lock.unlock();
-    try {
-      publish_status();
-    } catch (const std::exception& e) {
-      log_.error(text("status failed: ", e.what()));
-    }
-    lock.lock();
-    if (exit) return;
-  }
-}
-
 void MappingServer::print_summary(std::ostream& out) {
   RunSummaryInputs in;
   in.status = gather_status();
   in.scans_in_map = map_.order.size();
   in.applied_log = cfg_.applied_log;
-  in.last_save_ms = last_save_ms_;
-  in.max_save_lock_ms = max_save_lock_ms_;
+  const SaveFigures saves = saver_->figures();
+  in.last_save_ms = saves.last_save_ms;
+  in.max_save_lock_ms = saves.max_save_lock_ms;
   if (map_service_) in.map_service = map_service_->stats();
   if (deltas_) in.deltas = deltas_->stats();
   in.deltas_on = deltas_ != nullptr;

@@ -1,15 +1,16 @@
 // octomap-rt-server's logic, as a library so tests can run it in-process over memq://.
 // It wires the parts: map (loaded from --map), engine, the LCM loop with the scan intake
-// on it, the two-stage pipeline, status heartbeats, periodic atomic saves, and the orderly
-// stop (intake off, drain, save, loop off).
+// on it, the two-stage pipeline, the services that serve and answer from the map, the
+// status reporter (daemon/status/status_reporter.h), the map saver (daemon/map_saver.h), and
+// runs the lifecycle: start in order, the orderly stop (intake off, drain, save, loop off).
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <ostream>
+#include <shared_mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -25,6 +26,7 @@
 #include "daemon/map/map_residency.h"
 #include "daemon/map/map_state.h"
 #include "daemon/map/map_upkeep.h"
+#include "daemon/map_saver.h"
 #include "daemon/persistence/map_file_lock.h"
 #include "daemon/persistence/map_identity_file.h"
 #include "daemon/persistence/map_store.h"
@@ -37,7 +39,9 @@
 #include "daemon/serving/map_service.h"
 #include "daemon/serving/octomap_raw_publisher.h"
 #include "daemon/status/degraded_causes.h"
+#include "daemon/status/map_figures.h"
 #include "daemon/status/status_message.h"
+#include "daemon/status/status_reporter.h"
 #include "daemon/transport/lcm_loop.h"
 #include "octomap_rt/server_status_t.hpp"
 
@@ -62,7 +66,7 @@ class MappingServer {
   const std::string& final_save_error() const { return final_save_error_; }
 
   // Saves now if the map changed since the last save (or `force`). Thread-safe.
-  void save(bool force = false);
+  void save(bool force = false) { saver_->save(force); }
 
   octomap_rt::server_status_t status();
   std::vector<ProducerStats> producer_stats() const { return producers_.snapshot(); }
@@ -123,16 +127,10 @@ class MappingServer {
   // The engine's warm-up scan (ServerConfig::warm_up_points), logged.
   void warm_up_engine();
   void drain_until_deadline();
-  LoadedMapFile load_checked_map();       // tree nullptr: moved aside, start anew
-  void save_map(bool force, bool clean);  // clean: the last save of an orderly stop
-  std::string absolute_map_path() const;
-  void write_identity(const MapIdentityRecord& r);
-  void set_state(int8_t state, std::string message);
+  LoadedMapFile load_checked_map();  // tree nullptr: moved aside, start anew
+  // The status' figures of now, gathered from every part (any thread).
   StatusInputs gather_status();
-  void publish_status();
   DegradedSignals degraded_signals(const StatusInputs& in);
-  void run_status_loop();
-  void run_save_loop();
 
   ServerConfig cfg_;
   Log log_;
@@ -155,38 +153,17 @@ class MappingServer {
   std::unique_ptr<OctomapRawPublisher> raw_publisher_;  // the map for LCM viewers (off by default)
   std::unique_ptr<DeltaPublisher> deltas_;
   std::unique_ptr<MapService> map_service_;
+  std::unique_ptr<MapSaver> saver_;
+  std::unique_ptr<StatusReporter> status_;
 
   std::string host_, server_id_;
   int64_t start_utime_ = 0;
   SteadyClock::time_point start_;
 
-  mutable std::mutex state_mutex_;  // state, message, status seq, threads' wake-up
-  std::condition_variable wake_;
-  int8_t state_ = octomap_rt::server_status_t::STATE_STARTING;
-  std::string message_;
-  bool state_changed_ = false, stopping_ = false, status_exit_ = false, started_ = false, stopped_ = false;
-  int64_t status_seq_ = 0;
-  // The last map figures read under the map lock (atomic: read without it when the lock is busy).
-  std::atomic<size_t> cached_leaves_{0};
-  std::atomic<int64_t> cached_nodes_{0}, cached_memory_{0}, cached_version_{0}, cached_epoch_{0};
-  // The leaf-count cache is written by whichever thread gathers a status (the status loop and
-  // any caller of status()); the map locks they take are shared, so this serializes them.
-  std::mutex leaf_cache_mutex_;
-  SteadyClock::time_point leaves_time_;
-  std::atomic<int64_t> leaves_version_{-1};    // map version of cached_leaves_
+  bool started_ = false, stopped_ = false;
+  MapFigures map_figures_;
   std::atomic<bool> pipeline_drained_{false};  // set by stop() once the pipeline is joined
-  // Maps up to this size have their leaves counted at every status (a short hold of the map
-  // lock even on the 2-core dev machine).
-  static constexpr size_t kLeafWalkEveryStatus = 65'536;
-  DegradedTracker degraded_;  // used by the status thread only
-  std::thread status_thread_, save_thread_;
-
-  std::mutex save_mutex_;  // one save at a time
-  uint64_t saved_version_ = UINT64_MAX;
-  std::atomic<int64_t> saves_{0}, last_save_utime_{0};
-  double max_save_lock_ms_ = 0, last_save_ms_ = 0;
-  std::string final_save_error_;  // "" unless the save at stop failed
-  std::string last_save_error_;   // "" unless the latest periodic save failed (under state_mutex_)
+  std::string final_save_error_;               // "" unless the save at stop failed
 };
 
 }  // namespace ort::daemon

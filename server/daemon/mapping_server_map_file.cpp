@@ -1,5 +1,5 @@
 // MappingServer and its map file: the map loaded (or a new one, or a prior) at start with its
-// identity, the saves with the identity written after each (docs/PROTOCOL.md "Ids").
+// identity (docs/PROTOCOL.md "Ids"); the saves are the MapSaver's (daemon/map_saver.h).
 #include "daemon/mapping_server.h"
 
 #include <cstdio>
@@ -8,11 +8,9 @@
 #include <optional>
 #include <utility>
 
-#include "core/clock.h"
 #include "daemon/map/map_identity.h"
 #include "daemon/persistence/map_identity_file.h"
 #include "daemon/persistence/map_store.h"
-#include "daemon/serving/map_snapshot.h"
 
 namespace ort::daemon {
 
@@ -71,12 +69,12 @@ void MappingServer::load_or_create_map() {
       map_.last_scan_utime = std::max(map_.last_scan_utime, at.first.utime);
     }
     const LoadedIdentity id =
-        identity_at_load(saved, loaded.bytes, loaded.hash, absolute_map_path(), map_.scans, new_map_epoch());
+        identity_at_load(saved, loaded.bytes, loaded.hash, saver_->absolute_map_path(), map_.scans, new_map_epoch());
     map_.epoch = id.epoch;
     map_.version = id.state_id;
-    saved_version_ = map_.version;
-    loaded_identity_ = MapIdentityRecord{map_.epoch,        map_.version, loaded.bytes,       loaded.hash,
-                                         map_.order.size(), false,        absolute_map_path()};
+    saver_->mark_saved(map_.version);
+    loaded_identity_ = MapIdentityRecord{
+        map_.epoch, map_.version, loaded.bytes, loaded.hash, map_.order.size(), false, saver_->absolute_map_path()};
     if (!cfg_.prior_path.empty())
       log_.info(text(cfg_.map_path, " exists: it is loaded, the prior ", cfg_.prior_path,
                      " is not (it was the start of this map, or of another)"));
@@ -100,43 +98,6 @@ void MappingServer::load_or_create_map() {
     apply_sensor_model(*map_.tree, cfg_.engine.sensor);
     if (!cfg_.map_path.empty()) log_.info(text("new map, will be saved to ", cfg_.map_path));
   }
-}
-
-std::string MappingServer::absolute_map_path() const {
-  std::error_code ec;
-  const auto abs = std::filesystem::absolute(cfg_.map_path, ec);
-  return ec ? cfg_.map_path : abs.lexically_normal().string();
-}
-
-void MappingServer::write_identity(const MapIdentityRecord& r) {
-  write_file_atomically(identity_path(cfg_.map_path), format_map_identity(r));
-}
-
-void MappingServer::save(bool force) { save_map(force, /*clean=*/false); }
-
-void MappingServer::save_map(bool force, bool clean) {
-  if (cfg_.map_path.empty()) return;
-  std::lock_guard save_lock(save_mutex_);
-  const auto t0 = SteadyClock::now();
-  // Copy under the map lock (a state between two whole scans); serialize and write outside it.
-  std::optional<MapCopy> copy = force ? std::optional<MapCopy>(copy_map(readable_map(map_)))
-                                      : copy_map_if_changed(readable_map(map_), saved_version_);
-  if (!copy) return;
-  const std::string bytes = serialize_map(*copy->tree);
-  copy->tree.reset();
-  // The order file holds at least the copy's scans once synced (stage 2 appends each scan's
-  // line before the replica or a copy can contain it); then the map; last its identity, which
-  // names the map file and how many order lines belong to it: one left older by a crash
-  // between the renames does not match the new map (a new epoch at the next start: safe).
-  map_.order.sync();
-  write_file_atomically(cfg_.map_path, bytes);
-  write_identity(MapIdentityRecord{copy->epoch, copy->version, bytes.size(), map_file_hash(bytes), copy->scans, clean,
-                                   absolute_map_path()});
-  saved_version_ = copy->version;
-  saves_++;
-  last_save_utime_ = now_utime();
-  max_save_lock_ms_ = std::max(max_save_lock_ms_, copy->lock_ms);
-  last_save_ms_ = ms_since(t0);
 }
 
 }  // namespace ort::daemon

@@ -1,0 +1,108 @@
+#include "daemon/map_saver.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <optional>
+
+#include "core/clock.h"
+#include "daemon/map/map_replica.h"
+#include "daemon/persistence/map_store.h"
+#include "daemon/serving/map_snapshot.h"
+
+namespace ort::daemon {
+
+MapSaver::MapSaver(std::string map_path, double interval_s, MapState& map, Log log)
+    : path_(std::move(map_path)), interval_s_(interval_s), map_(map), log_(std::move(log)) {}
+
+std::string MapSaver::absolute_map_path() const {
+  std::error_code ec;
+  const auto abs = std::filesystem::absolute(path_, ec);
+  return ec ? path_ : abs.lexically_normal().string();
+}
+
+void MapSaver::write_identity(const MapIdentityRecord& r) {
+  write_file_atomically(identity_path(path_), format_map_identity(r));
+}
+
+void MapSaver::start() {
+  if (path_.empty() || interval_s_ <= 0 || thread_.joinable()) return;
+  thread_ = std::thread([this] { run_periodic(); });
+}
+
+void MapSaver::stop() {
+  {
+    std::lock_guard lock(loop_mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void MapSaver::run_periodic() {
+  const auto period = std::chrono::duration<double>(interval_s_);
+  std::unique_lock lock(loop_mutex_);
+  while (!stopping_) {
+    if (wake_.wait_for(lock, period, [&] { return stopping_; })) break;
+    lock.unlock();
+    std::string error;
+    try {
+      save(false);
+    } catch (const std::exception& e) {
+      error = e.what();
+      log_.error(text("save failed (the previous map file is intact): ", error));
+    }
+    lock.lock();
+    last_error_ = error;  // the status is DEGRADED while it is set
+  }
+}
+
+void MapSaver::save(bool force, bool clean) {
+  if (path_.empty()) return;
+  std::lock_guard save_lock(save_mutex_);
+  const auto t0 = SteadyClock::now();
+  // Copy under the map lock (a state between two whole scans); serialize and write outside it.
+  std::optional<MapCopy> copy = force ? std::optional<MapCopy>(copy_map(readable_map(map_)))
+                                      : copy_map_if_changed(readable_map(map_), saved_version_);
+  if (!copy) return;
+  const std::string bytes = serialize_map(*copy->tree);
+  copy->tree.reset();
+  // The order file holds at least the copy's scans once synced (stage 2 appends each scan's
+  // line before the replica or a copy can contain it); then the map; last its identity, which
+  // names the map file and how many order lines belong to it: one left older by a crash
+  // between the renames does not match the new map (a new epoch at the next start: safe).
+  map_.order.sync();
+  write_file_atomically(path_, bytes);
+  write_identity(MapIdentityRecord{copy->epoch, copy->version, bytes.size(), map_file_hash(bytes), copy->scans, clean,
+                                   absolute_map_path()});
+  saved_version_ = copy->version;
+  saves_++;
+  last_save_utime_ = now_utime();
+  max_save_lock_ms_ = std::max(max_save_lock_ms_.load(), copy->lock_ms);
+  last_save_ms_ = ms_since(t0);
+}
+
+std::string MapSaver::save_final() {
+  if (path_.empty()) return "";
+  // A failed final save is reported (log, summary, status, exit status), not thrown.
+  try {
+    save(/*force=*/true, /*clean=*/true);
+    return "";
+  } catch (const std::exception& e) {
+    log_.error(text("the final save failed (the previous map file is intact): ", e.what()));
+    return e.what();
+  }
+}
+
+SaveFigures MapSaver::figures() const {
+  SaveFigures f;
+  f.saves = saves_;
+  f.last_save_utime = last_save_utime_;
+  f.last_save_ms = last_save_ms_;
+  f.max_save_lock_ms = max_save_lock_ms_;
+  std::lock_guard lock(loop_mutex_);
+  f.last_error = last_error_;
+  return f;
+}
+
+}  // namespace ort::daemon
