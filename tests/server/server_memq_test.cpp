@@ -15,6 +15,7 @@
 #include "protocol/channels.h"
 #include "protocol/inbound_checks.h"
 #include "scene/synthetic_scene.h"
+#include "server/memq_producers.h"
 #include "server/scan_fixtures.h"
 #include "support/octomap_reference.h"
 #include "support/test_data.h"
@@ -24,38 +25,6 @@ namespace ort::test {
 namespace {
 
 using daemon::Reject;
-
-std::string channel_of(const std::string& robot) {
-  std::string c = ort::protocol::kScanChannelPrefix;
-  for (char ch : robot) c += static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-  return c;
-}
-
-int64_t reason_count(const daemon::ProducerStats& p, Reject r) { return p.rejects[static_cast<size_t>(r)]; }
-
-const daemon::ProducerStats* find(const std::vector<daemon::ProducerStats>& v, const std::string& channel) {
-  for (const auto& p : v)
-    if (p.channel == channel) return &p;
-  return nullptr;
-}
-
-// Scans for several robots, thinned copies of the synthetic scene's scans (each robot sees
-// other points of the same poses) so a test is quick yet overlapping.
-std::map<std::string, std::vector<PosedScan>> robot_scans(int robots, int scans_each, int thin) {
-  const ScanSet scene = make_synthetic_rooms();
-  std::map<std::string, std::vector<PosedScan>> out;
-  for (int r = 0; r < robots; ++r) {
-    const std::string id = "robot" + std::to_string(r);
-    for (int k = 0; k < scans_each; ++k) {
-      const PosedScan& src = scene.scans[(r + 2 * k) % scene.scans.size()];
-      PosedScan s;
-      s.pose = src.pose;
-      for (size_t i = (r + k) % thin; i < src.points.size(); i += thin) s.points.push_back(src.points[i]);
-      out[id].push_back(std::move(s));
-    }
-  }
-  return out;
-}
 
 TEST(ServerMemq, CraftedBadMessagesAreCountedAndServingGoesOn) {
   lcm::LCM lc("memq://");
@@ -135,7 +104,7 @@ TEST(ServerMemq, CraftedBadMessagesAreCountedAndServingGoesOn) {
   ASSERT_TRUE(wait_until_done(server, sent));
   const auto stats = server.producer_stats();
   expect_counts_balance(stats);
-  const auto* a = find(stats, A);
+  const auto* a = producer_on(stats, A);
   ASSERT_NE(a, nullptr);
   EXPECT_EQ(a->received, sent - 1);
   EXPECT_EQ(a->applied, 3);
@@ -145,7 +114,7 @@ TEST(ServerMemq, CraftedBadMessagesAreCountedAndServingGoesOn) {
                    Reject::kNonUnitQuaternion, Reject::kRobotIdMismatch})
     EXPECT_EQ(reason_count(*a, r), 1) << daemon::to_string(r);
   EXPECT_EQ(a->missed, 2);  // seq gaps are judged on valid scans only: 10, 11, 14
-  const auto* bad_charset = find(stats, "OCTOMAP_RT_SCAN_R$2");
+  const auto* bad_charset = producer_on(stats, "OCTOMAP_RT_SCAN_R$2");
   ASSERT_NE(bad_charset, nullptr);
   EXPECT_EQ(reason_count(*bad_charset, Reject::kBadRobotId), 1);
 
@@ -291,119 +260,6 @@ TEST(ServerMemq, RealScansOnVulkanAfterWarmUpEqualOctomapInRecordedOrder) {
 #else
   run_real_scans(BackendKind::kVulkan, 640 * 480);
 #endif
-}
-
-// The warm-up scan is never larger than the largest scan the daemon accepts.
-TEST(ServerMemq, WarmUpIsNoLargerThanMaxPoints) {
-  lcm::LCM lc("memq://");
-  auto cfg = test_config(0.1, true);
-  cfg.warm_up_points = 640 * 480;
-  cfg.max_points = 1000;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
-  server.stop();
-  EXPECT_NE(log.str().find("warmed up on a scan of 1000 points"), std::string::npos) << log.str();
-}
-
-// A producer over its byte budget loses its newest scans, counted as dropped; what is
-// applied keeps the arrival order, and the counts still balance.
-TEST(ServerMemq, FullQueueDropsNewestAndCountsIt) {
-  const auto scans = robot_scans(1, 6, 1);
-  lcm::LCM lc("memq://");
-  auto cfg = test_config(0.05, true);
-  cfg.max_points = 30'000;
-  cfg.queue_budget_bytes = 12 * 30'000 + 8192;  // about one full scan per producer
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
-  const auto& list = scans.at("robot0");
-  const int rounds = 5;
-  for (int round = 0; round < rounds; ++round)
-    for (size_t k = 0; k < list.size(); ++k) {
-      const auto msg = scan_message(list[k], "robot0", static_cast<int64_t>(round * list.size() + k));
-      lc.publish("OCTOMAP_RT_SCAN_ROBOT0", &msg);
-    }
-  const int64_t sent = rounds * static_cast<int64_t>(list.size());
-  ASSERT_TRUE(wait_until_done(server, sent, std::chrono::seconds(300)));
-  const auto st = server.status();
-  server.stop();
-  const auto stats = server.producer_stats();
-  expect_counts_balance(stats);
-  ASSERT_EQ(stats.size(), 1u);
-  EXPECT_EQ(stats[0].received, sent);
-  EXPECT_GT(stats[0].dropped, 0) << "a one-scan budget must overflow when 30 scans arrive at once";
-  EXPECT_GT(stats[0].applied, 0);
-  EXPECT_EQ(stats[0].missed, 0);  // drops happen after arrival: they are not seq gaps
-  const auto order = server.applied_order();
-  EXPECT_EQ(static_cast<int64_t>(order.size()), stats[0].applied);
-  EXPECT_TRUE(std::is_sorted(order.begin(), order.end(), [](auto& a, auto& b) { return a.seq < b.seq; }));
-  EXPECT_NE(st.queue_policy.find("newest scan is dropped"), std::string::npos);
-}
-
-// More scan channels than --max-producers: the extra ones share one "*" entry whose scans
-// are all rejected (bounded memory whatever the channel names), and are still counted.
-TEST(ServerMemq, ProducersBeyondTheLimitAreRejectedAndCounted) {
-  lcm::LCM lc("memq://");
-  auto cfg = test_config(0.1, true);
-  cfg.max_producers = 2;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
-  for (const char* robot : {"a1", "a2", "a3", "a4"}) {
-    const auto msg = small_scan(robot, 0, 10);
-    lc.publish(channel_of(robot), &msg);
-  }
-  ASSERT_TRUE(wait_until_done(server, 4));
-  const auto stats = server.producer_stats();
-  expect_counts_balance(stats);
-  ASSERT_EQ(stats.size(), 3u);
-  const auto* other = find(stats, "*");
-  ASSERT_NE(other, nullptr);
-  EXPECT_EQ(other->received, 2);
-  EXPECT_EQ(reason_count(*other, Reject::kTooManyProducers), 2);
-  EXPECT_EQ(find(stats, "OCTOMAP_RT_SCAN_A1")->applied, 1);
-  EXPECT_EQ(find(stats, "OCTOMAP_RT_SCAN_A2")->applied, 1);
-  server.stop();
-}
-
-// stop() right after the scans arrived: intake closes, and every queued scan is still
-// applied (drained), not lost.
-TEST(ServerMemq, StopDrainsQueuedScans) {
-  const auto scans = robot_scans(1, 6, 4);
-  lcm::LCM lc("memq://");
-  const auto cfg = test_config(0.1, true);
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
-  const auto& list = scans.at("robot0");
-  for (size_t k = 0; k < list.size(); ++k) {
-    const auto msg = scan_message(list[k], "robot0", static_cast<int64_t>(k));
-    lc.publish("OCTOMAP_RT_SCAN_ROBOT0", &msg);
-  }
-  int64_t received = 0, in_flight = 0;
-  for (int i = 0; i < 2000 && received < 6; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    const auto st = server.producer_stats();
-    received = st.empty() ? 0 : st[0].received;
-    in_flight = st.empty() ? 0 : st[0].in_flight;
-  }
-  ASSERT_EQ(received, 6);
-  EXPECT_GT(in_flight, 0) << "stop() should find scans still queued (the test would prove nothing)";
-  server.stop();
-  const auto st = server.producer_stats();
-  expect_counts_balance(st);
-  EXPECT_EQ(st[0].applied, 6);
-  EXPECT_EQ(server.applied_order().size(), 6u);
-  // The status's map numbers are OctoMap's own.
-  const auto status = server.status();
-  server.with_map([&](const octomap::OcTree& t) {
-    EXPECT_EQ(status.num_nodes, static_cast<int64_t>(t.size()));
-    EXPECT_EQ(status.num_leaf_nodes, static_cast<int64_t>(t.getNumLeafNodes()));
-    EXPECT_NEAR(static_cast<double>(status.memory_bytes), static_cast<double>(t.memoryUsage()), 1024.0);
-    return 0;
-  });
-  EXPECT_EQ(status.scans_applied, 6);
 }
 
 }  // namespace

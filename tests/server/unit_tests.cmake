@@ -4,6 +4,7 @@ octomap_rt_add_test(server_validation_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/sca
                     ${CMAKE_CURRENT_LIST_DIR}/scan_decode_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 120)
 octomap_rt_add_test(server_memq_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_memq_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/server_admission_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/server_status_counts_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/server_published_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/map_request_bounds_test.cpp
