@@ -1,9 +1,6 @@
 #include "cpu/cpu_grid_backend.h"
 
 #include <sys/mman.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -19,6 +16,7 @@
 #include "core/octomap_ray_walk.h"
 #include "core/prepare_scan.h"
 #include "core/ray_space.h"
+#include "core/thread_priority.h"
 #include "cpu/brick_layout.h"
 #include "cpu/grid_marker.h"
 #include "cpu/walk_thread_choice.h"
@@ -117,10 +115,6 @@ struct WindowStepper {
   int sx = 0, sy = 0, sz = 0;
   int x_out = 0, y_out = 0, z_out = 0;  // the first coordinate outside the window along each step
 };
-
-// Nice 19 for the calling thread only (Linux: a thread's nice value is its own). Best effort:
-// a refusal leaves the thread as it was.
-void lower_own_priority() { (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19); }
 
 class CpuGridBackend final : public RayBackend {
  public:
@@ -224,7 +218,7 @@ class CpuGridBackend final : public RayBackend {
     std::atomic<int64_t> helper_cpu_ns{0};
     constexpr size_t kChunk = 1024;
     run_parallel(n_threads, [&](unsigned t) {
-      if (t > 0 && helpers_yield_) lower_own_priority();
+      if (t > 0 && helpers_yield_) lower_this_thread_priority(19);  // the lowest
       touched[t].clear();
       GridMarker marker{grid_.data(), touched[t], n_threads > 1};
       for (size_t begin; (begin = next.fetch_add(kChunk)) < batch.ends.size();) {

@@ -59,9 +59,12 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
     log_.info("a memory bound on: whole-map readers copy the map under its lock (no read replica)");
   else if (cfg_.read_replica) {
     OctreeUpdateOptions o = cfg_.engine.octree;
-    // A quarter of the cores: it runs beside the octree stage, which keeps the rest.
-    o.threads = std::max(1u, std::thread::hardware_concurrency() / 4);
-    replica_ = std::make_unique<MapReplica>(map_, o, cfg_.replica_pending_bytes);
+    // By default every hardware thread, the replica's helpers at the lowest priority: they
+    // take what the octree stage leaves idle and yield to it (daemon/map/map_replica.h).
+    o.threads = cfg_.replica_threads;
+    o.helper_nice = 19;
+    replica_ =
+        std::make_unique<MapReplica>(map_, o, cfg_.replica_pending_bytes, cfg_.replica_batch_voxels, cfg_.replica_nice);
     map_.replica = replica_.get();
   }
   engine_ = std::make_unique<MapEngine>(cfg_.engine, log_);

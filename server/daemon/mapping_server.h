@@ -101,6 +101,12 @@ class MappingServer {
     std::shared_lock lock(replica_->state().mutex);
     while (!release) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
+  // Holds the map of record's lock (exclusive) until `release` is set, as stage 2 does for a
+  // scan's update (tests: queries are answered from the read replica meanwhile).
+  void hold_map_until(const std::atomic<bool>& release) {
+    std::unique_lock lock(map_.mutex);
+    while (!release) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
   std::optional<ReplicaStats> replica_stats() const {
     return replica_ ? std::optional<ReplicaStats>(replica_->stats()) : std::nullopt;
   }

@@ -92,6 +92,10 @@ struct ServerConfig {
   // thread. false: they copy the map of record under its lock.
   bool read_replica = true;
   uint64_t replica_pending_bytes = 256ull << 20;  // changes the replica may lag behind by
+  // Scans waiting for the replica are applied together, up to this many voxels (0: one by one).
+  uint64_t replica_batch_voxels = uint64_t{1} << 23;
+  unsigned replica_threads = 0;  // its octree stage's threads (0: every hardware thread)
+  int replica_nice = 10;         // how much the replica's thread lowers its priority: the octree stage goes first
 };
 
 // "" when the memory bound's flags fit together; else why not (a bound or a store bound

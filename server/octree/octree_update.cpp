@@ -24,6 +24,7 @@ void OctreeStage::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> upda
   if (!batched_) {
     BatchedUpdateOptions o;
     o.threads = opts_.threads;
+    o.helper_nice = opts_.helper_nice;
     batched_ = std::make_unique<BatchedOctreeUpdater>(o);
   }
   batched_->apply(tree, updates, nullptr, changes);

@@ -21,6 +21,10 @@ enum class OctreeUpdateMode {
 struct OctreeUpdateOptions {
   OctreeUpdateMode mode = OctreeUpdateMode::kBatched;
   unsigned threads = 0;  // batched mode: 0 = hardware threads
+  // Batched mode: how much the threads other than the caller lower their priority
+  // (worker_pool.h); 19 for an update that should take only idle cores beside another (the
+  // read replica's).
+  int helper_nice = 0;
 };
 
 // Plain updateNode loop: each voxel updated once, occupied or free. With `changes`: reset,

@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "core/clock.h"
+#include "core/thread_priority.h"
 
 namespace ort {
 namespace {
@@ -37,9 +38,13 @@ unsigned resolve_thread_count(unsigned requested) {
   return hw > 0 ? hw : 1;
 }
 
-WorkerPool::WorkerPool(unsigned workers, std::optional<bool> spin)
+WorkerPool::WorkerPool(unsigned workers, std::optional<bool> spin, int helper_nice)
     : spin_(spin.value_or(workers < std::thread::hardware_concurrency())) {
-  for (unsigned w = 1; w < workers; ++w) threads_.emplace_back([this, w] { thread_main(w); });
+  for (unsigned w = 1; w < workers; ++w)
+    threads_.emplace_back([this, w, helper_nice] {
+      lower_this_thread_priority(helper_nice);
+      thread_main(w);
+    });
 }
 
 WorkerPool::~WorkerPool() {

@@ -36,7 +36,11 @@ class WorkerPool {
  public:
   // `workers` >= 1; worker 0 is the thread that calls run(), the others are started here.
   // `spin`: whether waiting threads spin first; unset: where workers < hardware threads.
-  explicit WorkerPool(unsigned workers, std::optional<bool> spin = std::nullopt);
+  // `helper_nice`: how much the started threads lower their priority below the caller's
+  // (core/thread_priority.h; 19: the lowest). Such helpers take only cores nothing else
+  // wants: run_shared jobs go on without the ones that do not get a core (the caller alone
+  // does what is left).
+  explicit WorkerPool(unsigned workers, std::optional<bool> spin = std::nullopt, int helper_nice = 0);
   ~WorkerPool();
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;

@@ -1,7 +1,8 @@
 // The read replica (daemon/map/map_replica.h), in one process over memq://: after scans,
 // clear-boxes and a reset it equals the map of record byte for byte (.ot), and a reader that
 // holds it for a long time does not stop the octree stage: scans go on being applied, and the
-// replica catches up once the reader lets go.
+// replica catches up once the reader lets go (the scans that waited applied as one list);
+// while stage 2 holds the map of record, queries are answered from the replica.
 #include <sstream>
 #include <thread>
 
@@ -87,6 +88,54 @@ TEST(MapReplica, AReaderHoldingItDoesNotStopTheOctreeStage) {
   EXPECT_EQ(during->version, 0u) << "the replica was held: it lags";
   EXPECT_GT(during->pending_items, 0u);
   EXPECT_EQ(replica_bytes(server), map_bytes(server)) << "caught up once the reader let go";
+  // It caught up by applying the scans that waited together (one voxel list), and still
+  // equals the map of record, which applied them one by one.
+  const auto after = server.replica_stats();
+  EXPECT_GT(after->largest_batch, 1u);
+  EXPECT_LT(after->updates, set.scans.size());
+  server.stop();
+}
+
+TEST(MapReplica, QueriesAreAnsweredFromItWhileAScanHoldsTheMap) {
+  lcm::LCM lc("memq://");
+  std::ostringstream log;
+  daemon::MappingServer server(test_config(0.1, true), lc, log);
+  Replies replies(server);
+  server.start();
+  octomap_rt::scan_t last;
+  for (int64_t k = 0; k < 4; ++k) {
+    last = wall_scan(k);
+    lc.publish("OCTOMAP_RT_SCAN_ALPHA", &last);
+  }
+  ASSERT_TRUE(wait_until_done(server, 4));
+  (void)replica_bytes(server);  // the replica caught up with the map of record
+  // The map of record is held as a scan's update holds it (for 3 s at most): a query is
+  // answered meanwhile, from the replica, at the state both hold, and a query that waits
+  // for its robot's next scan (not applied yet) is not answered from either.
+  std::atomic<bool> release{false};
+  std::thread writer([&] { server.hold_map_until(release); });
+  std::thread timer([&] {
+    for (int i = 0; i < 300 && !release; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    release = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  auto q = point_query(1, last.xyz);
+  lc.publish(ort::protocol::kQueryChannel, &q);
+  auto later = point_query(2, last.xyz);
+  later.wait_robot_id = "alpha", later.wait_seq = 4, later.wait_timeout_ms = 300;
+  lc.publish(ort::protocol::kQueryChannel, &later);
+  const Reply r = replies.wait_for<Reply>(1);
+  const bool while_held = !release;
+  const Reply nr = replies.wait_for<Reply>(2);
+  release = true;
+  writer.join();
+  timer.join();
+  EXPECT_TRUE(while_held) << "the query waited for the map of record";
+  ASSERT_EQ(r.status, Reply::REPLY_OK) << r.error;
+  EXPECT_EQ(r.snapshot_id, 4);
+  ASSERT_EQ(r.num_results, last.num_xyz / 3);
+  for (int8_t o : r.occupancy) EXPECT_EQ(o, Reply::OCC_OCCUPIED);
+  EXPECT_EQ(nr.status, Reply::REPLY_NOT_READY) << "seq 4 was never sent";
   server.stop();
 }
 

@@ -85,6 +85,9 @@ struct Args {
   int producers = 3;
   double rate = 1.0, duration = 60;
   std::string readers = "on", replica = "on";
+  uint64_t replica_batch_voxels = daemon::MapReplica::kDefaultBatchVoxels;
+  int replica_nice = 10;
+  unsigned replica_threads = 0;
   double snapshot_period = 1, save_interval = 10, raw_rate = 1, query_rate = 100;
   cli::EngineFlags engine;
 };
@@ -97,6 +100,9 @@ daemon::ServerConfig server_config(const Args& a) {
   cfg.chunk_interval_ms = 0.2;
   cfg.latency_bound_s = 60;
   cfg.read_replica = a.replica == "on";
+  cfg.replica_batch_voxels = a.replica_batch_voxels;
+  cfg.replica_nice = a.replica_nice;
+  cfg.replica_threads = a.replica_threads;
   // The producers go round the preset's scans (origins far apart, many new nodes a second at
   // the GPU machine's rates): the per-producer cost gates would refuse the scans it measures.
   cfg.scan_costs.max_origin_jump_m = 0;
@@ -220,16 +226,22 @@ int run(const Args& a) {
   if (!rs.snapshot_error.empty()) std::printf("  snapshot refused: %s\n", rs.snapshot_error.c_str());
   if (replica)
     std::printf(
-        "  read replica: %.1f s of updates on its thread, at most %.1f MB pending, stage 2 waited %.1f ms for "
-        "room\n",
-        replica->apply_ms_total / 1e3, double(replica->max_pending_bytes_seen) / 1e6, replica->writer_waited_ms);
+        "  read replica: %.1f s of updates on its thread (%llu updates, %llu scans in batches, at most %llu in one), "
+        "at most %.1f MB pending, stage 2 waited %.1f ms for room\n",
+        replica->apply_ms_total / 1e3, (unsigned long long)replica->updates,
+        (unsigned long long)replica->scans_in_batches, (unsigned long long)replica->largest_batch,
+        double(replica->max_pending_bytes_seen) / 1e6, replica->writer_waited_ms);
   std::printf("  memory: RSS %.0f MiB before the map, %.0f MiB loaded, %.0f MiB at the end, peak %.0f MiB\n",
               rss_before, rss_loaded, rss_end, hwm);
-  std::printf("csv,%s,%s,%lld,%lld,%.1f,%.3f,%.3f,%.2f,%.2f,%.2f,%.2f,%lld,%.2f,%.0f,%.0f\n", readers ? "on" : "off",
-              a.replica.c_str(), (long long)loaded.num_nodes, (long long)st.scans_applied, seconds,
-              st.octree_lock_wait_ms_max, st.octree_lock_wait_ms_p99, st.end_to_end_ms_p50, st.end_to_end_ms_p99,
-              percentile(rs.query_ms, 0.5), percentile(rs.query_ms, 0.99), (long long)rs.snapshots, rs.snapshot_s_max,
-              rss_loaded, hwm);
+  // readers, replica, nodes, scans, s, stall max, stall p99, e2e p50, e2e p99, query p50, query p99, snapshots,
+  // snapshot max s, RSS loaded, RSS peak, replica update s, replica batch voxels, replica nice
+  std::printf("csv,%s,%s,%lld,%lld,%.1f,%.3f,%.3f,%.2f,%.2f,%.2f,%.2f,%lld,%.2f,%.0f,%.0f,%.1f,%llu,%d\n",
+              readers ? "on" : "off", a.replica.c_str(), (long long)loaded.num_nodes, (long long)st.scans_applied,
+              seconds, st.octree_lock_wait_ms_max, st.octree_lock_wait_ms_p99, st.end_to_end_ms_p50,
+              st.end_to_end_ms_p99, percentile(rs.query_ms, 0.5), percentile(rs.query_ms, 0.99),
+              (long long)rs.snapshots, rs.snapshot_s_max, rss_loaded, hwm,
+              replica ? replica->apply_ms_total / 1e3 : 0.0, (unsigned long long)a.replica_batch_voxels,
+              a.replica_nice);
   return 0;
 }
 
@@ -261,6 +273,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   r->add_option("--read-replica", a.replica, "on: readers read the server's read replica; off: the map of record")
       ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  r->add_option("--replica-batch-voxels", a.replica_batch_voxels,
+                "scans waiting for the read replica are applied together up to this many voxels (0: one by one)")
+      ->capture_default_str();
+  r->add_option("--replica-threads", a.replica_threads, "the read replica's octree threads (0: every hardware thread)")
+      ->capture_default_str();
+  r->add_option("--replica-nice", a.replica_nice, "how much the read replica's thread lowers its priority (nice)")
       ->capture_default_str();
   r->add_option("--snapshot-period", a.snapshot_period, "a fresh snapshot pulled this often [s]")
       ->capture_default_str();

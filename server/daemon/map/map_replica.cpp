@@ -3,13 +3,16 @@
 #include <algorithm>
 #include <chrono>
 #include <shared_mutex>
+#include <span>
 
 #include "core/clock.h"
+#include "core/thread_priority.h"
 
 namespace ort::daemon {
 
-MapReplica::MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes)
-    : stage_(octree), max_pending_bytes_(max_pending_bytes) {
+MapReplica::MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
+                       uint64_t max_batch_voxels, int nice)
+    : stage_(octree), max_pending_bytes_(max_pending_bytes), max_batch_voxels_(max_batch_voxels) {
   state_.tree = std::make_unique<octomap::OcTree>(*map.tree);
   state_.version = map.version;
   state_.epoch = map.epoch;
@@ -17,7 +20,10 @@ MapReplica::MapReplica(const MapState& map, const OctreeUpdateOptions& octree, u
   state_.last_scan_utime = map.last_scan_utime;
   state_.newest_scan = map.newest_scan;
   stats_.version = map.version;
-  thread_ = std::thread([this] { run(); });
+  thread_ = std::thread([this, nice] {
+    lower_this_thread_priority(nice);
+    run();
+  });
 }
 
 MapReplica::~MapReplica() { stop(); }
@@ -73,35 +79,61 @@ void MapReplica::push(Item item) {
   work_.notify_one();
 }
 
+void MapReplica::take_batch(std::deque<Item>& batch) {
+  batch.push_back(std::move(queue_.front()));
+  queue_.pop_front();
+  if (batch.front().step) return;
+  uint64_t voxels = batch.front().voxels.size();
+  while (!queue_.empty() && !queue_.front().step && voxels + queue_.front().voxels.size() <= max_batch_voxels_) {
+    voxels += queue_.front().voxels.size();
+    batch.push_back(std::move(queue_.front()));
+    queue_.pop_front();
+  }
+}
+
+void MapReplica::apply_batch(std::deque<Item>& batch) {
+  std::span<const VoxelUpdate> voxels = batch.front().voxels;
+  if (batch.size() > 1) {
+    joined_.clear();
+    for (const Item& it : batch) joined_.insert(joined_.end(), it.voxels.begin(), it.voxels.end());
+    voxels = joined_;
+  }
+  std::unique_lock lock(state_.mutex);
+  if (batch.front().step)
+    batch.front().step(*state_.tree);
+  else
+    stage_.apply(*state_.tree, voxels);
+  for (Item& it : batch)
+    if (!it.robot.empty()) state_.newest_scan[it.robot] = std::move(it.newest);
+  const Item& last = batch.back();
+  state_.version = last.version;
+  state_.epoch = last.epoch;
+  state_.scans = last.scans;
+  state_.last_scan_utime = last.last_scan_utime;
+}
+
 void MapReplica::run() {
+  std::deque<Item> batch;
   for (;;) {
-    Item it;
     {
       std::unique_lock lock(mutex_);
       work_.wait(lock, [&] { return stop_ || !queue_.empty(); });
       if (queue_.empty()) return;  // stopped with nothing left
-      it = std::move(queue_.front());
-      queue_.pop_front();
+      take_batch(batch);
     }
     const auto t0 = SteadyClock::now();
-    {
-      std::unique_lock lock(state_.mutex);
-      if (it.step)
-        it.step(*state_.tree);
-      else
-        stage_.apply(*state_.tree, it.voxels);
-      state_.version = it.version;
-      state_.epoch = it.epoch;
-      state_.scans = it.scans;
-      state_.last_scan_utime = it.last_scan_utime;
-      if (!it.robot.empty()) state_.newest_scan[it.robot] = std::move(it.newest);
-    }
-    const uint64_t bytes = it.bytes;
-    it = Item{};  // the voxel list is freed outside both locks
+    apply_batch(batch);
+    uint64_t bytes = 0;
+    for (const Item& it : batch) bytes += it.bytes;
+    const uint64_t items = batch.size();
+    batch.clear();  // the voxel lists are freed outside both locks
     {
       std::lock_guard lock(mutex_);
       stats_.apply_ms_total += ms_since(t0);
-      stats_.pending_items--;
+      stats_.updates++;
+      if (items > 1) stats_.scans_in_batches += items;
+      stats_.largest_batch = std::max(stats_.largest_batch, items);
+      stats_.pending_items -= std::min(stats_.pending_items, items);
       stats_.pending_bytes -= std::min(stats_.pending_bytes, bytes);
       stats_.version = state_.version;
     }
@@ -131,6 +163,22 @@ MapState& readable_map(MapState& map) {
   }
   map.replica->wait_for(version, 1e9);
   return map.replica->state();
+}
+
+MapState& lock_for_short_read(MapState& map, uint64_t min_version, std::shared_lock<std::shared_mutex>& lock) {
+  lock = std::shared_lock(map.mutex, std::try_to_lock);
+  if (lock.owns_lock() || !map.replica) {
+    if (!lock.owns_lock()) lock = std::shared_lock(map.mutex);
+    return map;
+  }
+  MapState& replica = map.replica->state();
+  lock = std::shared_lock(replica.mutex, std::try_to_lock);
+  if (lock.owns_lock() && replica.version >= min_version) return replica;
+  // Never wait for the map of record while holding the replica: stage 2 may be waiting (under
+  // the map lock) for the replica's thread to make room, and that thread for this lock.
+  if (lock.owns_lock()) lock.unlock();
+  lock = std::shared_lock(map.mutex);
+  return map;
 }
 
 }  // namespace ort::daemon

@@ -10,7 +10,21 @@
 //
 // Memory: one more tree, plus the voxel lists and steps not applied yet, at most
 // `max_pending_bytes`; past that, stage 2 waits for the replica (only while a reader holds
-// the replica longer than it takes the producers to send that much).
+// the replica longer than it takes the producers to send that much); plus one buffer of at
+// most `max_batch_voxels` voxels (8 bytes each), kept from batch to batch.
+//
+// Keeping up: scans waiting back to back (a reader held the replica, or it fell behind) are
+// applied as one list, their voxel lists one after the other. The batched octree stage applies
+// a key repeated in a list in the list's order, as OctoMap's updateNode loop does
+// (octree/batched/batched_update.h), so one update of the joined lists gives the tree that the
+// scans give one by one; it costs less because each node on the scans' shared paths is walked
+// and settled once, nodes pruned by one scan and expanded by the next are not, and the stage's
+// fixed cost per update is paid once. The replica then goes from the state before the first
+// to the state after the last (readers never see a state within a scan). Its octree stage's
+// helper threads run at nice 19 (octree/worker_pool.h): they take the cores the octree stage
+// leaves idle, and yield them to it; the replica's own thread lowers its priority too (the
+// server's: by 10), so that on a machine with few cores the octree stage goes first and the
+// replica catches up, a batch at a time, when the stage waits for scans.
 #pragma once
 
 #include <condition_variable>
@@ -19,6 +33,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <shared_mutex>
 #include <string>
 #include <thread>
 
@@ -35,15 +50,23 @@ struct ReplicaStats {
   uint64_t version = 0;  // the replica's map state id
   uint64_t pending_items = 0, pending_bytes = 0;
   uint64_t max_pending_bytes_seen = 0;
-  double writer_waited_ms = 0;  // stage 2's total wait for room (the bound above)
-  double apply_ms_total = 0;    // the replica thread's own update time
+  double writer_waited_ms = 0;    // stage 2's total wait for room (the bound above)
+  double apply_ms_total = 0;      // the replica thread's own update time
+  uint64_t updates = 0;           // tree updates it made: one per batch of scans or per step
+  uint64_t scans_in_batches = 0;  // scans applied together with others
+  uint64_t largest_batch = 0;     // most scans in one update
 };
 
 class MapReplica {
  public:
   // Starts from a copy of `map` (its tree, id, epoch, scans, per-robot seqs): call before the
   // pipeline runs, with nothing else changing the map.
-  MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes);
+  // `max_batch_voxels` 0: one scan per update. `nice`: how much the replica's thread lowers
+  // its priority below the server's (core/thread_priority.h; its octree stage's helpers:
+  // octree.helper_nice).
+  static constexpr uint64_t kDefaultBatchVoxels = uint64_t{1} << 23;
+  MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
+             uint64_t max_batch_voxels = kDefaultBatchVoxels, int nice = 0);
   ~MapReplica();
   MapReplica(const MapReplica&) = delete;
   MapReplica& operator=(const MapReplica&) = delete;
@@ -74,10 +97,16 @@ class MapReplica {
   };
   void push(Item item);
   void run();
+  // Under mutex_: the front item, and the scans right behind a scan up to max_batch_voxels_.
+  void take_batch(std::deque<Item>& batch);
+  // Applies a batch to the tree and takes its last item's state (under state_.mutex).
+  void apply_batch(std::deque<Item>& batch);
 
   MapState state_;
   OctreeStage stage_;
   uint64_t max_pending_bytes_;
+  uint64_t max_batch_voxels_;
+  VoxelList joined_;          // a batch's voxel lists one after the other (capacity kept)
   mutable std::mutex mutex_;  // the queue and the stats
   std::condition_variable work_, room_, progress_;
   std::deque<Item> queue_;
@@ -90,5 +119,12 @@ class MapReplica {
 // record as it was at the call (read-your-writes: a reader that saw id N there gets N or
 // newer); else the map of record itself.
 MapState& readable_map(MapState& map);
+
+// For short readers (a turn of queries): a shared lock on the map of record when stage 2 does
+// not hold it; while it does, on the read replica if its thread is not writing it and it is at
+// `min_version` or newer (a reader that passes the newest id it answered from never answers
+// from an older state after a newer one); else it waits for the map of record. Both are
+// states between two whole scans, each named by its own `version`. Returns the state locked.
+MapState& lock_for_short_read(MapState& map, uint64_t min_version, std::shared_lock<std::shared_mutex>& lock);
 
 }  // namespace ort::daemon

@@ -8,6 +8,7 @@
 #include "core/clock.h"
 #include "core/errors.h"
 #include "daemon/map/map_edit_item.h"
+#include "daemon/map/map_replica.h"
 #include "daemon/map/map_residency.h"
 #include "daemon/queries/edit_audit.h"
 #include "daemon/queries/query_footprint.h"
@@ -240,19 +241,20 @@ void QueryService::on_edit(const lcm::ReceiveBuffer& rb, const std::string& chan
 }
 
 bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& out) {
+  MapState& map = *turn_map_;
   const QueryHeader h = header_of(q.msg);
-  const MapStamp stamp{static_cast<int64_t>(map_.version), map_.last_scan_utime, static_cast<int64_t>(map_.epoch)};
+  const MapStamp stamp{static_cast<int64_t>(map.version), map.last_scan_utime, static_cast<int64_t>(map.epoch)};
   // The robot id keys the wait: "" = no wait, whatever wait_seq holds (a default message
   // has wait_seq 0), so a plain query is never parked for a robot that does not exist.
   const bool waits_for_scan = !h.wait_robot_id.empty();
   int64_t applied = -1;
   if (waits_for_scan) {
-    auto it = map_.newest_scan.find(robot_key(h.wait_robot_id));
-    if (it != map_.newest_scan.end()) applied = it->second.seq;
+    auto it = map.newest_scan.find(robot_key(h.wait_robot_id));
+    if (it != map.newest_scan.end()) applied = it->second.seq;
   }
   const bool ready = stamp.snapshot_id >= h.min_snapshot_id && (!waits_for_scan || applied >= h.wait_seq);
   if (!ready) {
-    if (SteadyClock::now() < q.deadline) return false;
+    if (SteadyClock::now() < q.deadline || &map != &map_) return false;
     const std::string why = "map state " + std::to_string(stamp.snapshot_id) + " (robot '" + h.wait_robot_id +
                             "' applied seq " + std::to_string(applied) + ") did not reach min_snapshot_id " +
                             std::to_string(h.min_snapshot_id) + " / wait_seq " + std::to_string(h.wait_seq) +
@@ -262,8 +264,8 @@ bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& o
     return true;
   }
   // A query meeting an evicted region waits for the exclusive turn that brings it back.
-  if (map_.residency && !exclusive_turn_ &&
-      map_.residency->any_spilled_in(query_footprint(*map_.tree, map_.residency->grid(), q.msg))) {
+  if (map.residency && !exclusive_turn_ &&
+      map.residency->any_spilled_in(query_footprint(*map.tree, map.residency->grid(), q.msg))) {
     to_restore_.push_back(std::move(q));
     return true;
   }
@@ -276,10 +278,10 @@ bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& o
   try {
     if (const auto* d = std::get_if<octomap_rt::distance_query_t>(&q.msg)) {
       // Only the grid is read here (bounded in cells); the EDT runs after the lock, counted there.
-      out.push_back(read_distance(*map_.tree, *d, stamp, server_id_, cfg_.distance, edt_));
+      out.push_back(read_distance(*map.tree, *d, stamp, server_id_, cfg_.distance, edt_));
       return true;
     }
-    out.push_back(answer_query(*map_.tree, q.msg, stamp, server_id_, cfg_.bounds, budget));
+    out.push_back(answer_query(*map.tree, q.msg, stamp, server_id_, cfg_.bounds, budget));
   } catch (const std::exception& e) {  // query::QueryError: a query the map cannot answer
     clients_.count(h.client_id, Count::kBad, e.what());
     out.push_back(error_reply(q.msg, Reply::REPLY_BAD_REQUEST, e.what(), stamp, server_id_));
@@ -320,7 +322,19 @@ void QueryService::run() {
       // One turn at the map for every query ready now (within a budget): under a scan
       // backlog a reader gets the lock about once per scan, so each query taking it alone
       // waited a scan per query (on dev: ~20 answered a second, the rest BUSY).
-      std::shared_lock lock(map_.mutex);
+      // While stage 2 holds the map, the read replica when it is free and new enough; a turn
+      // with a query past its deadline reads the map of record (the newest state decides).
+      const auto now = SteadyClock::now();
+      const bool overdue =
+          std::any_of(parked.begin(), parked.end(), [&](const PendingQuery& p) { return p.deadline <= now; });
+      std::shared_lock<std::shared_mutex> lock;
+      if (overdue) {
+        lock = std::shared_lock(map_.mutex);
+        turn_map_ = &map_;
+      } else {
+        turn_map_ = &lock_for_short_read(map_, answered_version_, lock);
+      }
+      answered_version_ = std::max(answered_version_, turn_map_->version);
       const auto turn_end = SteadyClock::now() + kReadTurn;
       for (size_t i = 0; i < parked.size();) {
         if (answer_locked(parked[i], out)) {
@@ -359,6 +373,7 @@ void QueryService::run() {
 // they are answered, and the bound holds again (daemon/map/map_residency.h).
 void QueryService::answer_restoring(std::vector<PendingQuery>& parked, std::vector<EncodedReplies>& out) {
   std::unique_lock lock(map_.mutex);
+  turn_map_ = &map_;
   exclusive_turn_ = true;
   for (PendingQuery& q : to_restore_) {
     try {

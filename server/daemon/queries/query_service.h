@@ -13,7 +13,9 @@
 // is answered under a shared map lock, with every other query ready then (a turn of at most
 // 10 ms: stage 2 may be waiting; each query within its own bounds, QueryBounds, checked
 // inside its walk), and its replies are published after the lock, each naming
-// the map state (snapshot_id = MapState::version).
+// the map state (snapshot_id = MapState::version). While stage 2 holds the map for a scan's
+// update, a turn reads the read replica instead when it is free and not older than the
+// state the worker answered from last (a state between two whole scans too, named by its id).
 // With --grid-rate, its GridPublisher also publishes the 2D grid on OCTOMAP_RT_GRID.
 // Distance queries read their grid under the lock and run the EDT after it
 // (daemon/queries/distance_answers.h), on CPU threads or the Vulkan device (--distance-backend).
@@ -68,8 +70,9 @@ class QueryService {
   // "" when client_id and reply_channel are usable for a reply.
   std::string check_addressing(const std::string& client, const std::string& channel) const;
   void run();
-  // Under the map lock (shared): true when answered or refused for good, its replies added to
-  // `out` (published after the lock is released); false: not ready yet, within its deadline.
+  // Under the lock (shared) of the turn's map state (turn_map_): true when answered or refused
+  // for good, its replies added to `out` (published after the lock is released); false: not
+  // ready yet, within its deadline (or past it on the read replica: the map of record decides).
   bool answer_locked(PendingQuery& q, std::vector<EncodedReplies>& out);
   void answer_restoring(std::vector<PendingQuery>& parked, std::vector<EncodedReplies>& out);
   void publish(const EncodedReplies& r);
@@ -90,6 +93,10 @@ class QueryService {
   // answers them is on (the worker's own state).
   std::vector<PendingQuery> to_restore_;
   bool exclusive_turn_ = false;
+  // What a turn reads: the map of record, or the read replica while stage 2 holds the map
+  // (lock_for_short_read, daemon/map/map_replica.h); and the newest state answered from.
+  MapState* turn_map_ = nullptr;
+  uint64_t answered_version_ = 0;
   GridPublisher grids_;
   distance::SquaredEdt edt_;  // CPU threads or the device; used by the worker thread only
   std::string distance_backend_;

@@ -32,7 +32,7 @@ std::vector<size_t> work_order(const std::vector<PlannedSubtree>& subtrees, cons
 }  // namespace
 
 BatchedOctreeUpdater::BatchedOctreeUpdater(const BatchedUpdateOptions& opts)
-    : opts_(opts), pool_(resolve_thread_count(opts.threads)), sort_tmp_(pool_.size()) {
+    : opts_(opts), pool_(resolve_thread_count(opts.threads), std::nullopt, opts.helper_nice), sort_tmp_(pool_.size()) {
   // The counting trees never hold a root; the resolution is irrelevant to them.
   for (unsigned w = 0; w < pool_.size(); ++w) counting_trees_.push_back(std::make_unique<octomap::OcTree>(0.1));
 }

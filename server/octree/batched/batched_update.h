@@ -51,6 +51,7 @@ namespace ort {
 
 struct BatchedUpdateOptions {
   unsigned threads = 0;  // 0: all hardware threads
+  int helper_nice = 0;   // how much the worker threads lower their priority (worker_pool.h)
   BucketOptions buckets;
   // Below this many voxels a batch is updated on the calling thread alone.
   size_t min_parallel_voxels = 16384;
