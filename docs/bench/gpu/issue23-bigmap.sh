@@ -4,7 +4,11 @@
 # (octomap-rt-bigmap-bench run: memq://, the vulkan back end), 3 producers streaming campus scans for 45 s each:
 #   readers off                      (the baseline: no snapshot, no autosave, no viewer map, no queries)
 #   readers on, --read-replica off   (before: readers copy the map under the map lock)
-#   readers on, --read-replica on    (after: readers read the replica)
+#   readers on, --read-replica on    (after: readers read the replica; from session 3 on, 2026-12-02, the replica
+#                                     applies the scans that wait together, on every core its helpers at the lowest
+#                                     priority; queries read it while stage 2 holds the map)
+#   unbatched (session 3 on)         the replica one scan per update on 4 threads at the server's priority (the
+#                                     design of the first H200 run), for the same-call comparison
 # "readers on" = a fresh snapshot pulled every second, autosave every 10 s, the OCTOMAP viewer map at 1 Hz,
 # 100 point queries a second. Each run prints the octree stage's longest lock wait (the stall readers caused),
 # scans' end-to-end p50/p99, queries' p50/p99, snapshot fetch times and RSS (docs/BENCHMARKS.md, issue 23).
@@ -23,12 +27,14 @@ log grow
 timeout 240 "$B" grow "${E[@]}" --point-scale 1 --target-nodes 20000000 --map "$T/big.ot" > "$O/grow.txt" 2>&1
 echo "rc=$?" >> "$O/grow.txt"
 R=(--map "$T/big.ot" --stream-point-scale 0.25 --producers 3 --rate 3 --duration 45)
-run() { local name=$1; shift; log "run-$name"; timeout 170 "$B" run "${E[@]}" "${R[@]}" "$@" > "$O/run-$name.txt" 2>&1
+# Each run at most 170 s and never past 575 s into the call (the result is packed at exit).
+run() { local name=$1; shift; log "run-$name"; local t=$((575 - (SECONDS - start))); [ "$t" -gt 170 ] && t=170
+  timeout "$t" "$B" run "${E[@]}" "${R[@]}" "$@" > "$O/run-$name.txt" 2>&1
   echo "rc=$?" >> "$O/run-$name.txt"; }
-left 300 && run off-a --readers off
-left 360 && run before-a --readers on --read-replica off
-left 420 && run after-a --readers on --read-replica on
-left 480 && run after-b --readers on --read-replica on
-left 530 && run before-b --readers on --read-replica off
+left 300 && run off-a --readers off --read-replica off
+left 360 && run after-a --readers on --read-replica on
+left 420 && run unbatched-a --readers on --read-replica on --replica-batch-voxels 0 --replica-nice 0 --replica-threads 4
+left 470 && run off-b --readers off --read-replica off
+left 520 && run after-b --readers on --read-replica on
 grep -h '^csv' "$O"/run-*.txt > "$O/runs.csv" 2>/dev/null
 exit 0
