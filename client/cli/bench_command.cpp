@@ -18,6 +18,7 @@
 #include "cli/commands.h"
 #include "cli/map_summary.h"
 #include "core/clock.h"
+#include "core/log.h"
 #include "engine/engine_pipeline.h"
 #include "engine/map_engine.h"
 #include "scene/scan_set.h"
@@ -138,7 +139,7 @@ std::vector<std::pair<std::string, std::string>> datasets(const BenchArgs& a) {
       if (std::filesystem::exists(path))
         d.push_back({std::filesystem::path(rel).filename().string(), path});
       else
-        std::cerr << "octomap-rt bench: " << path << " not found, skipped\n";
+        log_to(std::cerr, "octomap-rt bench").warning(path + " not found, skipped");
     }
     const bool listed = std::find(a.presets.begin(), a.presets.end(), "fr079-real") != a.presets.end();
     if (!listed && std::filesystem::exists(a.data_dir + "/octomap_share/geb079.bt"))
@@ -160,7 +161,8 @@ void save_outputs(const std::vector<BenchRow>& rows, const BenchArgs& a) {
   }
   if (!a.png_dir.empty()) {
     std::string msg;
-    if (!bench::plot_stage_charts(rows, a.png_dir, msg)) std::cerr << "octomap-rt bench: charts: " << msg << "\n";
+    if (!bench::plot_stage_charts(rows, a.png_dir, msg))
+      log_to(std::cerr, "octomap-rt bench").warning("charts: " + msg);
   }
 }
 
@@ -191,7 +193,7 @@ int run_bench(const BenchArgs& a) {
     try {
       set = std::make_unique<ScanSet>(source == "preset" ? make_preset(name, popts) : load_scan_graph(source));
     } catch (const std::exception& e) {
-      std::cerr << "octomap-rt bench: " << name << ": " << e.what() << " (skipped)\n";
+      log_to(std::cerr, "octomap-rt bench").warning(text(name, ": ", e.what(), " (skipped)"));
       BenchRow r;
       r.dataset = name;
       r.backend = "octomap";
@@ -199,9 +201,11 @@ int run_bench(const BenchArgs& a) {
       rows.push_back(r);
       continue;
     }
-    std::fprintf(stderr, "octomap-rt bench: %s: %zu scans, %zu points (%.1f s to %s)\n", name.c_str(),
-                 set->scans.size(), set->total_points(), ms_since(tg) / 1000.0,
-                 source == "preset" ? "generate" : "load");
+    char took[32];
+    std::snprintf(took, sizeof took, "%.1f", ms_since(tg) / 1000.0);
+    log_to(std::cerr, "octomap-rt bench")
+        .info(text(name, ": ", set->scans.size(), " scans, ", set->total_points(), " points (", took, " s to ",
+                   source == "preset" ? "generate" : "load", ")"));
     for (double res : a.resolutions) {
       BenchRow base;
       base.dataset = name;
@@ -264,7 +268,8 @@ int run_bench(const BenchArgs& a) {
     if (r.status == "ok" && r.backend != "octomap" && r.traversal == "octomap" && r.map_identical != "yes")
       ++mismatches;
   if (mismatches) {
-    std::fprintf(stderr, "octomap-rt bench: %d octomap-mode run(s) did NOT reproduce OctoMap's map\n", mismatches);
+    log_to(std::cerr, "octomap-rt bench")
+        .error(text(mismatches, " octomap-mode run(s) did NOT reproduce OctoMap's map"));
     return 3;
   }
   return 0;

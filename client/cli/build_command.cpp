@@ -11,6 +11,7 @@
 #include "cli/map_summary.h"
 #include "core/clock.h"
 #include "core/file_checks/octree_binary.h"
+#include "core/log.h"
 #include "engine/engine_flags.h"
 #include "engine/engine_pipeline.h"
 #include "scene/scan_set.h"
@@ -55,12 +56,12 @@ int run_build(const BuildArgs& a) {
   const ScanSet set = a.input == "synthetic" ? make_synthetic_rooms() : load_scan_graph(a.input);
   const double load_ms = ms_since(t_load);
 
-  MapEngine engine(opts, log_to(std::cerr));
-  std::cerr << "octomap-rt build: " << set.scans.size() << " scans, " << set.total_points() << " points from "
-            << set.name << " (" << load_ms << " ms)\n"
-            << "  back end " << to_string(engine.backend().kind()) << " on " << engine.backend().device_name()
-            << ", traversal " << to_string(opts.traversal) << ", resolution " << opts.resolution << " m, max range "
-            << opts.max_range << ", octree threads " << engine.octree_threads() << "\n";
+  const Log log = log_to(std::cerr, "octomap-rt build");
+  MapEngine engine(opts, log);
+  log.info(text(set.scans.size(), " scans, ", set.total_points(), " points from ", set.name, " (", load_ms, " ms)"));
+  log.info(text("back end ", to_string(engine.backend().kind()), " on ", engine.backend().device_name(), ", traversal ",
+                to_string(opts.traversal), ", resolution ", opts.resolution, " m, max range ", opts.max_range,
+                ", octree threads ", engine.octree_threads()));
 
   auto tree = engine.make_tree();
   StageTimes total;

@@ -5,6 +5,7 @@
 
 #include "cli/commands.h"
 #include "cli/octomap_chatter.h"
+#include "core/log.h"
 #include "protocol/version.h"
 
 int main(int argc, char** argv) {
@@ -25,7 +26,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const std::exception& e) {
-    std::cerr << "octomap-rt: error: " << e.what() << "\n";
+    ort::log_to(std::cerr, "octomap-rt").error(e.what());
     return 1;
   }
   return 0;

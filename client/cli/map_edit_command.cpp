@@ -8,6 +8,7 @@
 
 #include "cli/commands.h"
 #include "cli/namespace_flag.h"
+#include "core/log.h"
 #include "octomap_rt/map_edit_t.hpp"
 #include "protocol/lcm_url.h"
 #include "query_client/query_args.h"
@@ -34,7 +35,7 @@ void run_edit(const EditArgs& a, int8_t op) {
   const auto ack = c.edit(op, b, a.token, flags);
   if (a.json) client::write_edit_json(std::cout, ack);
   if (ack.status != 0) {
-    std::cerr << "octomap-rt map: " << client::status_name(ack.status) << ": " << ack.error << "\n";
+    log_to(std::cerr, "octomap-rt map").error(std::string(client::status_name(ack.status)) + ": " + ack.error);
     std::exit(2);
   }
   if (!a.json) std::cout << "applied; the map holds it from map state " << ack.snapshot_id << "\n";

@@ -6,6 +6,7 @@
 
 #include "cli/commands.h"
 #include "core/clock.h"
+#include "core/log.h"
 #include "render/map_file.h"
 #include "render/map_render.h"
 #include "render/png_file.h"
@@ -48,10 +49,10 @@ int run_render(RenderArgs a) {
   const render::MapPicture picture = render::render_map(*tree, a.options);
   render::write_png(picture.canvas, a.output);
   const auto& s = picture.stats;
-  std::cerr << "octomap-rt render: " << a.output << " (" << picture.canvas.width() << " x " << picture.canvas.height()
-            << " px, " << picture.camera.pixels_per_metre() << " px/m): " << s.occupied_boxes << " occupied, "
-            << s.free_boxes << " free leaves; load " << load_ms << " ms, collect " << s.collect_ms << " ms, raster "
-            << s.raster_ms << " ms\n";
+  log_to(std::cerr, "octomap-rt render")
+      .info(text(a.output, " (", picture.canvas.width(), " x ", picture.canvas.height(), " px, ",
+                 picture.camera.pixels_per_metre(), " px/m): ", s.occupied_boxes, " occupied, ", s.free_boxes,
+                 " free leaves; load ", load_ms, " ms, collect ", s.collect_ms, " ms, raster ", s.raster_ms, " ms"));
   return 0;
 }
 

@@ -21,6 +21,7 @@
 #include "cli/replay/scan_message.h"
 #include "cli/replay/scan_selection.h"
 #include "core/clock.h"
+#include "core/log.h"
 #include "protocol/channels.h"
 #include "protocol/lcm_url.h"
 #include "protocol/limits.h"
@@ -265,8 +266,9 @@ int run_replay(ReplayArgs a) {
     // and fill the kernel's receive-error counters the server reports.
     lcm::LCM listener(url);
     if (!wait_for_server_status(listener, a.status_channel, a.wait_for_server_s)) {
-      std::cerr << "octomap-rt replay: no message on " << a.status_channel << " within " << a.wait_for_server_s
-                << " s at " << url << ": is octomap-rt-server running there?\n";
+      log_to(std::cerr, "octomap-rt replay")
+          .error(text("no message on ", a.status_channel, " within ", a.wait_for_server_s, " s at ", url,
+                      ": is octomap-rt-server running there?"));
       return 2;
     }
   }

@@ -9,6 +9,7 @@
 #include "cli/map_commands.h"
 #include "cli/status/status_text.h"
 #include "core/clock.h"
+#include "core/log.h"
 #include "protocol/lcm_url.h"
 #include "protocol/shards/shard_wire.h"
 #include "shard_client/shard_snapshot.h"
@@ -87,10 +88,10 @@ int run_get_shards(const MapArgs& a, const std::string& out_path, bool partial) 
     if (write)
       std::printf("merged map: %zu nodes -> %s%s\n", m.tree->size(), out_path.c_str(), m.partial ? " (PARTIAL)" : "");
   }
-  if (!late.empty()) std::cerr << "octomap-rt map get: LATE: " << late << "\n";
+  const Log log = log_to(std::cerr, "octomap-rt map get");
+  if (!late.empty()) log.warning("LATE: " + late);
   if (m.partial)
-    std::cerr << "octomap-rt map get: " << (write ? "PARTIAL map written: " : "no map written (--partial writes one): ")
-              << m.shortfall << "\n";
+    log.warning((write ? "PARTIAL map written: " : "no map written (--partial writes one): ") + m.shortfall);
   return m.partial ? (write ? 3 : 1) : 0;
 }
 
@@ -149,13 +150,13 @@ client::ShardRoster find_shards_for_query(const std::string& url, const std::str
   client::ShardRoster roster = client::discover_shards(url, ns, std::min(timeout_s, 3.0));
   if (!roster.set()) throw std::runtime_error("no server status in namespace '" + ns + "': no shard to ask");
   if (const std::string s = roster.shortfall(now_utime(), kLateAfterS); !s.empty())
-    std::cerr << "octomap-rt query: " << s << "\n";
+    log_to(std::cerr, "octomap-rt query").warning(s);
   return roster;
 }
 
 bool say_partial(const client::ShardAnswer& a) {
   if (!a.partial()) return false;
-  std::cerr << "octomap-rt query: PARTIAL answer: " << a.shortfall() << "\n";
+  log_to(std::cerr, "octomap-rt query").warning("PARTIAL answer: " + a.shortfall());
   return true;
 }
 
