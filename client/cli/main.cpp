@@ -10,6 +10,7 @@
 
 int main(int argc, char** argv) {
   const ort::cli::OctomapChatterFilter quiet(std::cerr);  // OctoMap's "Reading octree ..." lines
+  const ort::cli::OctomapStdioFilter quiet_stdio;         // its "Writing N nodes ..." lines (C stdio)
   CLI::App app{"octomap-rt: GPU-accelerated OctoMap building, and the client of octomap-rt-server"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("octomap-rt ") + OCTOMAP_RT_VERSION + " (protocol version " +

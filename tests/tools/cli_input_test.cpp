@@ -4,6 +4,7 @@
 // an error; non-finite or absurd resolutions, rates and ranges are refused; a resolution
 // that puts every point outside the key range gets a warning.
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -11,11 +12,13 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
+#include "cli/octomap_chatter.h"
 #include "scene/scan_set.h"
 #include "support/test_data.h"
 
@@ -167,6 +170,48 @@ TEST(CliInput, OctomapsReadProgressLinesDoNotReachTheUser) {
   const CliRun missing = run("map diff " + bt + " " + dir() + "/none.bt");
   EXPECT_NE(missing.exit, 0);
   EXPECT_NE(missing.output.find("none.bt"), std::string::npos) << missing.output;  // errors still pass
+}
+
+TEST(CliInput, OctomapsStdioProgressLinesDoNotReachTheUser) {
+  // OctoMap also prints through C stdio's stderr: "Reading N points from binary file...done."
+  // for every cloud of a .graph, "Writing N nodes to output stream... done." for every .bt
+  // writeBinary writes (`map get --shards -o FILE.bt`). octomap-rt drops those lines and
+  // nothing else: its own messages and OctoMap's warnings pass.
+  ScanSet set;
+  PosedScan s;
+  s.pose = octomap::pose6d(0, 0, 0, 0, 0, 0);
+  for (int i = 0; i < 20; ++i) s.points.push_back(2.0f, 0.1f * i, 0.5f);
+  set.scans.push_back(s);
+  const std::string graph = dir() + "/stdio.graph";
+  save_scan_graph(set, graph);
+  const CliRun built = run("build " + graph + " -r 0.1 --backend cpu -q -o " + dir() + "/stdio.bt");
+  EXPECT_EQ(built.exit, 0) << built.output;
+  EXPECT_EQ(built.output.find("points from binary file"), std::string::npos) << built.output;
+  EXPECT_NE(built.output.find("octomap-rt build: 1 scans, 20 points"), std::string::npos) << built.output;
+
+  // The filter the CLI's main holds, around what `map get --shards` does to write a .bt.
+  const std::string captured = dir() + "/stderr.txt";
+  std::fflush(stderr);
+  const int saved = ::dup(2);
+  FILE* into = std::fopen(captured.c_str(), "w");
+  ASSERT_NE(into, nullptr);
+  ::dup2(::fileno(into), 2);
+  {
+    const cli::OctomapStdioFilter quiet;
+    octomap::OcTree tree(0.1);
+    tree.updateNode(octomap::point3d(1, 1, 1), true);
+    std::ostringstream bt;
+    tree.writeBinary(bt);
+    std::fprintf(stderr, "WARNING: kept\n");
+    std::fprintf(stderr, "Writing is what we do");  // no newline: passes when the filter goes
+  }
+  std::fflush(stderr);
+  ::dup2(saved, 2);
+  ::close(saved);
+  std::fclose(into);
+  std::ifstream in(captured);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, "WARNING: kept\nWriting is what we do");
 }
 
 }  // namespace

@@ -6,7 +6,8 @@ target_compile_definitions(tools_bench_smoke_test PRIVATE OCTOMAP_RT_CLI="$<TARG
 add_dependencies(tools_bench_smoke_test octomap-rt)
 
 # Hostile and unlucky command-line input (issue 13): broken .graph files, full disks, NaN flags.
-octomap_rt_add_test(tools_cli_input_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/cli_input_test.cpp TIMEOUT 300)
+octomap_rt_add_test(tools_cli_input_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/cli_input_test.cpp
+                    ${CMAKE_SOURCE_DIR}/client/cli/octomap_chatter.cpp TIMEOUT 300)
 target_compile_definitions(tools_cli_input_test PRIVATE OCTOMAP_RT_CLI="$<TARGET_FILE:octomap-rt>")
 add_dependencies(tools_cli_input_test octomap-rt)
 
