@@ -30,6 +30,10 @@ void add_long_lived_flags(CLI::App& app, ServerConfig& c) {
                  "octree bytes kept in memory (e.g. 512MiB; 0: no bound); past them the least recently touched "
                  "regions go to FILE.ot.regions/ until touched")
       ->transform(CLI::AsSizeValue(false));
+  app.add_option("--evict-depth", c.evict_depth,
+                 "octree depth of the regions --max-map-memory evicts and restores, --region-depth..16 (0: one "
+                 "below --region-depth: 32 voxels a side)")
+      ->capture_default_str();
   app.add_option("--region-store-max", c.region_store_max_bytes, "bytes the region store may hold on disk")
       ->transform(CLI::AsSizeValue(false));
 }

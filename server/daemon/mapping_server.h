@@ -128,6 +128,9 @@ class MappingServer {
   // --max-map-memory: the region store (emptied: the map file holds what a previous run
   // evicted) and the residency, which brings a loaded map down to the bound.
   void open_memory_bound();
+  // --max-map-memory while the map file loads: the store and residency opened first, and the
+  // file split so that the tree is built within the bound (nullptr without a bound).
+  const MapLoadBound* map_load_bound();
   void take_resolution_from_file();  // cfg_.resolution_from_file
   void open_map_serving();
   // The engine's warm-up scan (ServerConfig::warm_up_points), logged.
@@ -148,6 +151,7 @@ class MappingServer {
   MapState map_;
   std::unique_ptr<RegionStore> region_store_;  // --max-map-memory's evicted regions
   std::unique_ptr<MapResidency> residency_;
+  std::optional<MapLoadBound> load_bound_;
   std::unique_ptr<MapReplica> replica_;  // what whole-map readers read (cfg_.read_replica)
   ProducerRegistry producers_;
   ScanQueue queue_;

@@ -19,7 +19,7 @@ namespace ort::daemon {
 // and starts anew.
 LoadedMapFile MappingServer::load_checked_map() {
   try {
-    return load_map_file(cfg_.map_path, cfg_.engine.resolution);
+    return load_map_file(cfg_.map_path, cfg_.engine.resolution, map_load_bound());
   } catch (const MapStoreError& e) {
     if (e.kind() != MapStoreError::Kind::kCorrupt) throw;
     if (!cfg_.move_corrupt_map_aside)

@@ -22,11 +22,18 @@ std::string memory_bound_problem(const ServerConfig& c) {
     return "must be 0 (no bound) or a number of bytes in [1 MiB, 2^50]";
   if (c.region_store_max_bytes < kMin || c.region_store_max_bytes > kMax)
     return "--region-store-max must be a number of bytes in [1 MiB, 2^50]";
+  if (c.evict_depth != 0 && (c.evict_depth < c.upkeep.region_depth || c.evict_depth > 16))
+    return "--evict-depth must be 0 (one below --region-depth) or between --region-depth (" +
+           std::to_string(c.upkeep.region_depth) + ") and 16";
   if (c.map_path.empty()) return "needs --map: evicted regions are kept in FILE.ot.regions/ beside the map file";
   if (c.queries.grid.rate_hz > 0)
     return "cannot go with --grid-rate: its whole-map grid would bring every evicted region back each period "
            "(ask for windowed grids instead)";
   return "";
+}
+
+unsigned evict_region_depth(const ServerConfig& c) {
+  return c.evict_depth != 0 ? c.evict_depth : std::min(16u, c.upkeep.region_depth + 1);
 }
 
 ProducerPolicy producer_policy(const ServerConfig& c) {

@@ -83,9 +83,13 @@ struct ServerConfig {
   // protocol/shards/shard_set.h); the default maps every region.
   protocol::ShardSet shard;
   // The memory bound (daemon/map/map_residency.h): past this many bytes of tree, the least
-  // recently touched regions (--region-depth) go to FILE.ot.regions/; 0: no bound.
+  // recently touched regions (--evict-depth) go to FILE.ot.regions/; 0: no bound.
   uint64_t max_map_memory = 0;
   uint64_t region_store_max_bytes = uint64_t(1) << 40;  // the store's own bound on disk
+  // Depth of the regions the bound evicts and restores: finer than decay's and clearing's
+  // regions (--region-depth), so that a scan brings back little more than it sees; 0: one
+  // level below --region-depth (at most 16).
+  unsigned evict_depth = 0;
   // Whole-map readers (snapshots, saves, the viewer publisher, status counts) read a replica
   // of the map fed by stage 2 (daemon/map/map_replica.h), so they never hold the octree stage
   // up; it costs one more tree in memory and a second octree update per scan on another
@@ -102,6 +106,8 @@ struct ServerConfig {
 // below 1 MiB or past 2^50 bytes, no --map for the store to live beside, a --grid-rate whose
 // whole-map grid would bring every spilled region back each period).
 std::string memory_bound_problem(const ServerConfig& c);
+// The depth the memory bound evicts at (ServerConfig::evict_depth, 0 resolved).
+unsigned evict_region_depth(const ServerConfig& c);
 
 struct ProducerPolicy;
 // The producer admission policy (slots, idle release, allow-list) of `c`.

@@ -3,6 +3,8 @@
 #include <cstring>
 #include <string>
 
+#include "octree/batched/node_access.h"
+#include "octree/batched/node_count.h"
 #include "octree/region_sweep.h"
 
 namespace ort {
@@ -40,8 +42,11 @@ void encode_node(const octomap::OcTree& tree, const octomap::OcTreeNode* node, s
   if (tree.nodeHasChildren(node))
     for (unsigned i = 0; i < 8; ++i)
       if (tree.nodeChildExists(node, i)) bits = static_cast<uint8_t>(bits | (1u << i));
-  put(out, node->getLogOdds());
-  out.push_back(bits);
+  const float value = node->getLogOdds();
+  const size_t at = out.size();
+  out.resize(at + kNodeBytes);
+  std::memcpy(out.data() + at, &value, sizeof value);
+  out[at + 4] = bits;
   for (unsigned i = 0; i < 8; ++i)
     if (bits & (1u << i)) encode_node(tree, tree.getNodeChild(node, i), out, count);
 }
@@ -69,6 +74,17 @@ void build_children(octomap::OcTree& tree, octomap::OcTreeNode* node, std::span<
   }
 }
 
+// Fills the header in front of `out`'s body (kHeaderBytes reserved at its start).
+void write_header(std::vector<uint8_t>& out, RegionId id, unsigned depth, uint64_t count) {
+  std::vector<uint8_t> header(kMagic, kMagic + 4);
+  put(header, kVersion);
+  put(header, uint64_t(id));
+  put(header, uint32_t(depth));
+  put(header, count);
+  put(header, fnv1a(std::span<const uint8_t>(out).subspan(kHeaderBytes)));
+  std::memcpy(out.data(), header.data(), kHeaderBytes);
+}
+
 }  // namespace
 
 std::vector<uint8_t> encode_region(const octomap::OcTree& tree, const RegionGrid& grid, RegionId id) {
@@ -78,13 +94,17 @@ std::vector<uint8_t> encode_region(const octomap::OcTree& tree, const RegionGrid
   std::vector<uint8_t> out(kHeaderBytes);
   uint64_t count = 0;
   encode_node(tree, r.node, out, count);
-  std::vector<uint8_t> header(kMagic, kMagic + 4);
-  put(header, kVersion);
-  put(header, uint64_t(id));
-  put(header, uint32_t(grid.depth));
-  put(header, count);
-  put(header, fnv1a(std::span<const uint8_t>(out).subspan(kHeaderBytes)));
-  std::memcpy(out.data(), header.data(), kHeaderBytes);
+  write_header(out, id, grid.depth, count);
+  return out;
+}
+
+std::vector<uint8_t> region_bytes_from_body(RegionId id, unsigned depth, std::span<const uint8_t> body) {
+  if (body.empty() || body.size() % kNodeBytes != 0)
+    throw RegionCodecError("region " + std::to_string(id) + ": a body of " + std::to_string(body.size()) +
+                           " bytes is not whole nodes");
+  std::vector<uint8_t> out(kHeaderBytes + body.size());
+  std::memcpy(out.data() + kHeaderBytes, body.data(), body.size());
+  write_header(out, id, depth, body.size() / kNodeBytes);
   return out;
 }
 
@@ -119,6 +139,35 @@ uint64_t strip_region(octomap::OcTree& tree, const RegionGrid& grid, RegionId id
     if (tree.nodeChildExists(r.node, i)) delete_subtree(tree, r.node, i);
   free_empty_child_array(r.node);
   return before - tree.size();
+}
+
+DetachedSubtree detach_region(octomap::OcTree& tree, const RegionGrid& grid, RegionId id, uint64_t nodes_below) {
+  const RegionNode r = find_region(tree, grid, id);
+  if (r.node == nullptr || r.depth != grid.depth || !tree.nodeHasChildren(r.node)) return {};
+  octomap::AbstractOcTreeNode**& children = detail::ChildArrayAccess::of(*r.node);
+  DetachedSubtree d{children, nodes_below};
+  children = nullptr;
+  add_to_node_count(tree, -static_cast<int64_t>(nodes_below));
+  return d;
+}
+
+namespace {
+void free_children(octomap::AbstractOcTreeNode** children) {
+  for (unsigned i = 0; i < 8; ++i) {
+    auto* child = static_cast<octomap::OcTreeNode*>(children[i]);
+    if (child == nullptr) continue;
+    octomap::AbstractOcTreeNode**& below = detail::ChildArrayAccess::of(*child);
+    if (below != nullptr) free_children(below);
+    below = nullptr;
+    delete child;
+  }
+  delete[] children;
+}
+}  // namespace
+
+void free_detached(DetachedSubtree& d) {
+  if (d.children != nullptr) free_children(d.children);
+  d = {};
 }
 
 void restore_region(octomap::OcTree& tree, const RegionGrid& grid, RegionId id, std::span<const uint8_t> bytes) {

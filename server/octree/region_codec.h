@@ -31,9 +31,26 @@ class RegionCodecError : public std::runtime_error {
 // have children; throws RegionCodecError otherwise).
 std::vector<uint8_t> encode_region(const octomap::OcTree& tree, const RegionGrid& grid, RegionId id);
 
+// The bytes of region `id` at `depth` from its subtree already laid out as the body above
+// (OctoMap's .ot writes nodes the same way: a float and a byte of child bits, in pre-order),
+// so a map file's region goes to the spill without being built as a tree first.
+std::vector<uint8_t> region_bytes_from_body(RegionId id, unsigned depth, std::span<const uint8_t> body);
+
 // Deletes every node below region `id`'s root (the root stays, as a childless stand-in with
 // its value). Returns the nodes freed.
 uint64_t strip_region(octomap::OcTree& tree, const RegionGrid& grid, RegionId id);
+
+// Region `id`'s nodes below its root taken out of the tree at once (the root stays as the
+// childless stand-in strip_region leaves; the tree's node counter goes down by `nodes`), to
+// be freed later on any thread by free_detached: nothing in the tree refers to them any more,
+// so freeing them need not hold up the tree's writer.
+struct DetachedSubtree {
+  octomap::AbstractOcTreeNode** children = nullptr;  // the root's child array, as it was
+  uint64_t nodes = 0;                                // nodes below the root
+};
+// `nodes_below`: the subtree's nodes without its root (an encoding's count minus one).
+DetachedSubtree detach_region(octomap::OcTree& tree, const RegionGrid& grid, RegionId id, uint64_t nodes_below);
+void free_detached(DetachedSubtree& d);
 
 // Puts the subtree of `bytes` back below region `id`'s stand-in (a childless node at the
 // region depth). Throws RegionCodecError when the bytes are not a whole region of this id

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <unordered_set>
 
+#include "core/clock.h"
 #include "octree/region_codec.h"
 
 namespace ort {
@@ -13,8 +14,12 @@ RegionResidency::RegionResidency(const RegionGrid& grid, RegionSpill& spill, uin
 void RegionResidency::restore(octomap::OcTree& tree, RegionId id) {
   auto it = spilled_.find(id);
   if (it == spilled_.end()) return;
+  const auto t0 = SteadyClock::now();
   const std::vector<uint8_t> bytes = spill_.get(id);
+  const auto t1 = SteadyClock::now();
   restore_region(tree, grid_, id, bytes);
+  stats_.costs.get_ms += ms_between(t0, t1);
+  stats_.costs.rebuild_ms += ms_since(t1);
   stats_.evicted_bytes -= it->second;
   spilled_.erase(it);
   spill_.erase(id);
@@ -72,7 +77,7 @@ uint64_t inner_nodes(const std::vector<uint8_t>& encoded) {
 
 size_t RegionResidency::enforce(octomap::OcTree& tree) { return enforce(tree, tree.memoryUsage(), max_bytes_).regions; }
 
-EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, uint64_t target) {
+EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, uint64_t target, size_t max_groups) {
   EnforceResult result;
   if (bytes <= target) return result;
   // Siblings go together, as the group's most recent touch: a touch brings a region's seven
@@ -82,6 +87,7 @@ EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, ui
     uint64_t touched;
     RegionId group, id;
   };
+  const auto listing = SteadyClock::now();
   std::vector<Candidate> candidates;
   std::unordered_map<RegionId, uint64_t> group_touched;
   for_each_region(tree, grid_, [&](RegionId id, const RegionNode& r) {
@@ -99,11 +105,31 @@ EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, ui
     return a.group != b.group ? a.group < b.group : a.id < b.id;
   });
   result.listed = candidates.size();
+  stats_.costs.list_ms += ms_since(listing);
+  size_t groups = 0;
+  RegionId group = ~RegionId(0);
   for (const Candidate& c : candidates) {
-    if (bytes <= target) break;
+    if (c.group != group) {  // whole groups only: stop between two
+      if (bytes <= target || groups == max_groups) break;
+      group = c.group;
+      ++groups;
+    }
+    const auto t0 = SteadyClock::now();
     const std::vector<uint8_t> encoded = encode_region(tree, grid_, c.id);
+    const auto t1 = SteadyClock::now();
     spill_.put(c.id, encoded);  // durable before the nodes go
-    const uint64_t freed = strip_region(tree, grid_, c.id);
+    const auto t2 = SteadyClock::now();
+    uint64_t freed = 0;
+    if (free_later_) {
+      DetachedSubtree d = detach_region(tree, grid_, c.id, read_region_header(encoded).nodes - 1);
+      freed = d.nodes;
+      free_later_(d);
+    } else {
+      freed = strip_region(tree, grid_, c.id);
+    }
+    stats_.costs.encode_ms += ms_between(t0, t1);
+    stats_.costs.put_ms += ms_between(t1, t2);
+    stats_.costs.strip_ms += ms_since(t2);
     const uint64_t freed_bytes =
         freed * tree.memoryUsageNode() + inner_nodes(encoded) * 8 * sizeof(octomap::OcTreeNode*);
     spilled_[c.id] = encoded.size();
@@ -140,6 +166,15 @@ std::vector<RegionId> RegionResidency::spilled_in(const octomap::OcTreeKey& lo, 
   }
   std::sort(out.begin(), out.end());
   return out;
+}
+
+void RegionResidency::adopt_spilled(RegionId id, uint64_t bytes) {
+  auto [it, added] = spilled_.emplace(id, bytes);
+  if (!added) {
+    stats_.evicted_bytes -= it->second;
+    it->second = bytes;
+  }
+  stats_.evicted_bytes += bytes;
 }
 
 std::vector<RegionId> RegionResidency::spilled_ids() const {

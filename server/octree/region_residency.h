@@ -10,7 +10,9 @@
 // stand-in below it has children, so it is never pruned).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <unordered_map>
 #include <vector>
@@ -19,6 +21,7 @@
 
 #include "core/voxel_update.h"
 #include "octree/region.h"
+#include "octree/region_codec.h"
 
 namespace ort {
 
@@ -32,9 +35,21 @@ class RegionSpill {
   virtual void erase(RegionId id) = 0;
 };
 
+// Where the bound's time goes, summed over the run (milliseconds, steady clock): what the
+// daemon reports to say which part of eviction and restore costs a scan its latency.
+struct ResidencyCosts {
+  double list_ms = 0;     // listing and ordering the candidate regions (a walk above the region depth)
+  double encode_ms = 0;   // a region's subtree into bytes
+  double put_ms = 0;      // the spill's put (the store's file write)
+  double strip_ms = 0;    // freeing the spilled subtree's nodes (or detaching them, with set_free_later)
+  double get_ms = 0;      // the spill's get on restore (the store's file read)
+  double rebuild_ms = 0;  // decoding and rebuilding a restored subtree
+};
+
 struct ResidencyStats {
   uint64_t evictions = 0, restores = 0;
   uint64_t evicted_regions = 0, evicted_bytes = 0;  // now
+  ResidencyCosts costs;
 };
 
 // What one enforce() did: the regions spilled and the tree memory they freed, counted as
@@ -58,17 +73,24 @@ class RegionResidency {
   // memoryUsage()) is within the bound. Returns the regions spilled.
   size_t enforce(octomap::OcTree& tree);
   // The same from a known memory figure `bytes_now` down to `target` (a caller that keeps its
-  // own count: memoryUsage() walks the whole tree). A put() that throws leaves that region in
-  // the tree and ends the call with the exception (nothing was lost).
-  EnforceResult enforce(octomap::OcTree& tree, uint64_t bytes_now, uint64_t target);
+  // own count: memoryUsage() walks the whole tree), spilling at most `max_groups` sibling
+  // groups (a caller that spreads eviction over several calls). A put() that throws leaves
+  // that region in the tree and ends the call with the exception (nothing was lost).
+  EnforceResult enforce(octomap::OcTree& tree, uint64_t bytes_now, uint64_t target, size_t max_groups = SIZE_MAX);
   // Brings one spilled region back without counting it as touched (a sweep visiting every
   // region must not make the whole map "recent"). No-op when it is not spilled.
   void bring_back(octomap::OcTree& tree, RegionId id) { restore(tree, id); }
+  // Region `id` is in the spill already (`bytes` of it) and a stand-in in the tree: a map
+  // loaded under the bound (octree/map_file_split.h). Not counted as an eviction.
+  void adopt_spilled(RegionId id, uint64_t bytes);
   // The spilled regions whose cubes meet the key box [lo, hi] (inclusive).
   std::vector<RegionId> spilled_in(const octomap::OcTreeKey& lo, const octomap::OcTreeKey& hi) const;
   std::vector<RegionId> spilled_ids() const;
   // The tree no longer holds any spilled region (a reset): drops them from the spill.
   void forget_all();
+  // Where spilled regions' nodes go: with a hook, they are detached from the tree and handed
+  // to it to be freed elsewhere (octree/region_codec.h detach_region); without, freed here.
+  void set_free_later(std::function<void(DetachedSubtree)> free_later) { free_later_ = std::move(free_later); }
   // Brings every spilled region back (a whole-map save or snapshot without the bound).
   void restore_all(octomap::OcTree& tree);
   bool spilled(RegionId id) const { return spilled_.count(id) != 0; }
@@ -81,6 +103,7 @@ class RegionResidency {
   RegionGrid grid_;
   RegionSpill& spill_;
   uint64_t max_bytes_;
+  std::function<void(DetachedSubtree)> free_later_;
   uint64_t tick_ = 0;
   std::unordered_map<RegionId, uint64_t> last_touch_;
   std::unordered_map<RegionId, uint64_t> spilled_;  // id -> bytes spilled

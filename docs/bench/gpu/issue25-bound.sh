@@ -1,10 +1,11 @@
 #!/bin/bash
 # Issue 25's memory bound on the GPU machine, one device call of at most 8 minutes: 4 robots x
 # 10 Hz going round the skt-corridor preset (RGB-D corridors, 89k points a scan: a working set
-# far smaller than the map) against octomap-rt-server on the vulkan back end, 150 s without and
-# 150 s with --max-map-memory 8MiB (no decay: the map grows); the server's RSS, tree memory,
-# evicted bytes, end-to-end and octree p99 at every status (0.5 s). The server's log says how
-# large the ray space grew (sized from the scans).
+# far smaller than the map) against octomap-rt-server on the vulkan back end, alternating rounds
+# of 60 s without and with --max-map-memory 8MiB (off, on, off, on; no decay: the map grows); the
+# server's RSS, tree memory, evicted bytes, end-to-end and octree p99 at every status (0.5 s),
+# and in server-on-rK.log the bound's cost breakdown every 10 s ("memory bound costs"). The
+# server's log says how large the ray space grew (sized from the scans).
 #
 # Here, first (from the repository root, after building the three targets):
 #   cmake --build build --target octomap-rt-server octomap-rt-loadtest octomap-rt-scenegen
@@ -15,22 +16,27 @@
 # The device call: carry [".device-bundle"], command
 #   bash docs/bench/gpu/issue25-bound.sh        (timeout 480 s)
 # Back here: mkdir -p docs/bench/gpu/issue25-bound && tar -xzf <files_at>/issue25b.tar.gz -C docs/bench/gpu/issue25-bound/
-#   and docs/bench/dev/issue25-bound/plot.sh docs/bench/gpu/issue25-bound docs/bench/gpu/issue25-bound/bound.png \
-#     "skt-corridor, 4 robots x 10 Hz, H200, bound 8MiB"
+#   docs/bench/dev/issue25-bound/summary.py docs/bench/gpu/issue25-bound
+#   docs/bench/dev/issue25-bound/plot.sh docs/bench/gpu/issue25-bound docs/bench/gpu/issue25-bound/bound.png \
+#     "skt-corridor, 4 robots x 10 Hz, H200, bound 8MiB (round 1)" -r1
 . docs/bench/gpu/lib.sh issue25b
 ( while :; do echo "$(date -u +%T) $(cut -d' ' -f1-3 /proc/loadavg) $(nproc)"; sleep 15; done ) > "$O/load.txt" &
 load_pid=$!
-for mode in off on; do
-  left 230 || break
-  log "bound-$mode"
-  extra=(--map "$T/$mode.ot")
-  [ "$mode" = on ] && extra+=(--max-map-memory 8MiB)
-  timeout 215 "$N/bin/octomap-rt-loadtest" --server "$N/bin/octomap-rt-server" --producers 4 --rate 10 \
-    --duration 150 --settle 30 --points 89000 --scene skt-corridor \
-    --series "$O/series-$mode.csv" --log "$O/server-$mode.log" -- -r 0.1 --backend vulkan "${extra[@]}" \
-    > "$O/report-$mode.txt" 2>&1
-  echo "rc=$?" >> "$O/report-$mode.txt"
-  du -sb "$T/$mode.ot" "$T/$mode.ot.regions" >> "$O/report-$mode.txt" 2>&1
+for round in 1 2; do
+  for mode in off on; do
+    left 350 || break 2
+    log "bound-$mode-r$round"
+    rm -rf "$T/$mode.ot" "$T/$mode.ot".*
+    extra=(--map "$T/$mode.ot")
+    [ "$mode" = on ] && extra+=(--max-map-memory 8MiB)
+    r="$mode-r$round"
+    timeout 100 "$N/bin/octomap-rt-loadtest" --server "$N/bin/octomap-rt-server" --producers 4 --rate 10 \
+      --duration 60 --settle 20 --points 89000 --scene skt-corridor \
+      --series "$O/series-$r.csv" --log "$O/server-$r.log" -- -r 0.1 --backend vulkan "${extra[@]}" \
+      > "$O/report-$r.txt" 2>&1
+    echo "rc=$?" >> "$O/report-$r.txt"
+    du -sb "$T/$mode.ot" "$T/$mode.ot.regions" >> "$O/report-$r.txt" 2>&1
+  done
 done
 kill "$load_pid"
 exit 0

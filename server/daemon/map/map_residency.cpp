@@ -1,6 +1,7 @@
 #include "daemon/map/map_residency.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <stdexcept>
 
 #include "daemon/map/map_identity.h"
@@ -15,8 +16,11 @@ MapResidency::MapResidency(MapState& map, const RegionGrid& grid, RegionSpill& s
       spill_(spill),
       max_bytes_(max_bytes),
       log_(std::move(log)),
+      // What waits to be freed: at most about a quarter of the bound (OctoMap's bytes a node).
+      reaper_(std::max<uint64_t>(uint64_t(1) << 16, max_bytes / 4 / sizeof(octomap::OcTreeNode))),
       residency_(grid, spill, max_bytes) {
   stats_.max_bytes = max_bytes;
+  residency_.set_free_later([this](DetachedSubtree d) { reaper_.push(d); });
 }
 
 // The one place eviction and restore are counted as a change of the map (its state id,
@@ -37,10 +41,50 @@ void MapResidency::publish_stats(const octomap::OcTree& tree) {
   stats_.evicted_bytes = r.evicted_bytes;
   stats_.evictions = r.evictions;
   stats_.restores = r.restores;
+  stats_.costs = r.costs;
+}
+
+void MapResidency::note_costs(double touch_ms, double enforce_ms, double walk_ms) {
+  std::string line;
+  {
+    std::lock_guard lock(stats_mutex_);
+    if (enforce_ms > 0) {
+      stats_.enforce_passes++;
+      stats_.enforce_ms += enforce_ms;
+      stats_.walk_ms += walk_ms;
+      stats_.max_enforce_ms = std::max(stats_.max_enforce_ms, enforce_ms);
+    }
+    stats_.touch_ms += touch_ms;
+    stats_.max_touch_ms = std::max(stats_.max_touch_ms, touch_ms);
+    if (seconds_since(reported_at_) < kCostReportS) return;
+    if (stats_.evictions != reported_.evictions || stats_.restores != reported_.restores)
+      line = residency_cost_line(reported_, stats_);
+    reported_ = stats_;
+    reported_.max_enforce_ms = reported_.max_touch_ms = 0;
+    stats_.max_enforce_ms = stats_.max_touch_ms = 0;  // maxima per report
+    reported_at_ = SteadyClock::now();
+  }
+  if (!line.empty()) log_.info(line);
+}
+
+std::string residency_cost_line(const MapResidencyStats& a, const MapResidencyStats& b) {
+  const ResidencyCosts &x = a.costs, &y = b.costs;
+  char line[640];
+  std::snprintf(line, sizeof line,
+                "memory bound costs: %llu passes evicted %llu regions in %.1f ms (most %.1f ms a pass; walks %.1f, "
+                "list %.1f, encode %.1f, store write %.1f, strip %.1f); %llu restores in %.1f ms (most %.1f ms a "
+                "scan; store read %.1f, rebuild %.1f)",
+                (unsigned long long)(b.enforce_passes - a.enforce_passes),
+                (unsigned long long)(b.evictions - a.evictions), b.enforce_ms - a.enforce_ms, b.max_enforce_ms,
+                b.walk_ms - a.walk_ms, y.list_ms - x.list_ms, y.encode_ms - x.encode_ms, y.put_ms - x.put_ms,
+                y.strip_ms - x.strip_ms, (unsigned long long)(b.restores - a.restores), b.touch_ms - a.touch_ms,
+                b.max_touch_ms, y.get_ms - x.get_ms, y.rebuild_ms - x.rebuild_ms);
+  return line;
 }
 
 bool MapResidency::touch_scan(octomap::OcTree& tree, std::span<const VoxelUpdate> voxels, std::string& error) {
   std::lock_guard lock(mutex_);
+  const auto t0 = SteadyClock::now();
   const uint64_t before = residency_.stats().restores;
   try {
     residency_.touch_voxels(tree, voxels);
@@ -55,6 +99,7 @@ bool MapResidency::touch_scan(octomap::OcTree& tree, std::span<const VoxelUpdate
   }
   if (residency_.stats().restores != before) count_residency_change();
   publish_stats(tree);
+  note_costs(ms_since(t0), 0, 0);
   return true;
 }
 
@@ -91,16 +136,26 @@ bool MapResidency::any_spilled_in(std::span<const query::KeyBox> boxes) const {
 
 void MapResidency::enforce(octomap::OcTree& tree) {
   std::lock_guard lock(mutex_);
-  if (estimate(tree) <= max_bytes_) return publish_stats(tree);
-  // Over by the estimate: count exactly, then spill down to the low-water mark.
-  const uint64_t exact = tree.memoryUsage();
-  if (tree.size() > 0) bytes_per_node_ = double(exact - sizeof(octomap::OcTree)) / double(tree.size());
-  if (exact > max_bytes_) {
-    const auto target = static_cast<uint64_t>(kLowWater * static_cast<double>(max_bytes_));
+  const uint64_t estimated = estimate(tree);
+  const auto soft = static_cast<uint64_t>(kSoftStart * static_cast<double>(max_bytes_));
+  if (estimated <= soft) return publish_stats(tree);
+  const auto target = static_cast<uint64_t>(kLowWater * static_cast<double>(max_bytes_));
+  const auto t0 = SteadyClock::now();
+  double walk_ms = 0;
+  uint64_t bytes = estimated;
+  size_t groups = 1;  // between the soft start and the bound: one sibling group a change
+  if (estimated > max_bytes_ || bytes_per_node_ <= 0) {
+    // Over by the estimate: count exactly, and go down to the low-water mark at once.
+    bytes = tree.memoryUsage();
+    walk_ms = ms_since(t0);
+    if (tree.size() > 0) bytes_per_node_ = double(bytes - sizeof(octomap::OcTree)) / double(tree.size());
+    groups = bytes > max_bytes_ ? SIZE_MAX : 1;
+  }
+  if (bytes > soft) {
     const uint64_t before = residency_.stats().evictions;
     EnforceResult r;
     try {
-      r = residency_.enforce(tree, exact, target);
+      r = residency_.enforce(tree, bytes, groups == 1 ? soft : target, groups);
     } catch (const std::exception& e) {  // the store refused a put: that region stays here
       std::lock_guard s(stats_mutex_);
       if (stats_.evict_failures++ == 0 || stats_.evict_failures % 1000 == 0)
@@ -109,28 +164,32 @@ void MapResidency::enforce(octomap::OcTree& tree) {
       stats_.last_error = std::string("evict: ") + e.what();
     }
     if (r.listed) resident_regions_ = r.listed - r.regions;
-    if (residency_.stats().evictions != before) {
-      count_residency_change();
-      const uint64_t after = tree.memoryUsage();
-      if (tree.size() > 0) bytes_per_node_ = double(after - sizeof(octomap::OcTree)) / double(tree.size());
-    }
+    if (residency_.stats().evictions != before) count_residency_change();
   }
   publish_stats(tree);
+  note_costs(0, ms_since(t0), walk_ms);
 }
 
-SweepSpill MapResidency::sweep_hooks() {
+SweepSpill MapResidency::sweep_hooks(const RegionGrid& sweep) {
   SweepSpill s;
-  s.bring_back = [this](octomap::OcTree& tree, RegionId id) {
+  s.bring_back = [this, sweep](octomap::OcTree& tree, RegionId id) {
     std::lock_guard lock(mutex_);
-    if (!residency_.spilled(id)) return;
-    residency_.bring_back(tree, id);  // throws when the store refuses: the sweep stops there
+    const std::vector<RegionId> inside = residency_.spilled_in(region_min_key(sweep, id), region_max_key(sweep, id));
+    if (inside.empty()) return;
+    for (RegionId r : inside) residency_.bring_back(tree, r);  // throws when the store refuses: the sweep stops
     count_residency_change();
   };
-  s.spilled = [this](RegionId id) {
+  s.spilled = [this, sweep](RegionId id) {
     std::lock_guard lock(mutex_);
-    return residency_.spilled(id);
+    return !residency_.spilled_in(region_min_key(sweep, id), region_max_key(sweep, id)).empty();
   };
   return s;
+}
+
+void MapResidency::adopt_loaded(RegionId id, std::span<const uint8_t> bytes) {
+  std::lock_guard lock(mutex_);
+  spill_.put(id, bytes);
+  residency_.adopt_spilled(id, bytes.size());
 }
 
 void MapResidency::forget_all() {
@@ -144,10 +203,15 @@ void MapResidency::forget_all() {
   publish_stats(*map_.tree);
 }
 
-void MapResidency::fill_copy(octomap::OcTree& copy) const {
+MapResidency::SpilledRegions MapResidency::spilled_regions() const {
   std::lock_guard lock(mutex_);
-  const RegionGrid& grid = residency_.grid();
-  for (RegionId id : residency_.spilled_ids()) restore_region(copy, grid, id, spill_.get(id));
+  SpilledRegions out;
+  for (RegionId id : residency_.spilled_ids()) out.emplace_back(id, spill_.get(id));
+  return out;
+}
+
+void MapResidency::fill_copy(octomap::OcTree& copy, const RegionGrid& grid, const SpilledRegions& regions) {
+  for (const auto& [id, bytes] : regions) restore_region(copy, grid, id, bytes);
 }
 
 MapResidencyStats MapResidency::stats() const {

@@ -13,20 +13,24 @@
 //
 // Memory is counted as OctoMap's memoryUsage() counts it: the tree is walked only when the
 // running estimate (nodes times the bytes a node took at the last walk) passes the bound;
-// eviction then goes down to kLowWater of the bound so that it runs every few scans, not
-// every scan.
+// eviction then goes down to kLowWater of the bound. Between kSoftStart and the bound each
+// change spills one sibling group by the estimate alone (no walk), so the map rarely gets
+// there: the cost is spread over the scans (docs/BENCHMARKS.md "The memory bound").
 #pragma once
 
 #include <cstdint>
 #include <mutex>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <octomap/OcTree.h>
 
+#include "core/clock.h"
 #include "core/log.h"
 #include "core/voxel_update.h"
+#include "daemon/map/subtree_reaper.h"
 #include "octree/region_residency.h"
 #include "octree/region_sweep.h"
 #include "query/key_box.h"
@@ -43,12 +47,27 @@ struct MapResidencyStats {
   uint64_t evictions = 0, restores = 0;             // over the run
   uint64_t evict_failures = 0, restore_failures = 0;
   std::string last_error;  // the store's last refusal ("" if none)
+  // Where the time goes, over the run (ms): the passes that evict, the exact memory walks
+  // they start with, the scans' restores, and the octree layer's parts of both.
+  uint64_t enforce_passes = 0;
+  double enforce_ms = 0, walk_ms = 0, touch_ms = 0;
+  double max_enforce_ms = 0, max_touch_ms = 0;
+  ResidencyCosts costs;
 };
+
+// One line saying where the bound's time went between `before` and `now` (the daemon logs it
+// every kCostReportS seconds while the bound works; the benchmarks read it).
+std::string residency_cost_line(const MapResidencyStats& before, const MapResidencyStats& now);
 
 class MapResidency {
  public:
-  // Eviction back to this fraction of the bound.
+  // Past kSoftStart of the bound (by the running estimate), each change spills one sibling
+  // group (the least recently touched), so eviction is spread over the scans instead of one
+  // long pass; past the bound itself (counted exactly) it spills down to kLowWater at once.
+  static constexpr double kSoftStart = 0.95;
   static constexpr double kLowWater = 0.9;
+  // How often the cost breakdown is logged while regions move.
+  static constexpr double kCostReportS = 10;
 
   MapResidency(MapState& map, const RegionGrid& grid, RegionSpill& spill, uint64_t max_bytes, Log log);
 
@@ -64,13 +83,23 @@ class MapResidency {
   // Under the exclusive map lock, after a change: spills past the bound. Never throws: a store
   // that refuses keeps the regions in memory (counted, logged).
   void enforce(octomap::OcTree& tree);
-  // A sweep's hooks (octree/region_sweep.h): call under the exclusive map lock.
-  SweepSpill sweep_hooks();
+  // A sweep's hooks (octree/region_sweep.h) for a sweep over `sweep` regions, as coarse as the
+  // bound's or coarser: a sweep region comes back whole (every spilled region inside it) and
+  // counts as spilled while any region inside it is. Call under the exclusive map lock.
+  SweepSpill sweep_hooks(const RegionGrid& sweep);
+  // While the map is loaded, before anything reads it: region `id` of the map file goes to the
+  // store as `bytes` and is a stand-in in the tree being built (daemon/persistence/map_store.h
+  // MapLoadBound). Throws when the store refuses (the server then does not start).
+  void adopt_loaded(RegionId id, std::span<const uint8_t> bytes);
   // Under the exclusive map lock: the map was emptied (a reset).
   void forget_all();
-  // Under the map lock (shared is enough): puts every spilled region into `copy`, a copy of
-  // the map's tree, which then is the whole map. Throws when the store cannot give one back.
-  void fill_copy(octomap::OcTree& copy) const;
+  // Under the map lock (shared is enough): the bytes of every spilled region, read from the
+  // store, which put into a copy of the map's tree taken under the same lock (fill_copy, after
+  // the lock is let go: the rebuild costs no one a wait) make it the whole map. Throws when
+  // the store cannot give one back.
+  using SpilledRegions = std::vector<std::pair<RegionId, std::vector<uint8_t>>>;
+  SpilledRegions spilled_regions() const;
+  static void fill_copy(octomap::OcTree& copy, const RegionGrid& grid, const SpilledRegions& regions);
 
   MapResidencyStats stats() const;
   const RegionGrid& grid() const { return grid_; }
@@ -85,15 +114,20 @@ class MapResidency {
   uint64_t max_bytes_;
   Log log_;
   void publish_stats(const octomap::OcTree& tree);
+  // Adds a touch's or an enforce pass's time to the stats; logs the breakdown now and then.
+  void note_costs(double touch_ms, double enforce_ms, double walk_ms);
 
   // residency_ and the spill (shared-lock readers fill copies at the same time).
   mutable std::mutex mutex_;
+  SubtreeReaper reaper_;  // frees evicted regions' nodes off the map lock (before residency_: outlives its hook)
   RegionResidency residency_;
   double bytes_per_node_ = 0;  // at the last walk
   uint64_t resident_regions_ = 0;
   // What stats() reports, behind its own lock: the status never waits for a spill.
   mutable std::mutex stats_mutex_;
   MapResidencyStats stats_;
+  MapResidencyStats reported_;  // at the last cost line
+  SteadyClock::time_point reported_at_ = SteadyClock::now();
 };
 
 }  // namespace ort::daemon

@@ -71,9 +71,10 @@ void MapUpkeep::run_sweep(std::function<std::unique_ptr<Sweep>(const octomap::Oc
   // With a memory bound, spilled regions come back as the map of record's sweep reaches them
   // and the bound holds after every slice (daemon/map/map_residency.h).
   const octomap::OcTree* record = map_.tree.get();
-  auto make_here = [residency = map_.residency, record, make = std::move(make)](const octomap::OcTree& t) {
+  auto make_here = [residency = map_.residency, record, grid = grid_,
+                    make = std::move(make)](const octomap::OcTree& t) {
     std::unique_ptr<Sweep> s = make(t);
-    if (residency && &t == record) s->regions().set_spill(residency->sweep_hooks());
+    if (residency && &t == record) s->regions().set_spill(residency->sweep_hooks(grid));
     return s;
   };
   const auto [slices, slice] = SweepSlices<Sweep>::steps(std::move(make_here), cfg_.slice_nodes);

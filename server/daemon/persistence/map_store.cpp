@@ -66,11 +66,16 @@ void sync_directory(const std::string& dir) {
   if (d.fd < 0 || ::fsync(d.fd) != 0) throw sys_error(Kind::kSync, "cannot fsync directory", dir);
 }
 
+// Read at its size (no doubling growth: a large map's bytes are held once).
 std::string read_whole(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw sys_error(Kind::kOpen, "cannot open map", path);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw sys_error(Kind::kRead, "cannot read map", path);
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw sys_error(Kind::kRead, "cannot read map", path);
+  std::string bytes(static_cast<size_t>(size), '\0');
+  in.seekg(0);
+  in.read(bytes.data(), size);
+  if (in.bad() || in.gcount() != size) throw sys_error(Kind::kRead, "cannot read map", path);
   return bytes;
 }
 
@@ -118,8 +123,8 @@ std::unique_ptr<octomap::OcTree> load_map(const std::string& path, double resolu
   return load_map_file(path, resolution).tree;
 }
 
-LoadedMapFile load_map_file(const std::string& path, double resolution) {
-  const std::string bytes = read_whole(path);
+LoadedMapFile load_map_file(const std::string& path, double resolution, const MapLoadBound* bound) {
+  std::string bytes = read_whole(path);
   const OctreeFileCheck check = check_octree_file(bytes, /*inner_is_max=*/true);
   if (!check.ok) {
     const bool other_tree = !check.tree_type.empty() && check.tree_type != "OcTree";
@@ -130,14 +135,33 @@ LoadedMapFile load_map_file(const std::string& path, double resolution) {
     throw MapStoreError(Kind::kWrongType, "map '" + path +
                                               "' is a .bt file (no log-odds); the map of record is kept as .ot: "
                                               "start from it with --prior and save to another --map");
-  std::unique_ptr<octomap::OcTree> tree;
-  try {
-    tree = read_octree_file_bytes(bytes, "map '" + path + "'", /*inner_is_max=*/true);
-  } catch (const std::runtime_error& e) {
-    throw MapStoreError(Kind::kCorrupt, e.what());
+  LoadedMapFile loaded;
+  loaded.bytes = bytes.size();
+  loaded.hash = map_file_hash(bytes);
+  MapFileSplit split;
+  if (bound) {
+    try {
+      split = split_map_file(bytes, check.data_offset, bound->grid, bound->keep_bytes, bound->spill);
+    } catch (const MapStoreError&) {
+      throw;
+    } catch (const std::runtime_error& e) {  // the spill refused (the region store says why) or the data
+      throw MapStoreError(Kind::kRead, "map '" + path + "' could not be loaded within the memory bound: " + e.what());
+    }
+    loaded.spilled_regions = split.spilled_regions;
+    loaded.spilled_nodes = split.spilled_nodes;
+    std::string().swap(bytes);  // the tree is built from the kept part alone
   }
-  require_resolution(*tree, resolution, path, "--map");
-  return LoadedMapFile{std::move(tree), bytes.size(), map_file_hash(bytes)};
+  try {
+    loaded.tree = read_octree_file_bytes(bound ? std::string_view(split.kept) : std::string_view(bytes),
+                                         "map '" + path + "'", /*inner_is_max=*/true);
+  } catch (const std::runtime_error& e) {
+    // The file was checked whole above: a kept part that does not read is this server's
+    // fault, not the file's (never moved aside as corrupt; regions already went to the spill).
+    throw MapStoreError(bound ? Kind::kRead : Kind::kCorrupt,
+                        bound ? std::string("the part within the memory bound did not read: ") + e.what() : e.what());
+  }
+  require_resolution(*loaded.tree, resolution, path, "--map");
+  return loaded;
 }
 
 std::unique_ptr<octomap::OcTree> load_prior_map(const std::string& path, double resolution, const SensorModel& sensor) {

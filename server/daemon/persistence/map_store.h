@@ -17,6 +17,7 @@
 #include <octomap/OcTree.h>
 
 #include "core/sensor_model.h"
+#include "octree/map_file_split.h"
 
 namespace ort::daemon {
 
@@ -55,11 +56,20 @@ std::string serialize_map(const octomap::OcTree& tree);
 std::unique_ptr<octomap::OcTree> load_map(const std::string& path, double resolution);
 
 // load_map with what the map's identity needs of the file: its size and FNV-1a 64 hash.
+// With `bound` (a memory bound, issue 25), the checked file is split before OctoMap reads it
+// (octree/map_file_split.h): the tree holds the regions that fit `keep_bytes`, the others go
+// to `spill` as region bytes and stay stand-ins, so the whole map is never built in memory.
+struct MapLoadBound {
+  RegionGrid grid;
+  uint64_t keep_bytes = 0;
+  RegionSink spill;
+};
 struct LoadedMapFile {
   std::unique_ptr<octomap::OcTree> tree;
   uint64_t bytes = 0, hash = 0;
+  uint64_t spilled_regions = 0, spilled_nodes = 0;  // with a bound: what went to the spill
 };
-LoadedMapFile load_map_file(const std::string& path, double resolution);
+LoadedMapFile load_map_file(const std::string& path, double resolution, const MapLoadBound* bound = nullptr);
 
 // A prior map to start a new map from (octomap_server's map file at start): .ot (log-odds
 // kept) or .bt (maximum likelihood: each node at `sensor`'s clamping maximum if occupied,

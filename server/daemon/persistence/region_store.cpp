@@ -146,7 +146,7 @@ void RegionStore::erase(RegionId id) {
     throw RegionStoreError(RegionStoreError::Kind::kIo, why("cannot remove", path));
   used_ -= it->second;
   sizes_.erase(it);
-  sync_dir();
+  if (durable_) sync_dir();  // not durable: the daemon's restores must not wait for the disk
 }
 
 std::vector<RegionId> RegionStore::ids() const {

@@ -9,12 +9,12 @@
 namespace ort::daemon {
 namespace {
 
-// Under map.mutex.
-MapCopy copy_locked(const MapState& map, SteadyClock::time_point t0) {
+// Under map.mutex. With a memory bound, `spilled` gets the bytes of every region the copy has
+// a stand-in for (read under the same lock, so they are the copy's).
+MapCopy copy_locked(const MapState& map, SteadyClock::time_point t0, MapResidency::SpilledRegions& spilled) {
   MapCopy c;
   c.tree = std::make_unique<octomap::OcTree>(*map.tree);
-  // With a memory bound the copy is the whole map: its stand-ins get their regions back.
-  if (map.residency) map.residency->fill_copy(*c.tree);
+  if (map.residency) spilled = map.residency->spilled_regions();
   c.version = map.version;
   c.epoch = map.epoch;
   c.scans = map.scans;
@@ -24,19 +24,37 @@ MapCopy copy_locked(const MapState& map, SteadyClock::time_point t0) {
   return c;
 }
 
+// With a memory bound the copy is the whole map: its stand-ins get their regions back, after
+// the lock is let go (the rebuild is most of a bounded copy's time).
+void fill_spilled(const MapState& map, MapCopy& c, const MapResidency::SpilledRegions& spilled) {
+  if (map.residency && !spilled.empty()) MapResidency::fill_copy(*c.tree, map.residency->grid(), spilled);
+}
+
 }  // namespace
 
 MapCopy copy_map(MapState& map) {
   const auto t0 = SteadyClock::now();
-  std::shared_lock lock(map.mutex);  // a reader: queries may read at the same time
-  return copy_locked(map, t0);
+  MapResidency::SpilledRegions spilled;
+  MapCopy c;
+  {
+    std::shared_lock lock(map.mutex);  // a reader: queries may read at the same time
+    c = copy_locked(map, t0, spilled);
+  }
+  fill_spilled(map, c, spilled);
+  return c;
 }
 
 std::optional<MapCopy> copy_map_if_changed(MapState& map, uint64_t unchanged_since) {
   const auto t0 = SteadyClock::now();
-  std::shared_lock lock(map.mutex);  // a reader: queries may read at the same time
-  if (map.version == unchanged_since) return std::nullopt;
-  return copy_locked(map, t0);
+  MapResidency::SpilledRegions spilled;
+  MapCopy c;
+  {
+    std::shared_lock lock(map.mutex);  // a reader: queries may read at the same time
+    if (map.version == unchanged_since) return std::nullopt;
+    c = copy_locked(map, t0, spilled);
+  }
+  fill_spilled(map, c, spilled);
+  return c;
 }
 
 }  // namespace ort::daemon

@@ -1,20 +1,26 @@
 #!/usr/bin/env python3
-"""The memory bound benchmark's summary: per run (series-off.csv, series-on.csv in OUT_DIR), the
-status windows' end-to-end and octree p99 over the run's second half (median and max), the tree
-memory's and RSS's most over it, the bound, and the evictions and restores at the end.
+"""The memory bound benchmark's summary: per run (series-MODE[-rK].csv in OUT_DIR; MODE off or on,
+K the round when run.sh alternated rounds), the status windows' end-to-end and octree p99 over the
+run's second half (median and max), the tree memory's and RSS's most over it, the bound, and the
+evictions and restores at the end; then the ratio of the bounded runs' p99 to the unbounded ones'
+(medians over the rounds), and where the bound's time went (the server's "memory bound costs"
+lines in server-on[-rK].log, summed over the run).
     summary.py OUT_DIR"""
 import csv
+import re
 import statistics
 import sys
 from pathlib import Path
 
 out = Path(sys.argv[1])
-print("run  e2e p99 ms (median, max)  octree p99 ms (median, max)  tree MiB max  RSS MiB max  bound MiB"
+print("run      e2e p99 ms (median, max)  octree p99 ms (median, max)  tree MiB max  RSS MiB max  bound MiB"
       "  evictions  restores")
-for mode in ("off", "on"):
-    path = out / f"series-{mode}.csv"
-    if not path.exists():
+per_mode = {"off": [], "on": []}
+for path in sorted(out.glob("series-*.csv")):
+    m = re.fullmatch(r"series-(off|on)(-r\d+)?\.csv", path.name)
+    if not m:
         continue
+    mode, mode_run = m.group(1), m.group(1) + (m.group(2) or "")
     rows = list(csv.DictReader(path.open()))
     if not rows:
         continue
@@ -24,6 +30,30 @@ for mode in ("off", "on"):
     octree = [float(r["octree_p99_ms"]) for r in half]
     tree = max(float(r["map_memory_mib"]) for r in half)
     rss = max(float(r["rss_mib"]) for r in half)
-    print(f"{mode:4} {statistics.median(e2e):10.1f} {max(e2e):8.1f} {statistics.median(octree):14.1f} "
+    per_mode[mode].append((statistics.median(e2e), statistics.median(octree)))
+    print(f"{mode_run:8} {statistics.median(e2e):10.1f} {max(e2e):8.1f} {statistics.median(octree):14.1f} "
           f"{max(octree):8.1f} {tree:16.2f} {rss:11.1f} {float(rows[-1]['bound_mib']):10.1f} "
           f"{rows[-1]['region_evictions']:>10} {rows[-1]['region_restores']:>9}")
+if per_mode["off"] and per_mode["on"]:
+    off_e2e = statistics.median(r[0] for r in per_mode["off"])
+    on_e2e = statistics.median(r[0] for r in per_mode["on"])
+    off_oct = statistics.median(r[1] for r in per_mode["off"])
+    on_oct = statistics.median(r[1] for r in per_mode["on"])
+    print(f"on / off (medians over {len(per_mode['on'])} and {len(per_mode['off'])} runs): e2e p99 "
+          f"{on_e2e:.1f} / {off_e2e:.1f} = {on_e2e / off_e2e:.2f}x, octree p99 {on_oct:.1f} / {off_oct:.1f} = "
+          f"{on_oct / off_oct:.2f}x")
+cost = re.compile(r"memory bound costs: (\d+) passes evicted (\d+) regions in ([0-9.]+) ms \(most ([0-9.]+) ms a "
+                  r"pass; walks ([0-9.]+), list ([0-9.]+), encode ([0-9.]+), store write ([0-9.]+), strip "
+                  r"([0-9.]+)\); (\d+) restores in ([0-9.]+) ms \(most ([0-9.]+) ms a scan; store read ([0-9.]+), "
+                  r"rebuild ([0-9.]+)\)")
+names = ["passes", "evicted", "evict ms", "most a pass", "walks", "list", "encode", "store write", "strip",
+         "restores", "restore ms", "most a scan", "store read", "rebuild"]
+for path in sorted(out.glob("server-on*.log")):
+    total = [0.0] * len(names)
+    for line in path.open(errors="replace"):
+        m = cost.search(line)
+        if m:
+            for i, v in enumerate(m.groups()):
+                total[i] = max(total[i], float(v)) if names[i].startswith("most") else total[i] + float(v)
+    if any(total):
+        print(f"{path.name}: " + ", ".join(f"{n} {v:.0f}" for n, v in zip(names, total)))
