@@ -17,19 +17,13 @@
 #include "query_client/query_json.h"
 
 namespace ort::cli {
-namespace {
 
-using namespace ort::client;
-
-// The flags every subcommand here shares, and --shards (distance queries are not routed).
-void add_query_flags(CLI::App* cmd, CommonArgs& a) {
-  add_common(cmd, a);
+void add_shards_flag(CLI::App* cmd, CommonArgs& a) {
   cmd->add_flag("--shards", a.shards,
                 "the namespace is a shard set (octomap-rt-server --shard): route by region, say which shard did "
                 "not answer (exit status 3); no --wait-robot/--min-snapshot");
 }
 
-// The namespace's shard set and a client routing to it (query --shards).
 std::unique_ptr<ShardQueries> connect_shards(const CommonArgs& a) {
   if (!a.wait_robot.empty() || a.min_snapshot != 0)
     throw CLI::ValidationError("--shards", "does not wait for a robot or a map state (each shard has its own)");
@@ -40,11 +34,14 @@ std::unique_ptr<ShardQueries> connect_shards(const CommonArgs& a) {
                                         ns, *roster.set(), roster.resolution());
 }
 
-// A routed answer: its reply, and exit status 3 when a shard's part is missing.
-template <class R>
-R routed(const Routed<R>& r, bool& partial) {
-  partial = say_partial(r.shards);
-  return r.reply;
+namespace {
+
+using namespace ort::client;
+
+// The flags every subcommand here shares, and --shards.
+void add_query_flags(CLI::App* cmd, CommonArgs& a) {
+  add_common(cmd, a);
+  add_shards_flag(cmd, a);
 }
 
 void register_points(CLI::App& parent) {

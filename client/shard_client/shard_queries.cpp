@@ -1,21 +1,31 @@
 #include "shard_client/shard_queries.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <future>
 #include <limits>
 #include <optional>
+#include <span>
 #include <stdexcept>
 
 #include <octomap/OcTree.h>
 
 #include "octomap_rt/box_query_t.hpp"
+#include "protocol/limits.h"
 
 namespace ort::client {
 namespace {
 
 using Occ = octomap_rt::occupancy_reply_t;
+
+// The status and map state of a reply (a distance box's are in its first chunk).
+template <class Reply>
+const Reply& head(const Reply& r) {
+  return r;
+}
+const octomap_rt::distance_box_chunk_t& head(const DistanceBox& b) { return b.header; }
 
 // Runs ask(i) for every shard i in `which` side by side; each result or the reason it failed.
 template <class Reply>
@@ -28,8 +38,8 @@ std::vector<std::optional<Reply>> ask_each(const std::vector<uint32_t>& which, s
   for (auto& [i, f] : pending) {
     try {
       Reply r = f.get();
-      if (r.status != Occ::REPLY_OK) throw std::runtime_error("refused: " + r.error);
-      answer.snapshot_ids[i] = r.snapshot_id;
+      if (head(r).status != Occ::REPLY_OK) throw std::runtime_error("refused: " + head(r).error);
+      answer.snapshot_ids[i] = head(r).snapshot_id;
       out[i] = std::move(r);
     } catch (const std::exception& e) {
       answer.missing.push_back(i);
@@ -214,6 +224,113 @@ Routed<octomap_rt::ray_reply_t> ShardQueries::rays(const std::vector<float>& ori
   }
   for (const auto& g : got)
     if (g && g->cut != Occ::CUT_NONE && (r.cut_at < 0 || g->cut_at < r.cut_at)) r.cut = g->cut, r.cut_at = g->cut_at;
+  return out;
+}
+
+namespace {
+
+// The shards with a region within `pad` voxels of the points xyz (3 floats each); every shard
+// when a point is outside the key range (each then refuses it alike).
+std::vector<uint32_t> within_reach(const protocol::ShardSet& set, std::span<const float> xyz, double res, int64_t pad) {
+  std::array<int64_t, 3> lo{}, hi{};
+  for (size_t p = 0; p + 2 < xyz.size(); p += 3)
+    for (int a = 0; a < 3; ++a) {
+      int64_t k = 0;
+      if (!voxel_key(xyz[p + a], res, k)) return every_shard(set.count);
+      lo[a] = p ? std::min(lo[a], k - pad) : k - pad, hi[a] = p ? std::max(hi[a], k + pad) : k + pad;
+    }
+  const std::vector<uint32_t> out = shards_meeting(set, lo, hi);
+  return out.empty() ? std::vector<uint32_t>{0} : out;
+}
+
+template <class R>
+std::vector<const R*> views_of(const std::vector<std::optional<R>>& got) {
+  std::vector<const R*> v;
+  for (const auto& g : got) v.push_back(g ? &*g : nullptr);
+  return v;
+}
+
+// Adds one batch's shard answer to the whole query's.
+void add_batch(ShardAnswer& all, const ShardAnswer& batch, bool first) {
+  if (first) {
+    all = batch;
+    return;
+  }
+  for (size_t k = 0; k < batch.missing.size(); ++k)
+    if (std::find(all.missing.begin(), all.missing.end(), batch.missing[k]) == all.missing.end())
+      all.missing.push_back(batch.missing[k]), all.errors.push_back(batch.errors[k]);
+  for (size_t i = 0; i < batch.snapshot_ids.size() && i < all.snapshot_ids.size(); ++i)
+    all.snapshot_ids[i] = std::max(all.snapshot_ids[i], batch.snapshot_ids[i]);
+}
+
+}  // namespace
+
+Routed<octomap_rt::distance_points_reply_t> ShardQueries::distance_points(const std::vector<float>& xyz,
+                                                                          const DistanceRequest& d) {
+  using R = octomap_rt::distance_points_reply_t;
+  const size_t n = xyz.size() / 3, per = d.gradient ? 7 : 1;
+  const size_t batch = std::max<size_t>(1, size_t(protocol::kMaxQueryPoints) / per);
+  DistanceRequest plain = d;
+  plain.gradient = false, plain.cell_voxels = 1;
+  const int64_t pad = distance_padding_cells(d.max_distance, resolution_, 1) + 1;
+  Routed<R> out;
+  out.reply.max_distance = d.max_distance;
+  for (size_t first = 0; first < n; first += batch) {
+    const size_t count = std::min(batch, n - first);
+    const std::span<const float> part(xyz.data() + 3 * first, 3 * count);
+    const std::vector<float> asked =
+        d.gradient ? with_neighbours(part, resolution_) : std::vector<float>(part.begin(), part.end());
+    ShardAnswer answer;
+    const auto got = ask_each<R>(within_reach(set_, part, resolution_, pad), set_.count, answer,
+                                 [&](uint32_t i) { return clients_[i]->distance_points(asked, plain); });
+    const R merged = merge_distance_points(views_of(got), count, d.gradient);
+    add_batch(out.shards, answer, first == 0);
+    std::vector<float> distance = std::move(out.reply.distance), gradient = std::move(out.reply.gradient);
+    if (first == 0 || merged.snapshot_id > out.reply.snapshot_id || merged.status != Occ::REPLY_OK) {
+      const int8_t status = first == 0 ? merged.status : std::max(out.reply.status, merged.status);
+      const std::string error = merged.status != Occ::REPLY_OK ? merged.error : out.reply.error;
+      out.reply = merged;
+      out.reply.status = status, out.reply.error = error;
+    }
+    distance.insert(distance.end(), merged.distance.begin(), merged.distance.end());
+    gradient.insert(gradient.end(), merged.gradient.begin(), merged.gradient.end());
+    out.reply.distance = std::move(distance), out.reply.gradient = std::move(gradient);
+  }
+  out.reply.num_points = int32_t(out.reply.distance.size());
+  out.reply.num_gradient = int32_t(out.reply.gradient.size());
+  return out;
+}
+
+Routed<DistanceBox> ShardQueries::distance_box(const Box& box, const DistanceRequest& d) {
+  const Box asked = d.gradient ? grown_distance_box(box, resolution_, d.cell_voxels) : box;
+  DistanceRequest plain = d;
+  plain.gradient = false;
+  const int64_t pad = int64_t(distance_padding_cells(d.max_distance, resolution_, d.cell_voxels) + 1) * d.cell_voxels;
+  const std::vector<float> corners = {float(asked.min[0]), float(asked.min[1]), float(asked.min[2]),
+                                      float(asked.max[0]), float(asked.max[1]), float(asked.max[2])};
+  Routed<DistanceBox> out;
+  const auto got = ask_each<DistanceBox>(within_reach(set_, corners, resolution_, pad), set_.count, out.shards,
+                                         [&](uint32_t i) { return clients_[i]->distance_box(asked, plain); });
+  const auto views = views_of(got);
+  if (std::none_of(views.begin(), views.end(), [](const DistanceBox* b) { return b != nullptr; })) {
+    out.reply.header.status = Occ::REPLY_BAD_REQUEST;
+    out.reply.header.error = "no shard answered";
+    return out;
+  }
+  out.reply = merge_distance_boxes(views, d.gradient, resolution_);
+  return out;
+}
+
+Routed<octomap_rt::distance_path_reply_t> ShardQueries::distance_path(const std::vector<float>& vertices,
+                                                                      const DistanceRequest& d) {
+  using R = octomap_rt::distance_path_reply_t;
+  DistanceRequest plain = d;
+  plain.gradient = false, plain.cell_voxels = 1;
+  const int64_t pad = distance_padding_cells(d.max_distance, resolution_, 1) + 1;
+  Routed<R> out;
+  const auto got = ask_each<R>(within_reach(set_, vertices, resolution_, pad), set_.count, out.shards,
+                               [&](uint32_t i) { return clients_[i]->distance_path(vertices, plain); });
+  out.reply = merge_distance_paths(views_of(got));
   return out;
 }
 

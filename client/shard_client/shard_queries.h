@@ -2,7 +2,8 @@
 // regions, so a point goes to the shard owning its region (a coarse depth above the region
 // depth asks every shard and takes the largest value, as OctoMap's inner nodes do), a box is
 // counted on every shard and summed, and a ray is cast on every shard and gets the hit the ray
-// enters first. A shard that does not answer leaves its part unknown, and the answer says so.
+// enters first; a distance is the smallest of the shards' within reach (shard_distance.h). A
+// shard that does not answer leaves its part unknown, and the answer says so.
 #pragma once
 
 #include <chrono>
@@ -13,6 +14,7 @@
 
 #include "protocol/shards/shard_set.h"
 #include "query_client/query_client.h"
+#include "shard_client/shard_distance.h"
 
 namespace ort::client {
 
@@ -44,6 +46,14 @@ class ShardQueries {
   // std::invalid_argument otherwise.
   Routed<octomap_rt::ray_reply_t> rays(const std::vector<float>& origins, const std::vector<float>& directions,
                                        float max_range, bool ignore_unknown);
+
+  // Distances (shard_distance.h): the shards with a region within reach of what is asked; per
+  // cell the smallest distance, gradients from the merged field. Points go in batches of at
+  // most kMaxQueryPoints asked points (7 a point with the gradient). A missing shard's
+  // obstacles are left out: the distances are then upper bounds (partial).
+  Routed<octomap_rt::distance_points_reply_t> distance_points(const std::vector<float>& xyz, const DistanceRequest& d);
+  Routed<DistanceBox> distance_box(const Box& box, const DistanceRequest& d);
+  Routed<octomap_rt::distance_path_reply_t> distance_path(const std::vector<float>& vertices, const DistanceRequest& d);
 
   // The shard owning the voxel of point (x, y, z); set.count for a point outside the key range.
   uint32_t shard_of_point(double x, double y, double z) const;

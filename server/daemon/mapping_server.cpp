@@ -122,8 +122,9 @@ void MappingServer::start() {
       std::make_unique<ScanIntake>(*loop_, cfg_.scan_channels, limits, producers_, queue_, cfg_.lcm_queue_capacity);
   intake_->open();  // services subscribe before the loop starts: 1.3.1's subscribe races with handle
   map_service_->open();
-  queries_ =
-      std::make_unique<QueryService>(cfg_.queries, map_, queue_, *loop_, server_id_, cfg_.engine.resolution, log_);
+  QueryServiceConfig query_cfg = cfg_.queries;
+  query_cfg.distance.shard = cfg_.shard;  // a shard's distances count its own regions' obstacles
+  queries_ = std::make_unique<QueryService>(query_cfg, map_, queue_, *loop_, server_id_, cfg_.engine.resolution, log_);
   queries_->open();
   log_.info(text("distance queries run their EDT on ", queries_->distance_backend()));
   loop_->start();

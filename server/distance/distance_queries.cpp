@@ -75,7 +75,7 @@ PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, 
   r.cells.resize(n);
   const CellBox all = cell_box_around(lo, hi, m, pad);
   if (all.dims.cells() <= std::min(lim.single_grid_cells, lim.max_grid_cells)) {
-    r.grids.push_back(read_occupancy(tree, all, opt.unknown));
+    r.grids.push_back(read_occupancy(tree, all, opt.unknown, opt.ownership));
     for (size_t p = 0; p < n; ++p) r.cells[p] = {0, cell_index(keys[p], all)};
     return r;
   }
@@ -98,7 +98,7 @@ PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, 
   check_cells(cells, lim);
   for (const auto& [box, points] : boxes) {
     for (size_t p : *points) r.cells[p] = {static_cast<int>(r.grids.size()), cell_index(keys[p], box)};
-    r.grids.push_back(read_occupancy(tree, box, opt.unknown));
+    r.grids.push_back(read_occupancy(tree, box, opt.unknown, opt.ownership));
   }
   return r;
 }
@@ -139,7 +139,7 @@ BoxRead read_box(const octomap::OcTree& tree, const double lo[3], const double h
                         std::to_string(lim.max_box_cells) + "): ask for a smaller box or a coarser cell");
   const CellBox padded = cell_box_around(klo, khi, opt.cell_voxels, r.pad);
   check_cells(padded.dims.cells(), lim);
-  r.grid = read_occupancy(tree, padded, opt.unknown);
+  r.grid = read_occupancy(tree, padded, opt.unknown, opt.ownership);
   return r;
 }
 

@@ -18,10 +18,22 @@ namespace ort::distance {
 
 enum class UnknownAs : int8_t { kFree = 0, kOccupied = 1 };
 
+// The regions a map owns when it is one shard of a set (docs/PROTOCOL.md, "Shards"): the
+// unknown space of other shards' regions is theirs to count, so with UnknownAs::kOccupied a
+// shard counts as obstacles only its own unknown space (and what lies outside the key range,
+// which every shard counts alike). The obstacles of the set are then the union of its shards',
+// and a distance of the set is the smallest of its shards' distances. Empty `owns`: every
+// region is this map's.
+struct RegionOwnership {
+  unsigned region_depth = 16;  // regions are the subtrees at this depth (1..16)
+  std::function<bool(uint32_t rx, uint32_t ry, uint32_t rz)> owns;
+};
+
 struct DistanceOptions {
   double max_distance = 2.0;  // [m] > 0; distances are clamped here, obstacles this far counted
   int cell_voxels = 1;        // 1 = the map's resolution; else a coarser cell (<= kMaxCellVoxels)
   UnknownAs unknown = UnknownAs::kFree;
+  RegionOwnership ownership;  // a shard's regions; empty: the whole map
 };
 
 inline constexpr int kMaxCellVoxels = 64;

@@ -49,7 +49,8 @@ CellBox cell_box_around(const std::array<int64_t, 3>& key_lo, const std::array<i
   return b;
 }
 
-OccupancyGrid read_occupancy(const octomap::OcTree& tree, const CellBox& box, UnknownAs unknown) {
+OccupancyGrid read_occupancy(const octomap::OcTree& tree, const CellBox& box, UnknownAs unknown,
+                             const RegionOwnership& own) {
   OccupancyGrid g;
   g.box = box;
   const int m = box.cell_voxels;
@@ -72,6 +73,29 @@ OccupancyGrid read_occupancy(const octomap::OcTree& tree, const CellBox& box, Un
     kmin[a] = static_cast<octomap::key_type>(std::clamp<int64_t>(lo, 0, key_top));
     kmax[a] = static_cast<octomap::key_type>(std::clamp<int64_t>(hi, 0, key_top));
   }
+  // Adds the voxels a known-free cube [c0, c0 + side) shares with each cell it touches.
+  auto add_free = [&](const AxisSpan(&s)[3]) {
+    for (int64_t k = s[2].first; k <= s[2].last; ++k)
+      for (int64_t j = s[1].first; j <= s[1].last; ++j) {
+        const size_t row = static_cast<size_t>((k * ny + j) * nx);
+        const int32_t yz = s[1].shared[j - s[1].first] * s[2].shared[k - s[2].first];
+        for (int64_t i = s[0].first; i <= s[0].last; ++i) free_voxels[row + i] += yz * s[0].shared[i - s[0].first];
+      }
+  };
+  if (inside && unknown_blocks && own.owns) {  // other shards' regions: theirs to count
+    const unsigned shift = depth - std::min(own.region_depth, depth);
+    const int64_t side = int64_t(1) << shift;
+    for (uint32_t rz = kmin[2] >> shift; rz <= uint32_t(kmax[2] >> shift); ++rz)
+      for (uint32_t ry = kmin[1] >> shift; ry <= uint32_t(kmax[1] >> shift); ++ry)
+        for (uint32_t rx = kmin[0] >> shift; rx <= uint32_t(kmax[0] >> shift); ++rx) {
+          if (own.owns(rx, ry, rz)) continue;
+          const uint32_t r[3] = {rx, ry, rz};
+          AxisSpan s[3];
+          for (int a = 0; a < 3; ++a)
+            s[a] = axis_span(int64_t(r[a]) << shift, (int64_t(r[a]) << shift) + side - 1, box.key_lo[a], n[a], m);
+          add_free(s);
+        }
+  }
   if (inside && tree.getRoot()) {
     for (auto it = tree.begin_leafs_bbx(kmin, kmax), end = tree.end_leafs_bbx(); it != end; ++it) {
       const bool occ = tree.isNodeOccupied(*it);
@@ -87,15 +111,14 @@ OccupancyGrid read_occupancy(const octomap::OcTree& tree, const CellBox& box, Un
       }
       // The bbx iterator also yields nodes that end one voxel below the box (query/leaf_walk.h).
       if (!touches) continue;
+      if (!occ) {
+        add_free(s);
+        continue;
+      }
       for (int64_t k = s[2].first; k <= s[2].last; ++k)
         for (int64_t j = s[1].first; j <= s[1].last; ++j) {
           const size_t row = static_cast<size_t>((k * ny + j) * nx);
-          if (occ) {
-            std::fill(g.occupied.begin() + row + s[0].first, g.occupied.begin() + row + s[0].last + 1, uint8_t(1));
-            continue;
-          }
-          const int32_t yz = s[1].shared[j - s[1].first] * s[2].shared[k - s[2].first];
-          for (int64_t i = s[0].first; i <= s[0].last; ++i) free_voxels[row + i] += yz * s[0].shared[i - s[0].first];
+          std::fill(g.occupied.begin() + row + s[0].first, g.occupied.begin() + row + s[0].last + 1, uint8_t(1));
         }
     }
   }

@@ -34,6 +34,9 @@ CellBox cell_box_around(const std::array<int64_t, 3>& key_lo, const std::array<i
 
 // Obstacle cells of `box`: a cell is an obstacle if any finest voxel in it is occupied, or
 // (unknown == kOccupied) not known free. One walk of the stored leaves that touch the box.
-OccupancyGrid read_occupancy(const octomap::OcTree& tree, const CellBox& box, UnknownAs unknown);
+// With `own.owns`, the voxels of regions it does not own count as known free (a shard's share
+// of the obstacles: distance_types.h).
+OccupancyGrid read_occupancy(const octomap::OcTree& tree, const CellBox& box, UnknownAs unknown,
+                             const RegionOwnership& own = {});
 
 }  // namespace ort::distance

@@ -1,7 +1,8 @@
 // A shard set with real processes in a network namespace (docs/PROTOCOL.md, "Shards"): three
 // octomap-rt-server --shard i/3 in one namespace hear a robot's real scans (3DTK) over udpm.
 // The CLI finds them by their statuses and merges their snapshots into one .bt that is OctoMap's
-// map of those scans; points and rays routed by region get OctoMap's answers; with one shard
+// map of those scans; points and rays routed by region get OctoMap's answers, distances (points
+// with the gradient, a box, a path through the CLI) the distances on OctoMap's map; with one shard
 // stopped, the map and the answers say they are partial and which shard is missing.
 #include <gtest/gtest.h>
 
@@ -11,6 +12,8 @@
 
 #include "cli/replay/scan_message.h"
 #include "core/clock.h"
+#include "distance/distance_queries.h"
+#include "distance/squared_edt.h"
 #include "integration_harness.h"
 #include "protocol/shards/shard_set.h"
 #include "query/point_query.h"
@@ -54,7 +57,8 @@ TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
     shards.push_back(std::make_unique<ChildProcess>(
         std::vector<std::string>{server_program(), "--lcm-url", url, "-r", std::to_string(kRes), "--namespace", kNs,
                                  "--shard", std::to_string(i) + "/" + std::to_string(kShards), "--warm-up-points", "0",
-                                 "--backend", "cpu"},
+                                 // On 2 loaded cores 300 rays may pass the 10 ms lock bound and be cut.
+                                 "--backend", "cpu", "--query-lock-ms", "2000"},
         dir + "/shard" + std::to_string(i) + ".log"));
   for (auto& s : shards) ASSERT_TRUE(status.wait_for([&](const auto& m) { return m.pid == s->pid(); }, 60)) << s->log();
 
@@ -117,6 +121,7 @@ TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
   }
   const auto rays = q.rays(origins, directions, 60.0f, true);
   ASSERT_FALSE(rays.shards.partial()) << rays.shards.shortfall();
+  EXPECT_EQ(rays.reply.cut, 0) << rays.reply.error;
   query::RayBatchOptions opt;
   opt.ignore_unknown = true, opt.max_range = 60.0;
   const auto cast = query::cast_rays(*reference, origins, directions, opt);
@@ -127,17 +132,51 @@ TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
                      rays.reply.end_xyz[3 * i + 1] != cast[i].end.y() ||
                      rays.reply.end_xyz[3 * i + 2] != cast[i].end.z();
   }
-  EXPECT_EQ(ray_differing, 0) << "of " << cast.size() << " rays";
-  std::cerr << "origin " << origins[0] << " " << origins[1] << " " << origins[2] << " dir " << directions[0] << " "
-            << directions[1] << " " << directions[2] << "\n";
-  for (int i = 0; i < 3; ++i) {
-    client::QueryClient one(client_url, "dbg", std::chrono::seconds(3), protocol::shard_namespace(kNs, i));
-    const auto r =
-        one.rays({origins[0], origins[1], origins[2]}, {directions[0], directions[1], directions[2]}, 60.0f, true);
-    std::cerr << "shard " << i << " hit " << int(r.hit[0]) << " at " << r.end_xyz[0] << " " << r.end_xyz[1] << " "
-              << r.end_xyz[2] << "\n";
-  }
+  EXPECT_EQ(ray_differing, 0) << "of " << cast.size() << " rays; cut " << int(rays.reply.cut) << " at "
+                              << rays.reply.cut_at << ": " << rays.reply.error;
   EXPECT_GT(hits, static_cast<int>(cast.size() / 2));
+
+  // Distances routed to the shards within reach, the smallest of theirs: the distance on
+  // OctoMap's map (server/distance/ on it is the one daemon's answer: distance_query_test).
+  const std::vector<float> near(xyz.begin(), xyz.begin() + std::min<size_t>(xyz.size(), 3 * 400));
+  for (const bool unknown_occupied : {false, true}) {
+    client::DistanceRequest dr;
+    dr.max_distance = 1.5, dr.gradient = true, dr.unknown_occupied = unknown_occupied;
+    distance::DistanceOptions opt;
+    opt.max_distance = dr.max_distance;
+    opt.unknown = unknown_occupied ? distance::UnknownAs::kOccupied : distance::UnknownAs::kFree;
+    const auto dp = q.distance_points(near, dr);
+    ASSERT_FALSE(dp.shards.partial()) << dp.shards.shortfall();
+    ASSERT_EQ(dp.reply.status, 0) << dp.reply.error;
+    const auto want = distance::answer_points(distance::read_points(*reference, near, opt, {}), distance::cpu_edt(1));
+    ASSERT_EQ(dp.reply.distance.size(), want.size());
+    int differing_points = 0;
+    for (size_t p = 0; p < want.size(); ++p) {
+      differing_points += dp.reply.distance[p] != want[p].distance;
+      for (int a = 0; a < 3; ++a) differing_points += dp.reply.gradient[3 * p + a] != want[p].gradient[a];
+    }
+    EXPECT_EQ(differing_points, 0) << "of " << want.size() << " points, unknown occupied " << unknown_occupied;
+    const client::Box box{{-3.0, -3.0, -0.6}, {3.0, 3.0, 1.0}};
+    const auto db = q.distance_box(box, dr);
+    ASSERT_FALSE(db.shards.partial()) << db.shards.shortfall();
+    ASSERT_EQ(db.reply.header.status, 0) << db.reply.header.error;
+    const auto wb =
+        distance::answer_box(distance::read_box(*reference, box.min, box.max, opt, {}), distance::cpu_edt(1), true);
+    EXPECT_EQ(db.reply.squared, wb.squared);
+    EXPECT_EQ(db.reply.gradient, wb.gradient);
+  }
+  // The CLI's path across the shards: the clearance on OctoMap's map.
+  ChildProcess path({client_program(), "query", "distance", "path", "--shards", "--namespace", kNs, "--lcm-url",
+                     client_url, "--max", "1.5", "--json", "-3,-3,0.2", "3,3,0.4"},
+                    dir + "/path.log");
+  ASSERT_EQ(path.wait(30), 0) << path.log();
+  distance::DistanceOptions path_opt;
+  path_opt.max_distance = 1.5;
+  const std::vector<double> vertices = {-3, -3, 0.2, 3, 3, 0.4};
+  const auto clearance =
+      distance::answer_path(distance::read_path(*reference, vertices, path_opt, {}), distance::cpu_edt(1));
+  EXPECT_NE(path.log().find("\"min_sample\": " + std::to_string(clearance.min_sample) + ","), std::string::npos)
+      << path.log() << " want sample " << clearance.min_sample;
 
   // Shard 2 stops: a merged map and a routed answer say what is missing.
   shards[2]->signal(SIGTERM);

@@ -1,6 +1,7 @@
 // `octomap-rt query distance points|box|path`: Euclidean distance to the nearest obstacle
-// from a running octomap-rt-server (docs/PROTOCOL.md, "Distance queries"): text or one JSON
-// document on stdout; a box also as a PNG of one horizontal slice.
+// from a running octomap-rt-server (docs/PROTOCOL.md, "Distance queries"), or from a shard set
+// with --shards (the smallest of the shards' distances: shard_client/shard_distance.h): text or
+// one JSON document on stdout; a box also as a PNG of one horizontal slice.
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -40,6 +41,7 @@ void register_points(CLI::App& parent) {
   auto pts = std::make_shared<std::vector<std::string>>();
   auto file = std::make_shared<std::string>();
   add_common(cmd, *a);
+  add_shards_flag(cmd, *a);
   add_distance(cmd, *d, true);
   cmd->add_option("points", *pts, "X,Y,Z points [m]");
   cmd->add_option("--file", *file, "points from a file, three numbers a line");
@@ -48,9 +50,12 @@ void register_points(CLI::App& parent) {
     const auto more = parse_points(*pts);
     xyz.insert(xyz.end(), more.begin(), more.end());
     if (xyz.empty()) throw CLI::ValidationError("points", "give X,Y,Z points or --file");
-    const auto r = connect(*a)->distance_points(xyz, request(*d), wait_for(*a));
+    bool partial = false;
+    const auto r = a->shards ? routed(connect_shards(*a)->distance_points(xyz, request(*d)), partial)
+                             : connect(*a)->distance_points(xyz, request(*d), wait_for(*a));
     if (a->json) write_distance_points_json(std::cout, xyz, r);
     if (refused(r)) std::exit(2);
+    if (partial) std::exit(3);
     if (a->json) return;
     for (int i = 0; i < r.num_points; ++i) {
       std::cout << xyz[3 * i] << " " << xyz[3 * i + 1] << " " << xyz[3 * i + 2] << " " << r.distance[i];
@@ -69,6 +74,7 @@ void register_box(CLI::App& parent) {
   auto cell_voxels = std::make_shared<int>(1);
   auto slice_z = std::make_shared<double>(NAN);
   add_common(cmd, *a);
+  add_shards_flag(cmd, *a);
   add_distance(cmd, *d, true);
   cmd->add_option("box", *box, "MINX,MINY,MINZ:MAXX,MAXY,MAXZ [m]")->required();
   cmd->add_option("--cell-voxels", *cell_voxels,
@@ -79,7 +85,9 @@ void register_box(CLI::App& parent) {
   cmd->add_option("--slice-z", *slice_z, "height of the slice [m] (default: the box's middle)");
   cmd->callback([=] {
     const Box b = parse_box(*box);
-    const DistanceBox f = connect(*a)->distance_box(b, request(*d, *cell_voxels), wait_for(*a));
+    bool partial = false;
+    const DistanceBox f = a->shards ? routed(connect_shards(*a)->distance_box(b, request(*d, *cell_voxels)), partial)
+                                    : connect(*a)->distance_box(b, request(*d, *cell_voxels), wait_for(*a));
     if (f.header.status != 0) {
       if (a->json) write_distance_box_json(std::cout, f, "");
       refused(f.header);
@@ -88,6 +96,7 @@ void register_box(CLI::App& parent) {
     if (!png->empty()) write_distance_slice(f, std::isnan(*slice_z) ? (b.min[2] + b.max[2]) / 2 : *slice_z, *png);
     if (a->json) {
       write_distance_box_json(std::cout, f, *png);
+      if (partial) std::exit(3);
       return;
     }
     std::cout << "distance box " << f.nx() << " x " << f.ny() << " x " << f.nz() << " cells of " << f.header.cell_size
@@ -95,6 +104,7 @@ void register_box(CLI::App& parent) {
               << "), max " << f.header.max_distance << " m, map state " << f.header.snapshot_id << ", "
               << f.header.num_chunks << " chunks, " << f.header.total_size << " bytes"
               << (png->empty() ? "" : ", slice written to " + *png) << "\n";
+    if (partial) std::exit(3);
   });
 }
 
@@ -104,17 +114,21 @@ void register_path(CLI::App& parent) {
   auto d = std::make_shared<DistanceArgs>();
   auto pts = std::make_shared<std::vector<std::string>>();
   add_common(cmd, *a);
+  add_shards_flag(cmd, *a);
   add_distance(cmd, *d, false);
   cmd->add_option("vertices", *pts, "X,Y,Z vertices [m], in order")->required();
   cmd->callback([=] {
     const auto v = parse_points(*pts);
-    const auto r = connect(*a)->distance_path(v, request(*d), wait_for(*a));
+    bool partial = false;
+    const auto r = a->shards ? routed(connect_shards(*a)->distance_path(v, request(*d)), partial)
+                             : connect(*a)->distance_path(v, request(*d), wait_for(*a));
     if (a->json) write_distance_path_json(std::cout, r);
     if (refused(r)) std::exit(2);
     if (!a->json)
       std::cout << "clearance " << r.min_distance << " m at (" << r.min_xyz[0] << ", " << r.min_xyz[1] << ", "
                 << r.min_xyz[2] << "), " << r.min_arc_length << " m along the path (sample " << r.min_sample << " of "
                 << r.num_samples << "), map state " << r.snapshot_id << "\n";
+    if (partial) std::exit(3);
   });
 }
 

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cli/namespace_flag.h"
+#include "cli/shard_commands.h"
 #include "protocol/channels.h"
 #include "protocol/lcm_url.h"
 #include "query_client/query_client.h"
@@ -45,6 +46,18 @@ inline std::unique_ptr<QueryClient> connect(const CommonArgs& a) {
   return std::make_unique<QueryClient>(ort::protocol::lcm_url_or_default(a.lcm_url), id,
                                        std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)),
                                        protocol::namespace_from(a.ns));
+}
+
+// --shards (query_command.cpp): the flag, and the namespace's shard set found by its statuses
+// with a client routing to it (no waits: each shard has its own map states).
+void add_shards_flag(CLI::App* cmd, CommonArgs& a);
+std::unique_ptr<ShardQueries> connect_shards(const CommonArgs& a);
+
+// A routed answer's reply; `partial` when a shard's part is missing (said on stderr: exit 3).
+template <class R>
+R routed(const Routed<R>& r, bool& partial) {
+  partial = say_partial(r.shards);
+  return r.reply;
 }
 
 inline WaitFor wait_for(const CommonArgs& a) {

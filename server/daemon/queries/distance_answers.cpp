@@ -26,11 +26,17 @@ void stamp(M& m, const Query& q, const MapStamp& s, const std::string& server_id
   m.max_distance = q.max_distance;
 }
 
-distance::DistanceOptions options_of(const Query& q) {
+distance::DistanceOptions options_of(const Query& q, const DistanceServiceConfig& cfg) {
   distance::DistanceOptions o;
   o.max_distance = q.max_distance;
   o.cell_voxels = q.mode == Query::MODE_BOX ? q.cell_voxels : 1;
   o.unknown = q.unknown_as == Query::UNKNOWN_OCCUPIED ? distance::UnknownAs::kOccupied : distance::UnknownAs::kFree;
+  if (cfg.shard.sharded()) {  // a shard's share: the obstacles of its own regions (PROTOCOL.md, "Shards")
+    o.ownership.region_depth = cfg.shard.region_depth;
+    o.ownership.owns = [set = cfg.shard](uint32_t x, uint32_t y, uint32_t z) {
+      return protocol::shard_of(set, protocol::RegionCoords{x, y, z}) == set.index;
+    };
+  }
   return o;
 }
 
@@ -124,7 +130,7 @@ std::string validate_distance(const Query& q, double resolution, const DistanceS
     return "unknown_as " + std::to_string(q.unknown_as) + " is not 0 (free) or 1 (occupied)";
   if (q.mode == Query::MODE_BOX && (q.cell_voxels < 1 || q.cell_voxels > distance::kMaxCellVoxels))
     return "cell_voxels " + std::to_string(q.cell_voxels) + " is not in 1.." + std::to_string(distance::kMaxCellVoxels);
-  if (std::string bad = distance::check_options(options_of(q), resolution, cfg.limits); !bad.empty()) return bad;
+  if (std::string bad = distance::check_options(options_of(q, cfg), resolution, cfg.limits); !bad.empty()) return bad;
   if (q.num_xyz % 3) return "num_xyz is not a multiple of 3";
   for (float v : q.xyz)
     if (!std::isfinite(v)) return "a point is not finite";
@@ -142,7 +148,7 @@ EncodedReplies read_distance(const octomap::OcTree& tree, const Query& q, const 
   EncodedReplies out;
   out.channel = q.reply_channel;
   out.client_id = q.client_id;
-  const distance::DistanceOptions opt = options_of(q);
+  const distance::DistanceOptions opt = options_of(q, cfg);
   auto query = std::make_shared<const Query>(q);
   if (q.mode == Query::MODE_POINTS) {
     auto read = std::make_shared<const distance::PointsRead>(distance::read_points(tree, q.xyz, opt, cfg.limits));

@@ -7,6 +7,7 @@
 
 #include "distance/distance_queries.h"
 #include "protocol/channels.h"
+#include "protocol/shards/shard_set.h"
 #include "query/edit_cost.h"
 
 namespace ort::daemon {
@@ -42,6 +43,9 @@ struct DistanceServiceConfig {
   distance::DistanceLimits limits{.max_grid_cells = 16'000'000, .max_box_cells = 4'000'000};
   int64_t max_reply_bytes = 16 << 20;  // compressed box blob; larger is refused as too large
   int zstd_level = 1;
+  // The server's shard set (ServerConfig::shard, set where the query service is made): a
+  // shard answers for the obstacles of its own regions (distance_types.h's RegionOwnership).
+  protocol::ShardSet shard;
 };
 
 struct QueryServiceConfig {
