@@ -8,6 +8,7 @@
 
 #include "cli/commands.h"
 #include "cli/namespace_flag.h"
+#include "cli/shard_commands.h"
 #include "core/log.h"
 #include "octomap_rt/map_edit_t.hpp"
 #include "protocol/lcm_url.h"
@@ -23,20 +24,35 @@ struct EditArgs {
   double timeout_s = 10;
   bool json = false;
   bool include_unknown = false;
+  bool shards = false;  // a shard set: the edit goes to the shards owning its box
 };
 
 void run_edit(const EditArgs& a, int8_t op) {
   client::Box b{};
   if (op != octomap_rt::map_edit_t::OP_RESET) b = client::parse_box(a.box);
-  client::QueryClient c(ort::protocol::lcm_url_or_default(a.lcm_url), "cli-" + std::to_string(::getpid()),
-                        std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)),
-                        protocol::namespace_from(a.ns));
   const int8_t flags = a.include_unknown ? octomap_rt::map_edit_t::FLAG_INCLUDE_UNKNOWN : 0;
-  const auto ack = c.edit(op, b, a.token, flags);
+  bool partial = false;
+  octomap_rt::map_edit_ack_t ack;
+  if (a.shards) {
+    if (a.include_unknown) throw CLI::ValidationError("--include-unknown", "every shard refuses it (--shards)");
+    const std::string url = ort::protocol::lcm_url_or_default(a.lcm_url), ns = protocol::namespace_from(a.ns);
+    const client::ShardRoster roster = find_shards_for_query(url, ns, a.timeout_s);
+    client::ShardQueries q(url, "cli-" + std::to_string(::getpid()),
+                           std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)), ns, *roster.set(),
+                           roster.resolution());
+    const auto routed = q.edit(op, b, a.token, flags);
+    partial = say_partial(routed.shards);
+    ack = routed.reply;
+  } else {
+    client::QueryClient c(ort::protocol::lcm_url_or_default(a.lcm_url), "cli-" + std::to_string(::getpid()),
+                          std::chrono::milliseconds(static_cast<int64_t>(a.timeout_s * 1000)),
+                          protocol::namespace_from(a.ns));
+    ack = c.edit(op, b, a.token, flags);
+  }
   if (a.json) client::write_edit_json(std::cout, ack);
   if (ack.status != 0) {
     log_to(std::cerr, "octomap-rt map").error(std::string(client::status_name(ack.status)) + ": " + ack.error);
-    std::exit(2);
+    std::exit(partial ? 3 : 2);
   }
   if (!a.json) std::cout << "applied; the map holds it from map state " << ack.snapshot_id << "\n";
 }
@@ -47,6 +63,9 @@ void add_common(CLI::App* cmd, EditArgs& a) {
   add_namespace_flag(cmd, a.ns);
   cmd->add_option("--timeout", a.timeout_s, "seconds to wait for the acknowledgement")->capture_default_str();
   cmd->add_flag("--json", a.json, "one JSON document on stdout");
+  cmd->add_flag("--shards", a.shards,
+                "the namespace is a shard set: send the edit to the shards owning a region of its box (every "
+                "shard for reset); exit status 3 when one did not apply it");
 }
 
 }  // namespace

@@ -178,7 +178,10 @@ void register_grid(CLI::App& parent) {
       const auto lo = parse_numbers(window->substr(0, colon), 2), hi = parse_numbers(window->substr(colon + 1), 2);
       w = Box{{lo[0], lo[1], 0}, {hi[0], hi[1], 0}};
     }
-    const Grid g = connect(*a)->grid(z0, z1, *cell, window->empty() ? nullptr : &w, wait_for(*a));
+    bool partial = false;
+    const Box* win = window->empty() ? nullptr : &w;
+    const Grid g = a->shards ? routed(connect_shards(*a)->grid(z0, z1, *cell, win), partial)
+                             : connect(*a)->grid(z0, z1, *cell, win, wait_for(*a));
     if (refused(g.header)) {
       if (a->json) write_grid_json(std::cout, g, "");
       std::exit(2);
@@ -190,6 +193,7 @@ void register_grid(CLI::App& parent) {
       std::cout << "grid " << g.header.width << " x " << g.header.height << " cells of " << g.header.cell_size
                 << " m from (" << g.header.origin_x << ", " << g.header.origin_y << "), map state "
                 << g.header.snapshot_id << (out->empty() ? "" : ", written to " + *out) << "\n";
+    if (partial) std::exit(3);
   });
 }
 

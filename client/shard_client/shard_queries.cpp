@@ -14,46 +14,15 @@
 
 #include "octomap_rt/box_query_t.hpp"
 #include "protocol/limits.h"
+#include "shard_client/shard_ask.h"
 
 namespace ort::client {
 namespace {
 
+using detail::ask_each;
+using detail::every_shard;
+
 using Occ = octomap_rt::occupancy_reply_t;
-
-// The status and map state of a reply (a distance box's are in its first chunk).
-template <class Reply>
-const Reply& head(const Reply& r) {
-  return r;
-}
-const octomap_rt::distance_box_chunk_t& head(const DistanceBox& b) { return b.header; }
-
-// Runs ask(i) for every shard i in `which` side by side; each result or the reason it failed.
-template <class Reply>
-std::vector<std::optional<Reply>> ask_each(const std::vector<uint32_t>& which, size_t count, ShardAnswer& answer,
-                                           const std::function<Reply(uint32_t)>& ask) {
-  std::vector<std::optional<Reply>> out(count);
-  std::vector<std::pair<uint32_t, std::future<Reply>>> pending;
-  for (uint32_t i : which) pending.emplace_back(i, std::async(std::launch::async, ask, i));
-  answer.snapshot_ids.assign(count, -1);
-  for (auto& [i, f] : pending) {
-    try {
-      Reply r = f.get();
-      if (head(r).status != Occ::REPLY_OK) throw std::runtime_error("refused: " + head(r).error);
-      answer.snapshot_ids[i] = head(r).snapshot_id;
-      out[i] = std::move(r);
-    } catch (const std::exception& e) {
-      answer.missing.push_back(i);
-      answer.errors.push_back(e.what());
-    }
-  }
-  return out;
-}
-
-std::vector<uint32_t> every_shard(uint32_t count) {
-  std::vector<uint32_t> v(count);
-  for (uint32_t i = 0; i < count; ++i) v[i] = i;
-  return v;
-}
 
 // Which of the shards' hits the ray meets first: each is the first occupied voxel of its shard
 // on the same walk, so the first of them on that walk is the map's first. OctoMap's own castRay

@@ -55,6 +55,15 @@ class ShardQueries {
   Routed<DistanceBox> distance_box(const Box& box, const DistanceRequest& d);
   Routed<octomap_rt::distance_path_reply_t> distance_path(const std::vector<float>& vertices, const DistanceRequest& d);
 
+  // A grid of a z band (shard_grid_edit.h): with a window, the shards owning a region in it; without,
+  // every shard, merged on the union of their extents (the map's extent).
+  Routed<Grid> grid(double z_min, double z_max, double cell_size, const Box* window);
+  // A map edit (QueryClient::edit) sent to the shards owning a region the box meets (every shard
+  // for OP_RESET); reply status REPLY_OK when each applied it, else REPLY_NOT_READY with the
+  // shards that did not (`shards.missing`: a refusal says why). Throws std::invalid_argument for
+  // FLAG_INCLUDE_UNKNOWN (every shard refuses it).
+  Routed<octomap_rt::map_edit_ack_t> edit(int8_t op, const Box& box, const std::string& token, int8_t flags = 0);
+
   // The shard owning the voxel of point (x, y, z); set.count for a point outside the key range.
   uint32_t shard_of_point(double x, double y, double z) const;
 

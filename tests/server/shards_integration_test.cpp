@@ -2,7 +2,8 @@
 // octomap-rt-server --shard i/3 in one namespace hear a robot's real scans (3DTK) over udpm.
 // The CLI finds them by their statuses and merges their snapshots into one .bt that is OctoMap's
 // map of those scans; points and rays routed by region get OctoMap's answers, distances (points
-// with the gradient, a box, a path through the CLI) the distances on OctoMap's map; with one shard
+// with the gradient, a box, a path through the CLI) the distances on OctoMap's map, a band's grid
+// OctoMap's projected map, a clear-box goes to the shard owning its box; with one shard
 // stopped, the map and the answers say they are partial and which shard is missing.
 #include <gtest/gtest.h>
 
@@ -15,8 +16,11 @@
 #include "distance/distance_queries.h"
 #include "distance/squared_edt.h"
 #include "integration_harness.h"
+#include "octomap_rt/box_query_t.hpp"
+#include "octomap_rt/map_edit_t.hpp"
 #include "protocol/shards/shard_set.h"
 #include "query/point_query.h"
+#include "query/projected_grid.h"
 #include "query/ray_query.h"
 #include "scene/scan_set.h"
 #include "shard_client/shard_queries.h"
@@ -31,6 +35,7 @@ namespace {
 constexpr double kRes = 0.2;
 constexpr int kShards = 3;
 const char* kNs = "fleet";
+const char* kToken = "shards-edit-token-0123";
 
 // Every n-th end point of the scans, as x y z floats.
 std::vector<float> end_points(const ScanSet& set, size_t stride) {
@@ -58,7 +63,7 @@ TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
         std::vector<std::string>{server_program(), "--lcm-url", url, "-r", std::to_string(kRes), "--namespace", kNs,
                                  "--shard", std::to_string(i) + "/" + std::to_string(kShards), "--warm-up-points", "0",
                                  // On 2 loaded cores 300 rays may pass the 10 ms lock bound and be cut.
-                                 "--backend", "cpu", "--query-lock-ms", "2000"},
+                                 "--backend", "cpu", "--query-lock-ms", "2000", "--control-token", kToken},
         dir + "/shard" + std::to_string(i) + ".log"));
   for (auto& s : shards) ASSERT_TRUE(status.wait_for([&](const auto& m) { return m.pid == s->pid(); }, 60)) << s->log();
 
@@ -177,6 +182,54 @@ TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
       distance::answer_path(distance::read_path(*reference, vertices, path_opt, {}), distance::cpu_edt(1));
   EXPECT_NE(path.log().find("\"min_sample\": " + std::to_string(clearance.min_sample) + ","), std::string::npos)
       << path.log() << " want sample " << clearance.min_sample;
+
+  // A grid of a band merged from every shard: OctoMap's projected map of the band, on the map's extent.
+  const auto grid = q.grid(-0.5, 1.0, 0, nullptr);
+  ASSERT_FALSE(grid.shards.partial()) << grid.shards.shortfall();
+  ASSERT_EQ(grid.reply.header.status, 0) << grid.reply.header.error;
+  query::GridRequest band;
+  band.z_min = -0.5, band.z_max = 1.0;
+  const query::Grid2D want_grid = query::projected_grid(*reference, band);
+  EXPECT_EQ(grid.reply.header.width, want_grid.width);
+  EXPECT_EQ(grid.reply.header.height, want_grid.height);
+  EXPECT_DOUBLE_EQ(grid.reply.header.origin_x, want_grid.origin_x);
+  EXPECT_DOUBLE_EQ(grid.reply.header.origin_y, want_grid.origin_y);
+  if (grid.reply.cells.size() == want_grid.cells.size()) {
+    size_t differing_cells = 0;
+    for (size_t c = 0; c < want_grid.cells.size(); ++c)
+      differing_cells += grid.reply.cells[c] != int8_t(want_grid.cells[c]);
+    EXPECT_EQ(differing_cells, 0u) << "of " << want_grid.cells.size() << " cells";
+  }
+
+  // A clear-box inside one region goes to its shard alone; afterwards the box is unknown.
+  client::Box clear{};
+  uint32_t owner = kShards;
+  for (size_t i = 0; i + 3 <= xyz.size() && owner == kShards; i += 3) {
+    clear = client::Box{{xyz[i] - 0.3, xyz[i + 1] - 0.3, xyz[i + 2] - 0.3},
+                        {xyz[i] + 0.3, xyz[i + 1] + 0.3, xyz[i + 2] + 0.3}};
+    const uint32_t lo = q.shard_of_point(clear.min[0], clear.min[1], clear.min[2]);
+    if (lo == q.shard_of_point(clear.max[0], clear.max[1], clear.max[2]) &&
+        q.shard_of_point(xyz[i], xyz[i + 1], xyz[i + 2]) == lo && roster.set()->region_depth == 10) {
+      int64_t k0 = 0, k1 = 0;  // the same region on every axis, not just the same shard
+      bool same = true;
+      for (int a = 0; a < 3; ++a)
+        same = same && client::voxel_key(clear.min[a], kRes, k0) && client::voxel_key(clear.max[a], kRes, k1) &&
+               (k0 >> 6) == (k1 >> 6);
+      if (same) owner = lo;
+    }
+  }
+  ASSERT_LT(owner, uint32_t(kShards));
+  const auto edit = q.edit(octomap_rt::map_edit_t::OP_CLEAR_TO_UNKNOWN, clear, kToken);
+  ASSERT_EQ(edit.reply.status, 0) << edit.reply.error;
+  for (uint32_t i = 0; i < uint32_t(kShards); ++i)  // asked (a state id) only where the box is
+    EXPECT_EQ(edit.shards.snapshot_ids[i] >= 0, i == owner) << "shard " << i;
+  const auto after_clear = q.boxes({clear}, octomap_rt::box_query_t::MODE_COUNTS);
+  ASSERT_FALSE(after_clear.shards.partial()) << after_clear.shards.shortfall();
+  EXPECT_EQ(after_clear.reply.occupied[0] + after_clear.reply.free[0], 0);
+  EXPECT_GT(after_clear.reply.unknown[0], 0);
+  EXPECT_THROW(
+      q.edit(octomap_rt::map_edit_t::OP_CLEAR_TO_FREE, clear, kToken, octomap_rt::map_edit_t::FLAG_INCLUDE_UNKNOWN),
+      std::invalid_argument);
 
   // Shard 2 stops: a merged map and a routed answer say what is missing.
   shards[2]->signal(SIGTERM);
