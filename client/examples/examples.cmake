@@ -1,6 +1,6 @@
 # client/examples/: planners on the client libraries. grid_planner.cpp (octomap-rt-plan) is
-# built by default and installed; map_fetch/ is a planner's own project against the installed
-# library (built out of tree by install_integration_test).
+# built by default and installed; map_fetch/ and query_point/ are programs' own projects against
+# the installed libraries (built out of tree by install_integration_test).
 add_executable(octomap-rt-plan ${CMAKE_CURRENT_LIST_DIR}/grid_planner.cpp)
 target_link_libraries(octomap-rt-plan PRIVATE octomap_rt_client)
 target_compile_definitions(octomap-rt-plan PRIVATE OCTOMAP_RT_VERSION="${PROJECT_VERSION}")

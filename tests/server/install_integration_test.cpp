@@ -1,6 +1,7 @@
 // `cmake --install` and find_package(octomap_rt): the install tree of this build holds what a
-// planner's project needs; client/examples/map_fetch is configured and built out of tree
-// against it and run against a real server in a network namespace.
+// planner's project needs; client/examples/map_fetch (the map client) and query_point (the
+// query client, namespace ort::client alone) are configured and built out of tree against it
+// and run against a real server in a network namespace.
 #include <gtest/gtest.h>
 
 #include <signal.h>
@@ -30,12 +31,20 @@ TEST(InstallIntegration, AnOutOfTreeProgramBuildsAgainstTheInstallAndFetchesTheM
   EXPECT_TRUE(std::filesystem::exists(prefix + "/lib/cmake/octomap_rt/octomap_rtConfig.cmake"));
   EXPECT_TRUE(std::filesystem::exists(prefix + "/bin/octomap-rt-server"));
   EXPECT_TRUE(std::filesystem::exists(prefix + "/include/octomap_rt/octomap_rt/map_chunk_t.hpp"));
+  EXPECT_TRUE(std::filesystem::exists(prefix + "/include/octomap_rt/query_client/client.h"));
   ASSERT_EQ(
       run("cmake -S " OCTOMAP_RT_SOURCE_DIR "/client/examples/map_fetch -B " + ex + " -DCMAKE_PREFIX_PATH=" + prefix,
           dir + "/configure.log"),
       0)
       << dir << "/configure.log";
   ASSERT_EQ(run("cmake --build " + ex, dir + "/build.log"), 0) << dir << "/build.log";
+  const std::string qp = dir + "/query_point";
+  ASSERT_EQ(
+      run("cmake -S " OCTOMAP_RT_SOURCE_DIR "/client/examples/query_point -B " + qp + " -DCMAKE_PREFIX_PATH=" + prefix,
+          dir + "/configure_query_point.log"),
+      0)
+      << dir << "/configure_query_point.log";
+  ASSERT_EQ(run("cmake --build " + qp, dir + "/build_query_point.log"), 0) << dir << "/build_query_point.log";
 
   const std::string url = test_lcm_url(4, ns.rmem_max());
   StatusWatcher status(url);
@@ -50,6 +59,10 @@ TEST(InstallIntegration, AnOutOfTreeProgramBuildsAgainstTheInstallAndFetchesTheM
   ASSERT_EQ(fetch.wait(120), 0) << fetch.log();
   EXPECT_NE(fetch.log().find("snapshot 1: 1 scans"), std::string::npos) << fetch.log();
   EXPECT_NE(fetch.log().find("mirror at map state 1"), std::string::npos) << fetch.log();
+  ChildProcess point({qp + "/query_point", url.substr(0, url.find("&recv_buf_size")), "0", "0", "-100"},
+                     dir + "/query_point.log");
+  ASSERT_EQ(point.wait(60), 0) << point.log();
+  EXPECT_NE(point.log().find("map state 1: unknown"), std::string::npos) << point.log();
   server.signal(SIGTERM);
   EXPECT_EQ(server.wait(120), 0) << server.log();
   if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
