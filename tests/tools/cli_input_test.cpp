@@ -53,6 +53,18 @@ std::string dir() {
   return d;
 }
 
+// A .graph of one scan from the origin: 20 points `range` m ahead along x, 0.1 m apart.
+std::string one_scan_graph(float range, const std::string& name) {
+  ScanSet set;
+  PosedScan s;
+  s.pose = octomap::pose6d(0, 0, 0, 0, 0, 0);
+  for (int i = 0; i < 20; ++i) s.points.push_back(range, 0.1f * i, 0.5f);
+  set.scans.push_back(s);
+  const std::string graph = dir() + "/" + name;
+  save_scan_graph(set, graph);
+  return graph;
+}
+
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -141,13 +153,7 @@ TEST(CliInput, NonFiniteOrAbsurdNumbersAreRefused) {
 
 TEST(CliInput, EveryPointOutsideTheKeyRangeIsSaidOutLoud) {
   // At 0.1 mm the key range is +-3.3 m: a sensor at the origin seeing points 10 m away.
-  ScanSet set;
-  PosedScan s;
-  s.pose = octomap::pose6d(0, 0, 0, 0, 0, 0);
-  for (int i = 0; i < 20; ++i) s.points.push_back(10.0f, 0.1f * i, 0.5f);
-  set.scans.push_back(s);
-  const std::string graph = dir() + "/far.graph";
-  save_scan_graph(set, graph);
+  const std::string graph = one_scan_graph(10.0f, "far.graph");
   const CliRun r = run("build " + graph + " -r 0.0001 --backend cpu -q -o " + dir() + "/empty.bt");
   EXPECT_EQ(r.exit, 0) << r.output;
   EXPECT_NE(r.output.find("the map is empty; is the resolution right?"), std::string::npos) << r.output;
@@ -177,13 +183,7 @@ TEST(CliInput, OctomapsStdioProgressLinesDoNotReachTheUser) {
   // for every cloud of a .graph, "Writing N nodes to output stream... done." for every .bt
   // writeBinary writes (`map get --shards -o FILE.bt`). octomap-rt drops those lines and
   // nothing else: its own messages and OctoMap's warnings pass.
-  ScanSet set;
-  PosedScan s;
-  s.pose = octomap::pose6d(0, 0, 0, 0, 0, 0);
-  for (int i = 0; i < 20; ++i) s.points.push_back(2.0f, 0.1f * i, 0.5f);
-  set.scans.push_back(s);
-  const std::string graph = dir() + "/stdio.graph";
-  save_scan_graph(set, graph);
+  const std::string graph = one_scan_graph(2.0f, "stdio.graph");
   const CliRun built = run("build " + graph + " -r 0.1 --backend cpu -q -o " + dir() + "/stdio.bt");
   EXPECT_EQ(built.exit, 0) << built.output;
   EXPECT_EQ(built.output.find("points from binary file"), std::string::npos) << built.output;
