@@ -9,7 +9,7 @@
 namespace ort {
 
 RegionResidency::RegionResidency(const RegionGrid& grid, RegionSpill& spill, uint64_t max_bytes)
-    : grid_(grid), spill_(spill), max_bytes_(max_bytes) {}
+    : grid_(grid), spill_(spill), max_bytes_(max_bytes), tally_(grid) {}
 
 void RegionResidency::restore(octomap::OcTree& tree, RegionId id) {
   auto it = spilled_.find(id);
@@ -17,6 +17,7 @@ void RegionResidency::restore(octomap::OcTree& tree, RegionId id) {
   const auto t0 = SteadyClock::now();
   const std::vector<uint8_t> bytes = spill_.get(id);
   const auto t1 = SteadyClock::now();
+  tally_.changed(id);
   restore_region(tree, grid_, id, bytes);
   stats_.costs.get_ms += ms_between(t0, t1);
   stats_.costs.rebuild_ms += ms_since(t1);
@@ -30,6 +31,7 @@ void RegionResidency::touch(octomap::OcTree& tree, std::span<const RegionId> ids
   ++tick_;
   for (RegionId id : ids) {
     last_touch_[id] = tick_;
+    tally_.changed(id);  // about to be read or changed
     if (spilled_.empty()) continue;
     // The region and its parent's other children (region_residency.h says why).
     const octomap::OcTreeKey k = region_min_key(grid_, id);
@@ -75,7 +77,7 @@ uint64_t inner_nodes(const std::vector<uint8_t>& encoded) {
 
 }  // namespace
 
-size_t RegionResidency::enforce(octomap::OcTree& tree) { return enforce(tree, tree.memoryUsage(), max_bytes_).regions; }
+size_t RegionResidency::enforce(octomap::OcTree& tree) { return enforce(tree, memory(tree), max_bytes_).regions; }
 
 EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, uint64_t target, size_t max_groups) {
   EnforceResult result;
@@ -118,6 +120,7 @@ EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, ui
     const std::vector<uint8_t> encoded = encode_region(tree, grid_, c.id);
     const auto t1 = SteadyClock::now();
     spill_.put(c.id, encoded);  // durable before the nodes go
+    tally_.changed(c.id);
     const auto t2 = SteadyClock::now();
     uint64_t freed = 0;
     if (free_later_) {
@@ -169,6 +172,7 @@ std::vector<RegionId> RegionResidency::spilled_in(const octomap::OcTreeKey& lo, 
 }
 
 void RegionResidency::adopt_spilled(RegionId id, uint64_t bytes) {
+  tally_.changed(id);
   auto [it, added] = spilled_.emplace(id, bytes);
   if (!added) {
     stats_.evicted_bytes -= it->second;
@@ -188,6 +192,7 @@ void RegionResidency::forget_all() {
   for (RegionId id : spilled_ids()) spill_.erase(id);
   spilled_.clear();
   stats_.evicted_bytes = 0;
+  tally_.changed_all();
 }
 
 void RegionResidency::restore_all(octomap::OcTree& tree) {

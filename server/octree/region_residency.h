@@ -22,6 +22,7 @@
 #include "core/voxel_update.h"
 #include "octree/region.h"
 #include "octree/region_codec.h"
+#include "octree/region_tally.h"
 
 namespace ort {
 
@@ -86,7 +87,8 @@ class RegionResidency {
   // The spilled regions whose cubes meet the key box [lo, hi] (inclusive).
   std::vector<RegionId> spilled_in(const octomap::OcTreeKey& lo, const octomap::OcTreeKey& hi) const;
   std::vector<RegionId> spilled_ids() const;
-  // The tree no longer holds any spilled region (a reset): drops them from the spill.
+  // The tree no longer holds any spilled region (a reset): drops them from the spill (and
+  // counts the whole tree as changed).
   void forget_all();
   // Where spilled regions' nodes go: with a hook, they are detached from the tree and handed
   // to it to be freed elsewhere (octree/region_codec.h detach_region); without, freed here.
@@ -94,6 +96,13 @@ class RegionResidency {
   // Brings every spilled region back (a whole-map save or snapshot without the bound).
   void restore_all(octomap::OcTree& tree);
   bool spilled(RegionId id) const { return spilled_.count(id) != 0; }
+  // The tree's memory as OctoMap's memoryUsage() counts it, exactly, without walking every
+  // node (octree/region_tally.h): touches, restores and evictions tell the tally what they
+  // change; whoever else changes the tree (edits, sweeps) calls changed_box or changed_all.
+  uint64_t memory(const octomap::OcTree& tree) { return tally_.memory(tree); }
+  void changed_box(const octomap::OcTreeKey& lo, const octomap::OcTreeKey& hi) { tally_.changed_box(lo, hi); }
+  void changed_all() { tally_.changed_all(); }
+  const RegionTally& tally() const { return tally_; }
   ResidencyStats stats() const;
   const RegionGrid& grid() const { return grid_; }
 
@@ -108,6 +117,7 @@ class RegionResidency {
   std::unordered_map<RegionId, uint64_t> last_touch_;
   std::unordered_map<RegionId, uint64_t> spilled_;  // id -> bytes spilled
   ResidencyStats stats_;
+  RegionTally tally_;
 };
 
 }  // namespace ort

@@ -63,6 +63,7 @@ RegionSweep::RegionSweep(const octomap::OcTree& tree, const RegionGrid& grid) : 
 }
 
 void RegionSweep::visit_unit(octomap::OcTree& tree, const Unit& unit, const RegionVisit& visit) {
+  if (spill_.visiting) spill_.visiting(unit.min_key, unit.depth);
   if (unit.depth == grid_.depth && spill_.bring_back) spill_.bring_back(tree, region_of(grid_, unit.min_key));
   octomap::OcTreeNode* root = tree.getRoot();
   if (root == nullptr) return;

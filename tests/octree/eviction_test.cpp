@@ -13,9 +13,12 @@
 #include <octomap/OcTree.h>
 
 #include "engine/map_engine.h"
+#include "octree/decay.h"
 #include "octree/octree_update.h"
 #include "octree/region_codec.h"
 #include "octree/region_residency.h"
+#include "octree/region_tally.h"
+#include "query/map_edit.h"
 #include "real_scan_voxels.h"
 #include "scene/scan_set.h"
 #include "support/test_data.h"
@@ -97,6 +100,90 @@ void check_bounded_build(const std::string& graph, size_t scans) {
   EXPECT_TRUE(spill.regions.empty());
   ASSERT_TRUE(test::same_tree(unbounded, bounded)) << graph;
   EXPECT_EQ(ot_bytes(unbounded), ot_bytes(bounded));
+}
+
+// The bound's exact memory count (octree/region_tally.h) is OctoMap's memoryUsage() walk after
+// every kind of change the daemon makes to its tree: scans (their regions touched first),
+// evictions, restores, an edit, decay in slices with regions spilled; and it reuses the
+// counts of the regions nothing changed. A change nobody tells the tally of is seen.
+TEST(Eviction, ExactMemoryCountEqualsTheWalkAfterEveryChange) {
+  const std::vector<VoxelList> lists = test::shoot_real_scans("3dtk_dat/3dtk_3scans.graph", 2);
+  ASSERT_FALSE(lists.empty());
+  octomap::OcTree tree(0.1);
+  MemorySpill spill;
+  const RegionGrid grid = region_grid(11);
+  RegionResidency residency(grid, spill, UINT64_MAX);
+  OctreeStage stage(OctreeUpdateOptions{OctreeUpdateMode::kBatched, 2});
+  for (const VoxelList& l : lists) {
+    residency.touch_voxels(tree, l);
+    stage.apply(tree, l);
+    ASSERT_EQ(residency.memory(tree), tree.memoryUsage()) << "after a scan";
+  }
+  // Evictions down to half of the map, then a scan that brings some of it back.
+  const uint64_t whole = tree.memoryUsage();
+  const EnforceResult evicted = residency.enforce(tree, residency.memory(tree), whole / 2);
+  EXPECT_GT(evicted.regions, 10u);
+  ASSERT_EQ(residency.memory(tree), tree.memoryUsage()) << "after evictions";
+  // As stage 2 does it: the scan's regions touched (restored), the scan, then a count.
+  residency.touch_voxels(tree, lists[0]);
+  EXPECT_GT(residency.stats().restores, 0u);
+  stage.apply(tree, lists[0]);
+  ASSERT_EQ(residency.memory(tree), tree.memoryUsage()) << "after a scan over restored regions";
+  // Restores alone (a query's touch): everything spilled comes back.
+  residency.enforce(tree, residency.memory(tree), whole / 2);
+  ASSERT_GT(residency.stats().evicted_regions, 0u);
+  const std::vector<RegionId> spilled = residency.spilled_ids();
+  residency.touch(tree, spilled);
+  ASSERT_EQ(residency.memory(tree), tree.memoryUsage()) << "after restores";
+  // An edit: a box across the map back to unknown.
+  const query::KeyBox box = query::key_box(tree, octomap::point3d(-3, -3, -1), octomap::point3d(4, 2, 1.5));
+  residency.changed_box(box.min, box.max);
+  const uint64_t before_edit = tree.memoryUsage();
+  query::clear_box(tree, box, query::ClearTo::kUnknown);
+  ASSERT_NE(tree.memoryUsage(), before_edit) << "the edit changes the tree's memory";
+  ASSERT_EQ(residency.memory(tree), tree.memoryUsage()) << "after an edit";
+  // Decay in slices over 6.4 m regions, spilled ones brought back as the sweep reaches them.
+  residency.enforce(tree, residency.memory(tree), tree.memoryUsage() / 2);
+  DecaySweep decay(tree, region_grid(10), DecayRule{0.5f, 0.6f});
+  SweepSpill hooks;
+  const RegionGrid sweep_grid = region_grid(10);
+  hooks.bring_back = [&](octomap::OcTree& t, RegionId id) {
+    for (RegionId r : residency.spilled_in(region_min_key(sweep_grid, id), region_max_key(sweep_grid, id)))
+      residency.bring_back(t, r);
+  };
+  hooks.spilled = [&](RegionId id) {
+    return !residency.spilled_in(region_min_key(sweep_grid, id), region_max_key(sweep_grid, id)).empty();
+  };
+  hooks.visiting = [&](const octomap::OcTreeKey& k, unsigned depth) {
+    const auto last = static_cast<uint16_t>((1u << (16 - depth)) - 1);
+    residency.changed_box(k, octomap::OcTreeKey(uint16_t(k[0] | last), uint16_t(k[1] | last), uint16_t(k[2] | last)));
+  };
+  decay.regions().set_spill(hooks);
+  size_t slices = 0;
+  while (!decay.run_slice(tree, 20'000)) {
+    ++slices;
+    ASSERT_EQ(residency.memory(tree), tree.memoryUsage()) << "after decay slice " << slices;
+  }
+  EXPECT_GT(slices, 2u);
+  EXPECT_GT(decay.stats().nodes_deleted, 0u);
+  ASSERT_EQ(residency.memory(tree), tree.memoryUsage()) << "after the decay's last slice";
+  EXPECT_GT(residency.tally().regions_reused(), residency.tally().regions_recounted())
+      << "most counts reuse the regions nothing changed";
+
+  // Untold, a change inside a region goes unseen: the count is only as exact as what it is told.
+  query::KeyBox small;
+  for (RegionId id : list_regions(tree, grid)) {
+    const RegionNode r = find_region(tree, grid, id);
+    if (r.depth == grid.depth && tree.nodeHasChildren(r.node)) {
+      small = query::KeyBox{region_min_key(grid, id), region_max_key(grid, id)};
+      small.max[0] = static_cast<uint16_t>(small.min[0] + grid.side_keys() / 2 - 1);  // half of it
+      break;
+    }
+  }
+  const uint64_t before = residency.memory(tree);
+  query::clear_box(tree, small, query::ClearTo::kUnknown);
+  ASSERT_NE(tree.memoryUsage(), before);
+  EXPECT_NE(residency.memory(tree), tree.memoryUsage());
 }
 
 TEST(Eviction, BoundedBuildOfRealScansIsTheUnboundedMap) {

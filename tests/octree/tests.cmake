@@ -27,8 +27,10 @@ octomap_rt_add_test(forgetting_test
   TIMEOUT 300)
 
 # The memory bound's spill and restore on real scans: a map built with regions spilled and
-# brought back is, once everything is back, the map built without the bound.
+# brought back is, once everything is back, the map built without the bound; and the bound's
+# exact memory count equals OctoMap's walk after every kind of change (edits need the query layer).
 octomap_rt_add_test(eviction_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/eviction_test.cpp ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp ${CMAKE_CURRENT_LIST_DIR}/real_scan_voxels.cpp
+  LIBS octomap_rt_query
   TIMEOUT 300)
 
 set_property(TEST octree_test region_test forgetting_test eviction_test APPEND PROPERTY LABELS data)

@@ -34,6 +34,7 @@ MapEditResult apply_map_edit(MapState& map, const MapEditItem& edit) {
                 "; the map is unchanged";
       return r;
     }
+    if (map.residency) map.residency->will_change(std::span<const query::KeyBox>(&box, 1));
     apply_map_step(map, [box, to, unknown](octomap::OcTree& t) { query::clear_box(t, box, to, unknown); });
     if (map.residency) map.residency->enforce(tree);
   }

@@ -28,8 +28,11 @@ MapResidency::MapResidency(MapState& map, const RegionGrid& grid, RegionSpill& s
 void MapResidency::count_residency_change() { count_map_change(map_); }
 
 uint64_t MapResidency::estimate(const octomap::OcTree& tree) const {
-  if (bytes_per_node_ <= 0) return tree.memoryUsage();
-  return sizeof(octomap::OcTree) + static_cast<uint64_t>(bytes_per_node_ * static_cast<double>(tree.size()));
+  // Before the first exact count: every node as an inner one (an upper bound). Never counted
+  // here: a count between a touch and its change would take the touched regions as unchanged.
+  const double per_node =
+      bytes_per_node_ > 0 ? bytes_per_node_ : double(tree.memoryUsageNode() + sizeof(octomap::OcTreeNode* [8]));
+  return sizeof(octomap::OcTree) + static_cast<uint64_t>(per_node * static_cast<double>(tree.size()));
 }
 
 void MapResidency::publish_stats(const octomap::OcTree& tree) {
@@ -42,6 +45,8 @@ void MapResidency::publish_stats(const octomap::OcTree& tree) {
   stats_.evictions = r.evictions;
   stats_.restores = r.restores;
   stats_.costs = r.costs;
+  stats_.regions_recounted = residency_.tally().regions_recounted();
+  stats_.regions_reused = residency_.tally().regions_reused();
 }
 
 void MapResidency::note_costs(double touch_ms, double enforce_ms, double walk_ms) {
@@ -69,16 +74,18 @@ void MapResidency::note_costs(double touch_ms, double enforce_ms, double walk_ms
 
 std::string residency_cost_line(const MapResidencyStats& a, const MapResidencyStats& b) {
   const ResidencyCosts &x = a.costs, &y = b.costs;
-  char line[640];
+  char line[768];
   std::snprintf(line, sizeof line,
                 "memory bound costs: %llu passes evicted %llu regions in %.1f ms (most %.1f ms a pass; walks %.1f, "
                 "list %.1f, encode %.1f, store write %.1f, strip %.1f); %llu restores in %.1f ms (most %.1f ms a "
-                "scan; store read %.1f, rebuild %.1f)",
+                "scan; store read %.1f, rebuild %.1f); exact counts recounted %llu regions, reused %llu",
                 (unsigned long long)(b.enforce_passes - a.enforce_passes),
                 (unsigned long long)(b.evictions - a.evictions), b.enforce_ms - a.enforce_ms, b.max_enforce_ms,
                 b.walk_ms - a.walk_ms, y.list_ms - x.list_ms, y.encode_ms - x.encode_ms, y.put_ms - x.put_ms,
                 y.strip_ms - x.strip_ms, (unsigned long long)(b.restores - a.restores), b.touch_ms - a.touch_ms,
-                b.max_touch_ms, y.get_ms - x.get_ms, y.rebuild_ms - x.rebuild_ms);
+                b.max_touch_ms, y.get_ms - x.get_ms, y.rebuild_ms - x.rebuild_ms,
+                (unsigned long long)(b.regions_recounted - a.regions_recounted),
+                (unsigned long long)(b.regions_reused - a.regions_reused));
   return line;
 }
 
@@ -127,6 +134,11 @@ void MapResidency::touch_boxes(octomap::OcTree& tree, std::span<const query::Key
   publish_stats(tree);
 }
 
+void MapResidency::will_change(std::span<const query::KeyBox> boxes) {
+  std::lock_guard lock(mutex_);
+  for (const query::KeyBox& b : boxes) residency_.changed_box(b.min, b.max);
+}
+
 bool MapResidency::any_spilled_in(std::span<const query::KeyBox> boxes) const {
   std::lock_guard lock(mutex_);
   for (const query::KeyBox& b : boxes)
@@ -145,8 +157,9 @@ void MapResidency::enforce(octomap::OcTree& tree) {
   uint64_t bytes = estimated;
   size_t groups = 1;  // between the soft start and the bound: one sibling group a change
   if (estimated > max_bytes_ || bytes_per_node_ <= 0) {
-    // Over by the estimate: count exactly, and go down to the low-water mark at once.
-    bytes = tree.memoryUsage();
+    // Over by the estimate: count exactly (the tally recounts only what changed since its
+    // last count), and go down to the low-water mark at once.
+    bytes = residency_.memory(tree);
     walk_ms = ms_since(t0);
     if (tree.size() > 0) bytes_per_node_ = double(bytes - sizeof(octomap::OcTree)) / double(tree.size());
     groups = bytes > max_bytes_ ? SIZE_MAX : 1;
@@ -178,6 +191,12 @@ SweepSpill MapResidency::sweep_hooks(const RegionGrid& sweep) {
     if (inside.empty()) return;
     for (RegionId r : inside) residency_.bring_back(tree, r);  // throws when the store refuses: the sweep stops
     count_residency_change();
+  };
+  s.visiting = [this](const octomap::OcTreeKey& min_key, unsigned depth) {
+    std::lock_guard lock(mutex_);
+    const auto last = static_cast<uint16_t>((1u << (16 - depth)) - 1);
+    residency_.changed_box(min_key, octomap::OcTreeKey(uint16_t(min_key[0] | last), uint16_t(min_key[1] | last),
+                                                       uint16_t(min_key[2] | last)));
   };
   s.spilled = [this, sweep](RegionId id) {
     std::lock_guard lock(mutex_);

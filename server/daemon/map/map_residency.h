@@ -11,8 +11,9 @@
 //   the store (fill_copy), so every snapshot and save is the whole map.
 // Every batch of evictions or restores counts as one map change (count_residency_change).
 //
-// Memory is counted as OctoMap's memoryUsage() counts it: the tree is walked only when the
-// running estimate (nodes times the bytes a node took at the last walk) passes the bound;
+// Memory is counted as OctoMap's memoryUsage() counts it: exactly (octree/region_tally.h:
+// the nodes above the region depth and the regions changed since the last count are walked)
+// when the running estimate (nodes times the bytes a node took at the last count) passes the bound;
 // eviction then goes down to kLowWater of the bound. Between kSoftStart and the bound each
 // change spills one sibling group by the estimate alone (no walk), so the map rarely gets
 // there: the cost is spread over the scans (docs/BENCHMARKS.md "The memory bound").
@@ -53,6 +54,7 @@ struct MapResidencyStats {
   double enforce_ms = 0, walk_ms = 0, touch_ms = 0;
   double max_enforce_ms = 0, max_touch_ms = 0;
   ResidencyCosts costs;
+  uint64_t regions_recounted = 0, regions_reused = 0;  // by the exact counts (octree/region_tally.h)
 };
 
 // One line saying where the bound's time went between `before` and `now` (the daemon logs it
@@ -78,6 +80,9 @@ class MapResidency {
   // Under the exclusive map lock: brings back every region meeting the boxes (queries, edits).
   // Throws RegionStoreError-like std::runtime_error when the store refuses.
   void touch_boxes(octomap::OcTree& tree, std::span<const query::KeyBox> boxes);
+  // Under the exclusive map lock, before an edit changes the boxes (the exact memory count,
+  // octree/region_tally.h, recounts them).
+  void will_change(std::span<const query::KeyBox> boxes);
   // Under the map lock (shared is enough): whether a box meets a spilled region.
   bool any_spilled_in(std::span<const query::KeyBox> boxes) const;
   // Under the exclusive map lock, after a change: spills past the bound. Never throws: a store

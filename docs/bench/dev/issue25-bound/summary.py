@@ -45,15 +45,15 @@ if per_mode["off"] and per_mode["on"]:
 cost = re.compile(r"memory bound costs: (\d+) passes evicted (\d+) regions in ([0-9.]+) ms \(most ([0-9.]+) ms a "
                   r"pass; walks ([0-9.]+), list ([0-9.]+), encode ([0-9.]+), store write ([0-9.]+), strip "
                   r"([0-9.]+)\); (\d+) restores in ([0-9.]+) ms \(most ([0-9.]+) ms a scan; store read ([0-9.]+), "
-                  r"rebuild ([0-9.]+)\)")
+                  r"rebuild ([0-9.]+)\)(?:; exact counts recounted (\d+) regions, reused (\d+))?")
 names = ["passes", "evicted", "evict ms", "most a pass", "walks", "list", "encode", "store write", "strip",
-         "restores", "restore ms", "most a scan", "store read", "rebuild"]
+         "restores", "restore ms", "most a scan", "store read", "rebuild", "regions recounted", "reused"]
 for path in sorted(out.glob("server-on*.log")):
     total = [0.0] * len(names)
     for line in path.open(errors="replace"):
         m = cost.search(line)
         if m:
             for i, v in enumerate(m.groups()):
-                total[i] = max(total[i], float(v)) if names[i].startswith("most") else total[i] + float(v)
+                total[i] = max(total[i], float(v or 0)) if names[i].startswith("most") else total[i] + float(v or 0)
     if any(total):
         print(f"{path.name}: " + ", ".join(f"{n} {v:.0f}" for n, v in zip(names, total)))
