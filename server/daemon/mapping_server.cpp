@@ -53,6 +53,9 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
   if (cfg_.resolution_from_file) take_resolution_from_file();
   load_or_create_map();
   open_memory_bound();
+  // The leaves counted once, before anything reads or changes the map; from here on every
+  // change keeps the count or forgets it (MapState::leaves).
+  map_.leaves = static_cast<int64_t>(map_.tree->getNumLeafNodes());
   // The read replica would hold the whole map a memory bound keeps out of memory: with
   // --max-map-memory, readers read the map of record (as with --no-read-replica).
   if (cfg_.read_replica && cfg_.max_map_memory > 0)

@@ -182,10 +182,11 @@ void MapEngine::shoot_tiled(const RayBatch& batch, ShotScan& out) {
   }
 }
 
-void MapEngine::apply(ShotScan& scan, octomap::OcTree& tree, LeafChanges* changes) const {
+std::optional<int64_t> MapEngine::apply(ShotScan& scan, octomap::OcTree& tree, LeafChanges* changes) const {
   const auto t0 = SteadyClock::now();
-  octree_stage_.apply(tree, scan.voxels, changes);
+  const std::optional<int64_t> leaf_change = octree_stage_.apply(tree, scan.voxels, changes);
   scan.shoot.times.octree_ms += ms_since(t0);
+  return leaf_change;
 }
 
 }  // namespace ort

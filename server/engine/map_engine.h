@@ -8,6 +8,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -113,7 +114,9 @@ class MapEngine {
                        double max_range, ShotScan& out);
   // Stage 2. Adds its time to out.shoot.times.octree_ms. With `changes`: reset, then every
   // finest leaf the update changed, its value before and after (octree/leaf_changes.h).
-  void apply(ShotScan& scan, octomap::OcTree& tree, LeafChanges* changes = nullptr) const;
+  // Returns the change of the tree's leaf count, where the octree stage knows it
+  // (OctreeStage::apply).
+  std::optional<int64_t> apply(ShotScan& scan, octomap::OcTree& tree, LeafChanges* changes = nullptr) const;
   // Both stages.
   void insert(const octomap::point3d& origin, std::span<const octomap::point3d> points, octomap::OcTree& tree,
               ShotScan& out) {

@@ -16,10 +16,11 @@ OctreeStage::~OctreeStage() = default;
 OctreeStage::OctreeStage(OctreeStage&&) noexcept = default;
 OctreeStage& OctreeStage::operator=(OctreeStage&&) noexcept = default;
 
-void OctreeStage::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates, LeafChanges* changes) {
+std::optional<int64_t> OctreeStage::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
+                                          LeafChanges* changes) {
   if (opts_.mode == OctreeUpdateMode::kSequential) {
     apply_updates_sequential(tree, updates, changes);
-    return;
+    return std::nullopt;
   }
   if (!batched_) {
     BatchedUpdateOptions o;
@@ -27,7 +28,7 @@ void OctreeStage::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> upda
     o.helper_nice = opts_.helper_nice;
     batched_ = std::make_unique<BatchedOctreeUpdater>(o);
   }
-  batched_->apply(tree, updates, nullptr, changes);
+  return batched_->apply(tree, updates, nullptr, changes);
 }
 
 }  // namespace ort

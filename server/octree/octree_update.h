@@ -3,7 +3,9 @@
 // OctoMap's insertPointCloud gives.
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 
 #include <octomap/OcTree.h>
@@ -51,7 +53,10 @@ class OctreeStage {
   OctreeStage& operator=(OctreeStage&&) noexcept;
 
   // With `changes`: reset and filled with what the update changed (leaf_changes.h).
-  void apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates, LeafChanges* changes = nullptr);
+  // Returns the change of the tree's leaf count (getNumLeafNodes()) without a walk; none
+  // where the stage cannot say (sequential mode, change detection on).
+  std::optional<int64_t> apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
+                               LeafChanges* changes = nullptr);
 
  private:
   OctreeUpdateOptions opts_;

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -130,6 +131,7 @@ void run(unsigned seed, int batches, void (*sensor)(OcTree&), BlockCounts& count
   }
   BlockBatches gen(seed);
   LeafChanges log;
+  std::vector<int64_t> leaves(opts.size(), 0);  // from each update's leaf count change
   for (int b = 0; b < batches; ++b) {
     const VoxelList batch = gen.next(*reference, counts);
     const test::KeyValues before = test::values_of(*reference, batch);
@@ -137,8 +139,11 @@ void run(unsigned seed, int batches, void (*sensor)(OcTree&), BlockCounts& count
     const test::KeyChanges truth = test::true_changes(before, test::values_of(*reference, batch));
     for (size_t v = 0; v < opts.size(); ++v) {
       // Every other batch with the change log: the shortcut logs each leaf of the block.
-      updaters[v]->apply(*trees[v], batch, nullptr, b % 2 ? &log : nullptr);
+      const std::optional<int64_t> leaf_change = updaters[v]->apply(*trees[v], batch, nullptr, b % 2 ? &log : nullptr);
       ASSERT_TRUE(test::same_tree(*reference, *trees[v])) << "variant " << v << ", seed " << seed << ", batch " << b;
+      ASSERT_TRUE(leaf_change.has_value());
+      leaves[v] += *leaf_change;
+      ASSERT_EQ(leaves[v], static_cast<int64_t>(reference->getNumLeafNodes())) << "leaf count, variant " << v;
       if (b % 2) {
         ASSERT_EQ(test::collapse(log), truth) << "variant " << v << ", seed " << seed << ", batch " << b;
       }

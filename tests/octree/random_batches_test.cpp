@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -135,6 +136,9 @@ void run_scenario(unsigned seed, int batches, void (*sensor)(OcTree&), Start sta
         for (const VoxelUpdate& u : pre) t->updateNode(u.key(), u.occupied(), /*lazy_eval=*/true);
     }
   }
+  // The leaf count each update returns (no walk), kept from the start's.
+  std::vector<int64_t> leaves;
+  for (auto& t : trees) leaves.push_back(static_cast<int64_t>(t->getNumLeafNodes()));
   for (int b = 0; b < batches; ++b) {
     const VoxelList batch = gen.next();
     count_cases(*reference, batch, counts);
@@ -144,8 +148,12 @@ void run_scenario(unsigned seed, int batches, void (*sensor)(OcTree&), Start sta
     if (!std::includes(pruned_before.begin(), pruned_before.end(), pruned_after.begin(), pruned_after.end()))
       ++counts.batches_pruning;
     for (size_t v = 0; v < vs.size(); ++v) {
-      updaters[v]->apply(*trees[v], batch);
+      const std::optional<int64_t> leaf_change = updaters[v]->apply(*trees[v], batch);
       ASSERT_TRUE(test::same_tree(*reference, *trees[v])) << vs[v].name << ", seed " << seed << ", batch " << b;
+      ASSERT_TRUE(leaf_change.has_value());
+      leaves[v] += *leaf_change;
+      ASSERT_EQ(leaves[v], static_cast<int64_t>(reference->getNumLeafNodes()))
+          << "leaf count, " << vs[v].name << ", seed " << seed << ", batch " << b;
     }
   }
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -45,6 +46,7 @@ void check_data_set(const std::string& graph) {
     unsigned threads;
     octomap::OcTree tree{0.1};
     std::unique_ptr<BatchedOctreeUpdater> updater;
+    int64_t leaves = 0;  // from each update's leaf count change (no walk)
   };
   std::vector<std::unique_ptr<Batched>> batched;
   for (unsigned threads : {1u, 2u, 7u, 16u}) {
@@ -62,12 +64,16 @@ void check_data_set(const std::string& graph) {
       voxels += lists[s].size();
       for (auto& b : batched) {
         BatchedUpdateStats stats;
-        b->updater->apply(b->tree, lists[s], &stats);
+        const std::optional<int64_t> leaf_change = b->updater->apply(b->tree, lists[s], &stats);
         if (b->threads > 1) {
           EXPECT_GT(stats.subtrees, b->threads) << "the scan was not split";
         }
         ASSERT_TRUE(test::same_tree(reference, b->tree))
             << graph << ", " << b->threads << " threads, pass " << pass << ", scan " << s;
+        ASSERT_TRUE(leaf_change.has_value());
+        b->leaves += *leaf_change;
+        ASSERT_EQ(b->leaves, static_cast<int64_t>(reference.getNumLeafNodes()))
+            << "leaf count, " << graph << ", " << b->threads << " threads, pass " << pass << ", scan " << s;
       }
     }
   }
@@ -98,14 +104,18 @@ void check_joined_scans(const std::string& graph, size_t join) {
   opts.threads = 2;
   BatchedOctreeUpdater updater(opts);
   size_t repeated = 0;
+  int64_t leaves = 0;
   for (size_t s = 0; s < sequence.size(); s += join) {
     VoxelList joined;
     for (size_t k = s; k < std::min(sequence.size(), s + join); ++k) {
       apply_updates_sequential(reference, *sequence[k]);
       joined.insert(joined.end(), sequence[k]->begin(), sequence[k]->end());
     }
-    updater.apply(joined_tree, joined);
+    const std::optional<int64_t> leaf_change = updater.apply(joined_tree, joined);
     ASSERT_TRUE(test::same_tree(reference, joined_tree)) << graph << ", scans from " << s;
+    ASSERT_TRUE(leaf_change.has_value());
+    leaves += *leaf_change;
+    ASSERT_EQ(leaves, static_cast<int64_t>(reference.getNumLeafNodes())) << "leaf count, scans from " << s;
     std::vector<uint64_t> codes;
     for (const VoxelUpdate& u : joined) codes.push_back(uint64_t{u.x} << 32 | uint64_t{u.y} << 16 | u.z);
     std::sort(codes.begin(), codes.end());

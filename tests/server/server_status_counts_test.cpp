@@ -3,6 +3,7 @@
 // the run summary's slowest scans as the pipeline records them, and the LCM thread's handler
 // errors as the status and the log report them.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <set>
@@ -13,8 +14,11 @@
 #include <gtest/gtest.h>
 
 #include "daemon/mapping_server.h"
+#include "octomap_rt/map_edit_ack_t.hpp"
+#include "octomap_rt/map_edit_t.hpp"
 #include "protocol/channels.h"
 #include "scene/scan_set.h"
+#include "server/query_test_support.h"
 #include "server/scan_fixtures.h"
 #include "support/test_data.h"
 
@@ -49,6 +53,88 @@ TEST(ServerStatusCounts, BigMapIsExactOnceDrained) {
     EXPECT_NEAR(static_cast<double>(status.memory_bytes), static_cast<double>(t.memoryUsage()), 1024.0);
     return 0;
   });
+}
+
+// The status' leaf count is OctoMap's getNumLeafNodes() of the map at every status while a big
+// map grows (the octree stage's running count, with and without the read replica: no walk of
+// the tree, which made the count lag up to 10 s behind), after a reset and at every status of
+// scans from the empty tree again; after clear-boxes and decay slices (changes that do not say
+// how they changed the leaves) once the status counted them again (within a second).
+TEST(ServerStatusCounts, LeafCountIsOctomapsAfterScansEditsResetsAndDecay) {
+  const std::string path = data_file("3dtk_dat/3dtk_3scans.graph");
+  if (path.empty()) return;
+  const ScanSet set = load_scan_graph(path);
+  for (const bool replica : {false, true}) {
+    SCOPED_TRACE(replica ? "with the read replica" : "without the read replica");
+    lcm::LCM lc("memq://");
+    auto cfg = test_config(0.1, true);
+    cfg.read_replica = replica;
+    cfg.queries.control_token = kToken;
+    cfg.status_period_s = 0.02;
+    cfg.upkeep.decay_half_life_s = 10;
+    cfg.upkeep.decay_step_s = 5;
+    cfg.upkeep.manual = true;
+    cfg.upkeep.slice_nodes = 20'000;
+    std::ostringstream log;
+    daemon::MappingServer server(cfg, lc, log);
+    Replies replies(server);
+    server.start();
+    int64_t seq = 0;
+    // After a change that forgets the count, the status counts it again by a walk, spaced to
+    // at most 1/20 of the time: within a second here (the replica, if any, caught up first).
+    auto expect_exact = [&](const std::string& after) {
+      (void)server.with_readable_map([](const octomap::OcTree&) { return 0; });
+      const auto leaves = server.with_map([](const octomap::OcTree& t) { return t.getNumLeafNodes(); });
+      int64_t counted = -1;
+      for (int i = 0; i < 100 && counted != static_cast<int64_t>(leaves); ++i) {
+        if (i > 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        counted = server.status().num_leaf_nodes;
+      }
+      EXPECT_EQ(counted, static_cast<int64_t>(leaves)) << "after " << after;
+    };
+    // At once (no walk): the map of record's running count.
+    auto expect_kept = [&](const std::string& after) {
+      const auto status = server.status();
+      const auto leaves = server.with_map([](const octomap::OcTree& t) { return t.getNumLeafNodes(); });
+      EXPECT_EQ(status.num_leaf_nodes, static_cast<int64_t>(leaves)) << "after " << after;
+    };
+    auto scan = [&](size_t k) {
+      const auto msg = scan_message(set.scans[k], "husky1", seq++);
+      lc.publish(std::string(ort::protocol::kScanChannelPrefix) + "HUSKY1", &msg);
+      ASSERT_TRUE(wait_until_done(server, seq));
+    };
+    for (int pass = 0; pass < 2; ++pass)
+      for (size_t k = 0; k < set.scans.size(); ++k) {
+        scan(k);
+        expect_kept("scan " + std::to_string(seq));
+      }
+    const int64_t nodes = server.with_map([](const octomap::OcTree& t) { return static_cast<int64_t>(t.size()); });
+    EXPECT_GT(nodes, 65'536) << "a map big enough that the status never counted its leaves at every status";
+    int64_t edit_id = 0;
+    auto edit = [&](int8_t op, const std::array<double, 3>& lo, const std::array<double, 3>& hi) {
+      octomap_rt::map_edit_t e{};
+      e.request_id = ++edit_id, e.client_id = "op", e.reply_channel = kReply, e.op = op;
+      std::copy(lo.begin(), lo.end(), e.box_min), std::copy(hi.begin(), hi.end(), e.box_max);
+      sign(e);
+      lc.publish(ort::protocol::kMapEditChannel, &e);
+      ASSERT_EQ(replies.wait_for<octomap_rt::map_edit_ack_t>(edit_id).status, Reply::REPLY_OK);
+    };
+    edit(octomap_rt::map_edit_t::OP_CLEAR_TO_UNKNOWN, {-2.05, -3.3, -0.4}, {3.3, 2.05, 1.1});
+    expect_exact("a clear-box to unknown");
+    edit(octomap_rt::map_edit_t::OP_CLEAR_TO_FREE, {4.05, 1.3, -0.4}, {6.3, 3.05, 0.9});
+    expect_exact("a clear-box to free");
+    server.upkeep()->decay_steps(3);
+    expect_exact("decay slices");
+    scan(0);
+    expect_exact("a scan after the decay");
+    edit(octomap_rt::map_edit_t::OP_RESET, {0, 0, 0}, {0, 0, 0});
+    expect_kept("a reset");
+    scan(1);
+    expect_kept("a scan into the empty map");
+    scan(2);
+    expect_kept("another scan");
+    server.stop();
+  }
 }
 
 // The summary's slowest scans are scans the daemon applied (robot, seq), each with parts that

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 
 #include <octomap/OcTree.h>
 
@@ -22,8 +23,10 @@ using MapStep = std::function<void(octomap::OcTree&)>;
 uint64_t new_map_epoch();
 
 // The map changed and its history goes on (a scan, a clear-box, a decay or eviction step):
-// the state id grows by one. Returns the new id.
-uint64_t count_map_change(MapState& map);
+// the state id grows by one. `leaf_change`: how the change changed the tree's leaf count
+// (MapState::leaves), where the changer knows it (the octree stage does); none: the count is
+// forgotten until the status counts it again. Returns the new id.
+uint64_t count_map_change(MapState& map, std::optional<int64_t> leaf_change = std::nullopt);
 
 // The map's history forks (a reset, another map put in its place): a new epoch, and the
 // state id grows by one as for any change. Returns the new id.
@@ -32,7 +35,8 @@ uint64_t fork_map_history(MapState& map);
 // The one way to change the map other than by a scan (edits, resets, the long-lived map's
 // decay and eviction): applies `step` to the map of record's tree, counts it (or, with
 // `forks_history`, forks), and replays it on the read replica. Caller holds the map lock
-// exclusively. Returns the new state id.
+// exclusively. Returns the new state id. A step does not say how it changed the leaves: the
+// leaf count is 0 after a step that left the tree empty (a reset), else forgotten.
 uint64_t apply_map_step(MapState& map, const MapStep& step, bool forks_history = false);
 
 }  // namespace ort::daemon

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <shared_mutex>
 #include <span>
 
@@ -19,6 +20,7 @@ MapReplica::MapReplica(const MapState& map, const OctreeUpdateOptions& octree, u
   state_.scans = map.scans;
   state_.last_scan_utime = map.last_scan_utime;
   state_.newest_scan = map.newest_scan;
+  state_.leaves.store(map.leaves.load(std::memory_order_relaxed), std::memory_order_relaxed);
   stats_.version = map.version;
   thread_ = std::thread([this, nice] {
     lower_this_thread_priority(nice);
@@ -99,10 +101,18 @@ void MapReplica::apply_batch(std::deque<Item>& batch) {
     voxels = joined_;
   }
   std::unique_lock lock(state_.mutex);
+  // The leaf count as the map of record keeps it (daemon/map/map_identity.h): the octree
+  // stage says how the batch changed it; a step does not (0 if it left the tree empty).
+  std::optional<int64_t> leaf_change;
   if (batch.front().step)
     batch.front().step(*state_.tree);
   else
-    stage_.apply(*state_.tree, voxels);
+    leaf_change = stage_.apply(*state_.tree, voxels);
+  const int64_t leaves = state_.leaves.load(std::memory_order_relaxed);
+  state_.leaves.store(!state_.tree->getRoot()      ? 0
+                      : leaves >= 0 && leaf_change ? leaves + *leaf_change
+                                                   : -1,
+                      std::memory_order_relaxed);
   for (Item& it : batch)
     if (!it.robot.empty()) state_.newest_scan[it.robot] = std::move(it.newest);
   const Item& last = batch.back();

@@ -3,6 +3,7 @@
 // scans. Stage 2 holds the lock for one scan's octree update at a time.
 #pragma once
 
+#include <atomic>
 #include <cctype>
 #include <chrono>
 #include <condition_variable>
@@ -58,6 +59,13 @@ struct MapState {
   // and the map state a query was answered on are `version`.
   uint64_t version = 0;
   uint64_t epoch = 0;
+  // The tree's leaf count (OctoMap's getNumLeafNodes()) kept without walking the tree: each
+  // change through daemon/map/map_identity.h that knows how it changed the leaves adds that
+  // (a scan through the batched octree stage, a reset); -1 after one that does not say (a
+  // clear-box, a decay or clearing slice, an eviction or restore) until the status counts
+  // the leaves again (daemon/status/map_figures.h). Changed under the exclusive lock, or by
+  // that count under a shared lock (the status' calls are serialized): hence atomic.
+  std::atomic<int64_t> leaves{-1};
   uint64_t scans = 0;                     // applied scans over the map's life (the applied order's length)
   int64_t last_scan_utime = 0;            // utime of the newest applied scan
   octomap::point3d last_scan_origin;      // its sensor origin (where a clipped grid is centred)

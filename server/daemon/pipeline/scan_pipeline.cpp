@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <optional>
 #include <ostream>
 
 #include "core/clock.h"
@@ -224,7 +225,7 @@ void ScanPipeline::apply(ShotJob& job) {
     if (std::string why; map_.residency && !map_.residency->touch_scan(*map_.tree, job.shot.voxels, why))
       throw std::runtime_error(why);
     const auto nodes_before = static_cast<int64_t>(map_.tree->size());
-    engine_.apply(job.shot, *map_.tree, map_.observer ? &changes_ : nullptr);
+    const std::optional<int64_t> leaf_change = engine_.apply(job.shot, *map_.tree, map_.observer ? &changes_ : nullptr);
     new_nodes = static_cast<int64_t>(map_.tree->size()) - nodes_before;
     // A scan stamped in the far future must not pin the map's time there: its utime in the
     // map (order, snapshots, replies) is bounded by the daemon's clock plus the clock skew
@@ -232,7 +233,7 @@ void ScanPipeline::apply(ShotJob& job) {
     const int64_t utime = std::min(job.utime, now_utime() + gate_.max_future_us());
     map_.order.append(AppliedEntry{job.robot_id, job.seq, utime});
     map_.scans++;
-    count_map_change(map_);
+    count_map_change(map_, leaf_change);
     map_.last_scan_utime = std::max(map_.last_scan_utime, utime);
     map_.last_scan_origin = job.origin;
     const auto updated = SteadyClock::now();

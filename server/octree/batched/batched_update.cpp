@@ -39,28 +39,37 @@ BatchedOctreeUpdater::BatchedOctreeUpdater(const BatchedUpdateOptions& opts)
 
 BatchedOctreeUpdater::~BatchedOctreeUpdater() = default;
 
-void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates, BatchedUpdateStats* stats,
-                                 LeafChanges* changes) {
+std::optional<int64_t> BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
+                                                   BatchedUpdateStats* stats, LeafChanges* changes) {
   BatchedUpdateStats local;
   BatchedUpdateStats& st = stats ? *stats : local;
   st = BatchedUpdateStats{};
-  if (tree.isChangeDetectionEnabled() || updates.empty()) {
-    // Only updateNodeRecurs maintains the changed-keys set.
+  if (updates.empty()) {
     apply_updates_sequential(tree, updates, changes);
-    return;
+    return 0;
+  }
+  if (tree.isChangeDetectionEnabled()) {
+    // Only updateNodeRecurs maintains the changed-keys set; it does not say what it made.
+    apply_updates_sequential(tree, updates, changes);
+    return std::nullopt;
   }
   if (changes) changes->reset(pool_.size());
+  int64_t root_path_leaves = 0;  // leaves made with the root (the tree was empty)
   if (!tree.getRoot()) {
     // The root can only be made through updateNode; any voxel may go first (see header).
-    // Its change is read back first (order 0; the subtrees follow from 1).
+    // Its change is read back first (order 0; the subtrees follow from 1). The tree it makes
+    // is one path (17 nodes at most): its leaves are counted, and the change below is
+    // counted from there.
     update_node_logged(tree, updates.front(), changes ? &changes->lane(0) : nullptr);
     if (changes) changes->close_segment(0, 0);
     updates = updates.subspan(1);
+    root_path_leaves = static_cast<int64_t>(tree.getNumLeafNodes());
     if (updates.empty()) {
       if (changes) changes->finish();
-      return;
+      return root_path_leaves;
     }
   }
+  const auto nodes_start = static_cast<int64_t>(tree.size());
   const bool parallel = pool_.size() > 1 && updates.size() >= opts_.min_parallel_voxels;
 
   const auto t0 = SteadyClock::now();
@@ -78,6 +87,7 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
 
   std::atomic<size_t> next{0};
   std::vector<double> sort_ms(workers, 0.0);
+  std::vector<int64_t> inner_nodes(workers, 0);                  // per worker: inner nodes made less those pruned
   const unsigned node_bits = 3 * (kTreeDepth - buckets_.depth);  // a bucket's voxels lie below one node at depth D
   auto work = [&](unsigned worker) {
     octomap::OcTree& node_ops = *counting_trees_[worker];
@@ -91,9 +101,12 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
       } else {
         sort_bucket(voxels, sort_tmp_[worker], node_bits);
       }
-      const bool changed = update_subtree(tree, node_ops, s.root, voxels, changes ? &changes->lane(worker) : nullptr);
+      int64_t inner = 0;
+      const bool changed =
+          update_subtree(tree, node_ops, s.root, voxels, changes ? &changes->lane(worker) : nullptr, inner);
       if (changes) changes->close_segment(worker, order[k] + 1);
-      top.child_done(s.parent, changed, node_ops);
+      top.child_done(s.parent, changed, node_ops, inner);
+      inner_nodes[worker] += inner;
     }
   };
   if (parallel)
@@ -109,6 +122,11 @@ void BatchedOctreeUpdater::apply(octomap::OcTree& tree, std::span<const VoxelUpd
   for (auto& counting : counting_trees_) change += take_node_count(*counting);
   add_to_node_count(tree, change);
   st.node_count_change = change;
+
+  // leaves = nodes - inner nodes, before and after.
+  int64_t inner = top.inner_nodes_made();
+  for (int64_t n : inner_nodes) inner += n;
+  return root_path_leaves + (static_cast<int64_t>(tree.size()) - nodes_start - inner);
 }
 
 void apply_updates_batched(octomap::OcTree& tree, std::span<const VoxelUpdate> updates, unsigned threads) {

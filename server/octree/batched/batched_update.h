@@ -18,7 +18,9 @@
 //   2. SplitTop: the nodes above them made, one thread, a few hundred nodes at most
 //   3. per bucket, largest first: sort it (it is in this thread's cache now), update_subtree,
 //      and settle the nodes above when it was their last child (split_top.h)
-//   4. the worker threads' net node count added to the tree's counter (node_count.h)
+//   4. the worker threads' net node count added to the tree's counter (node_count.h); the
+//      leaf count's change is that less the inner nodes made (leaves given a first child,
+//      expansions) and plus those pruned, each counted where it happens
 //
 // A leaf above the finest level, made by this batch (value 0) or pruned (value v), whose whole
 // subtree the list updates one way (8^k keys, one state: free space near a LiDAR, mostly) is
@@ -36,7 +38,9 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -76,8 +80,11 @@ class BatchedOctreeUpdater {
 
   // With `changes`: reset, then filled with every finest leaf the update changed, each
   // worker writing its own lane while it updates its subtrees (leaf_changes.h).
-  void apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates, BatchedUpdateStats* stats = nullptr,
-             LeafChanges* changes = nullptr);
+  // Returns how the tree's leaf count (getNumLeafNodes()) changed, counted as the nodes are
+  // made, expanded and pruned (no walk); none on a tree with change detection on (the
+  // updateNode loop does not say).
+  std::optional<int64_t> apply(octomap::OcTree& tree, std::span<const VoxelUpdate> updates,
+                               BatchedUpdateStats* stats = nullptr, LeafChanges* changes = nullptr);
 
   unsigned threads() const { return pool_.size(); }
 

@@ -19,6 +19,10 @@ struct ChildArrayAccess : octomap::OcTreeNode {
 };
 }  // namespace detail
 
+// Whether `node` has its child array: a node made in this update and not yet given a child
+// has none (only deleteNodeChild leaves an empty array behind, and this update never calls it).
+inline bool has_child_array(octomap::OcTreeNode& node) { return detail::ChildArrayAccess::of(node) != nullptr; }
+
 // createNodeChild(parent, index) without the count: the caller adds the nodes it made to the
 // tree's counter (add_to_node_count). `parent` has no child at `index`.
 inline octomap::OcTreeNode* make_child_node(octomap::OcTreeNode& parent, unsigned index) {

@@ -42,8 +42,10 @@ SplitTop::SplitTop(octomap::OcTree& tree, VoxelBuckets& buckets) {
       } else if (!nodes_[parent].just_created && !tree.nodeHasChildren(node)) {
         if (!any_voxel_applies(tree, *node, voxels)) break;  // all return early: skip the bucket
         tree.expandNode(node);
+        ++inner_made_;
         child = tree.getNodeChild(node, pos);
       } else {
+        if (!tree.nodeHasChildren(node)) ++inner_made_;  // a node made here gets its first child
         child = tree.createNodeChild(node, pos);
         created = true;
       }
@@ -68,17 +70,17 @@ SplitTop::SplitTop(octomap::OcTree& tree, VoxelBuckets& buckets) {
   }
   // Nodes left without children (all their buckets skipped) are done, unchanged, now.
   for (size_t i = 0; i < nodes_.size(); ++i)
-    if (children[i] == 0 && nodes_[i].parent >= 0) child_done(nodes_[i].parent, false, tree);
+    if (children[i] == 0 && nodes_[i].parent >= 0) child_done(nodes_[i].parent, false, tree, inner_made_);
 }
 
-void SplitTop::child_done(int parent, bool changed, octomap::OcTree& node_ops) {
+void SplitTop::child_done(int parent, bool changed, octomap::OcTree& node_ops, int64_t& inner_nodes) {
   while (parent >= 0) {
     if (changed) changed_[parent].store(true, std::memory_order_relaxed);
     // acq_rel: the last child's thread sees every other child's writes to the tree.
     if (pending_[parent].fetch_sub(1, std::memory_order_acq_rel) != 1) return;
     const Node& n = nodes_[parent];
     changed = changed_[parent].load(std::memory_order_relaxed);
-    if (changed) settle_inner_node(node_ops, n.node);
+    if (changed) inner_nodes -= settle_inner_node(node_ops, n.node);
     parent = n.parent;
   }
 }

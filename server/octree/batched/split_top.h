@@ -7,6 +7,7 @@
 #pragma once
 
 #include <atomic>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -40,14 +41,19 @@ class SplitTop {
 
   // Called once per child (planned subtree, or node of the top) when it is done; `changed`:
   // a voxel below it was applied. The last child's thread settles the parent with
-  // `node_ops`'s node methods (see subtree_update.h), and so on upwards. Thread-safe.
-  void child_done(int parent, bool changed, octomap::OcTree& node_ops);
+  // `node_ops`'s node methods (see subtree_update.h), and so on upwards; each prune is one
+  // inner node less in `inner_nodes` (the calling thread's). Thread-safe.
+  void child_done(int parent, bool changed, octomap::OcTree& node_ops, int64_t& inner_nodes);
+
+  // Inner nodes the walk down made: leaves given their first child, pruned nodes expanded.
+  int64_t inner_nodes_made() const { return inner_made_; }
 
  private:
   std::vector<Node> nodes_;                      // root first, each node after its parent
   std::vector<PlannedSubtree> subtrees_;         // in Morton order
   std::unique_ptr<std::atomic<int>[]> pending_;  // children not yet done, per node
   std::unique_ptr<std::atomic<bool>[]> changed_;
+  int64_t inner_made_ = 0;
 };
 
 }  // namespace ort

@@ -60,11 +60,12 @@ inline bool apply_to_leaf(const octomap::OcTree& tree, octomap::OcTreeNode& leaf
 }  // namespace
 
 bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, const SubtreeRoot& root,
-                    std::span<const SortedVoxel> voxels, std::vector<LeafChange>* changes) {
+                    std::span<const SortedVoxel> voxels, std::vector<LeafChange>* changes, int64_t& inner_nodes) {
   const float hit = tree.getProbHitLog();
   const float miss = tree.getProbMissLog();
 
-  int64_t made = 0;  // nodes made by make_child_node, counted into node_ops at the end
+  int64_t made = 0;   // nodes made by make_child_node, counted into node_ops at the end
+  int64_t inner = 0;  // inner nodes made (a leaf's first child, an expansion) less those pruned
   std::array<PathNode, kTreeDepth + 1> path;
   path[root.depth] = PathNode{root.node, root.just_created, false};
   unsigned depth = root.depth;  // depth of the deepest node on the path
@@ -76,7 +77,7 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
     for (; depth > target; --depth) {
       PathNode& p = path[depth];
       if (!p.changed) continue;
-      if (depth < kTreeDepth) settle_inner_node(node_ops, p.node);
+      if (depth < kTreeDepth) inner -= settle_inner_node(node_ops, p.node);
       path[depth - 1].changed = true;
     }
   };
@@ -122,8 +123,11 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
           }
         }
         node_ops.expandNode(p.node);
+        ++inner;
         child = node_ops.getNodeChild(p.node, pos);
       } else {
+        // A node made in this update gets its first child (any other node here has children).
+        if (p.just_created && !has_child_array(*p.node)) ++inner;
         child = make_child_node(*p.node, pos);
         ++made;
         created = true;
@@ -162,7 +166,8 @@ bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, cons
 
   // The root of the subtree is settled here too; its ancestors are the caller's.
   PathNode& top = path[root.depth];
-  if (top.changed && root.depth < kTreeDepth) settle_inner_node(node_ops, top.node);
+  if (top.changed && root.depth < kTreeDepth) inner -= settle_inner_node(node_ops, top.node);
+  inner_nodes += inner;
   return top.changed;
 }
 

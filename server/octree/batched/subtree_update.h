@@ -8,6 +8,7 @@
 // gives (see batched_update.h for why the order of the voxels does not matter).
 #pragma once
 
+#include <cstdint>
 #include <limits>
 #include <span>
 
@@ -40,8 +41,12 @@ struct SubtreeRoot {
 // With `changes`, every finest leaf whose value the pass changed is appended to it, in the
 // voxels' order (leaf_changes.h), also each key of a block made a single leaf at once
 // (batched_update.h).
+//
+// `inner_nodes` gets the net number of inner nodes (nodes with children) the pass made: with
+// the node count's change it gives the leaf count's (leaves = nodes - inner nodes), so the
+// daemon keeps OctoMap's getNumLeafNodes() without walking the tree (batched_update.h).
 bool update_subtree(const octomap::OcTree& tree, octomap::OcTree& node_ops, const SubtreeRoot& root,
-                    std::span<const SortedVoxel> voxels, std::vector<LeafChange>* changes = nullptr);
+                    std::span<const SortedVoxel> voxels, std::vector<LeafChange>* changes, int64_t& inner_nodes);
 
 // Whether OctoMap's updateNode would return early for an update of `log_odds_update` that
 // finds `node` as the deepest existing node on its path: already at the clamping bound in
@@ -70,8 +75,9 @@ inline void update_leaf_log_odds(const octomap::OcTree& tree, octomap::OcTreeNod
 // pruned when its 8 children are leaves of one value (pruneNode), else the max of its
 // children's log-odds (updateOccupancyChildren). One read of the children decides both,
 // with isNodeCollapsible's and getMaxChildLogOdds's comparisons; the prune itself goes
-// through `node_ops` (it frees the children and counts them), which checks again.
-inline void settle_inner_node(octomap::OcTree& node_ops, octomap::OcTreeNode* node) {
+// through `node_ops` (it frees the children and counts them), which checks again. Returns
+// whether it pruned (the node is a leaf now).
+inline bool settle_inner_node(octomap::OcTree& node_ops, octomap::OcTreeNode* node) {
   float max = -std::numeric_limits<float>::max();
   bool collapsible = true;
   float first = 0;
@@ -87,8 +93,9 @@ inline void settle_inner_node(octomap::OcTree& node_ops, octomap::OcTreeNode* no
     // Once a child decides against the prune, only the max is left to find.
     if (collapsible && (!(l == first) || node_ops.nodeHasChildren(child))) collapsible = false;
   }
-  if (collapsible && node_ops.pruneNode(node)) return;
+  if (collapsible && node_ops.pruneNode(node)) return true;
   node->setLogOdds(max);
+  return false;
 }
 
 }  // namespace ort
