@@ -23,6 +23,8 @@ if(PYTHON3 AND LCM_LOGGER)
   # README's "Connect your robot": the C++ and the Python producer examples against a real server.
   octomap_rt_add_python_test(python_producers_test test_producers 300)
   octomap_rt_add_python_test(python_edits_test test_edits 300)
+  # A mirror that follows deltas, and resyncs on a new epoch (a reset).
+  octomap_rt_add_python_test(python_map_mirror_test test_map_mirror 300)
 else()
   message(WARNING "octomap-rt: python3 or lcm-logger missing: the Python client tests are not registered")
 endif()

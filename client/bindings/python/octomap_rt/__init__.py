@@ -5,9 +5,10 @@ from ._types import *  # noqa: F401,F403  (lcm-gen's own package imports: scan_t
 from .lcm_url import HOST_LOCAL_URL, LcmUrlError, default_url, parse_udpm_url  # noqa: F401
 from .transport import open_transport  # noqa: F401
 from .channels import Channels, namespace_from  # noqa: F401
-from .bt_reader import BtFormatError, BtMap, read_bt, read_bt_file  # noqa: F401
+from .bt_reader import BtFormatError, BtMap, read_bt, read_bt_file, read_bt_leaves  # noqa: F401
 from .map_client import MapClient, ServerTimeout  # noqa: F401
 from .snapshot_fetch import FetchError, Snapshot  # noqa: F401
 from .queries import FREE, OCCUPIED, UNKNOWN, QueryError  # noqa: F401
 from .distance import distance_box, distance_path, distance_points  # noqa: F401
 from .edits import MapEditor, edit_mac, sign_edit  # noqa: F401
+from .map_mirror import DeltaError, MapMirror, MirrorStats, canonical_leaves  # noqa: F401

@@ -29,7 +29,7 @@ class BtMap:
 
 
 def _header(blob: bytes):
-    """(resolution, byte offset of the tree data)."""
+    """(resolution, byte offset of the tree data; None for an empty tree)."""
     pos, first, fields = 0, True, {}
     while True:
         end = blob.find(b"\n", pos)
@@ -51,21 +51,30 @@ def _header(blob: bytes):
     if fields.get("id", "OcTree") != "OcTree":
         raise BtFormatError(f"tree type {fields['id']!r}, not OcTree")
     try:
-        return float(fields["res"]), pos
+        resolution = float(fields["res"])
     except (KeyError, ValueError):
         raise BtFormatError("missing or bad 'res' line") from None
+    # An empty tree (size 0) has no node records after the 'data' line.
+    return resolution, (None if fields.get("size") == "0" else pos)
 
 
-def read_bt(blob: bytes) -> BtMap:
-    """The leaves of a .bt file's tree (the bytes of the file, e.g. a snapshot's data)."""
-    import numpy as np
-
+def read_bt_leaves(blob: bytes):
+    """(resolution, {(depth, kx, ky, kz): occupied}) of a .bt file's bytes: every leaf by its
+    depth and its smallest key (OctoMap keys), True where occupied."""
     resolution, pos = _header(blob)
-    leaves = ([], [], [], [])  # occupied keys+depth, free keys+depth as flat lists
-    occ_keys, occ_depth, free_keys, free_depth = leaves
+    out = {}
+    for key, depth, occupied in _leaves(blob, pos):
+        out[(depth,) + key] = occupied
+    return resolution, out
+
+
+def _leaves(blob: bytes, pos: int):
+    """(smallest key, depth, occupied) of every leaf from byte `pos` on, in the writer's order."""
     # Depth-first, in the writer's order: (key origin, depth) of the nodes still to read.
-    stack = [((0, 0, 0), 0)]
+    if pos is None:
+        return
     n = len(blob)
+    stack = [((0, 0, 0), 0)]
     while stack:
         origin, depth = stack.pop()
         if pos + 2 > n:
@@ -82,13 +91,20 @@ def read_bt(blob: bytes) -> BtMap:
                      origin[2] + (half if i & 4 else 0))
             if code == 3:
                 inner.append((child, depth + 1))
-            elif code == 1:  # bit 2i set, bit 2i+1 clear: free leaf
-                free_keys.append(child)
-                free_depth.append(depth + 1)
-            else:  # bit 2i+1 set: occupied leaf
-                occ_keys.append(child)
-                occ_depth.append(depth + 1)
+            else:  # 1: bit 2i set, bit 2i+1 clear: free leaf; 2: bit 2i+1 set: occupied leaf
+                yield child, depth + 1, code == 2
         stack.extend(reversed(inner))  # first child on top: the writer's order
+
+
+def read_bt(blob: bytes) -> BtMap:
+    """The leaves of a .bt file's tree (the bytes of the file, e.g. a snapshot's data)."""
+    import numpy as np
+
+    resolution, pos = _header(blob)
+    occ_keys, occ_depth, free_keys, free_depth = [], [], [], []
+    for key, depth, occupied in _leaves(blob, pos):
+        (occ_keys if occupied else free_keys).append(key)
+        (occ_depth if occupied else free_depth).append(depth)
 
     def centres(keys, depths):
         k = np.asarray(keys, dtype=np.float64).reshape(-1, 3)

@@ -30,6 +30,7 @@ class Snapshot:
     num_chunks: int
     requests: int
     seconds: float
+    map_epoch: int = 0     # the history snapshot_id counts in (docs/PROTOCOL.md "Ids")
 
 
 def fnv1a64(data: bytes) -> int:
@@ -165,4 +166,4 @@ def fetch_snapshot(transport, fmt: str = "bt", timeout_s: float = 30.0, snapshot
         raise FetchError(f"snapshot {first.snapshot_id}: {len(data)} bytes once decompressed, "
                          f"expected {first.uncompressed_size}")
     return Snapshot(first.snapshot_id, first.num_scans, fmt, data, len(blob), first.num_chunks,
-                    len(request_ids), time.monotonic() - start)
+                    len(request_ids), time.monotonic() - start, first.map_epoch)
