@@ -10,11 +10,10 @@
 #include <span>
 #include <stdexcept>
 
-#include <octomap/OcTree.h>
-
 #include "octomap_rt/box_query_t.hpp"
 #include "protocol/limits.h"
 #include "shard_client/shard_ask.h"
+#include "shard_client/shard_rays.h"
 
 namespace ort::client {
 namespace {
@@ -23,23 +22,6 @@ using detail::ask_each;
 using detail::every_shard;
 
 using Occ = octomap_rt::occupancy_reply_t;
-
-// Which of the shards' hits the ray meets first: each is the first occupied voxel of its shard
-// on the same walk, so the first of them on that walk is the map's first. OctoMap's own castRay
-// on a tree holding just those voxels walks it (its step order decides ties: a ray from a voxel
-// corner meets two voxels at the same parameter). Returns the index into `hits`.
-size_t first_on_walk(const float* o, const float* d, float max_range, double resolution,
-                     const std::vector<const float*>& hits) {
-  octomap::OcTree probe(resolution);
-  for (const float* h : hits) probe.updateNode(octomap::point3d(h[0], h[1], h[2]), true);
-  octomap::point3d end;
-  if (probe.castRay(octomap::point3d(o[0], o[1], o[2]), octomap::point3d(d[0], d[1], d[2]), end, true, max_range)) {
-    const octomap::OcTreeKey k = probe.coordToKey(end);
-    for (size_t i = 0; i < hits.size(); ++i)
-      if (probe.coordToKey(octomap::point3d(hits[i][0], hits[i][1], hits[i][2])) == k) return i;
-  }
-  return 0;
-}
 
 template <class Reply>
 void merged_header(Reply& out, const std::vector<std::optional<Reply>>& got) {
@@ -151,48 +133,12 @@ Routed<octomap_rt::box_reply_t> ShardQueries::boxes(const std::vector<Box>& boxe
 Routed<octomap_rt::ray_reply_t> ShardQueries::rays(const std::vector<float>& origins,
                                                    const std::vector<float>& directions, float max_range,
                                                    bool ignore_unknown) {
-  if (!ignore_unknown)
-    throw std::invalid_argument(
-        "a ray across shards needs ignore_unknown (--ignore-unknown): each shard knows only its own unknown space");
   Routed<octomap_rt::ray_reply_t> out;
   const auto got = ask_each<octomap_rt::ray_reply_t>(every_shard(set_.count), set_.count, out.shards, [&](uint32_t i) {
     return clients_[i]->rays(origins, directions, max_range, ignore_unknown);
   });
-  auto& r = out.reply;
-  merged_header(r, got);
-  const size_t n = origins.size() / 3;
-  r.num_rays = static_cast<int32_t>(n);
-  r.hit.assign(n, 0), r.end_state.assign(n, Occ::OCC_UNKNOWN), r.end_xyz.assign(3 * n, 0.0f);
-  r.num_xyz = static_cast<int32_t>(3 * n);
-  r.cut = Occ::CUT_NONE, r.cut_at = -1;
-  for (size_t j = 0; j < n; ++j) {
-    std::vector<const float*> hits;
-    std::vector<int> hit_shard;
-    for (uint32_t i = 0; i < set_.count; ++i) {
-      const auto& g = got[i];
-      if (!g || g->num_rays != static_cast<int32_t>(n) || !g->hit[j]) continue;
-      hits.push_back(&g->end_xyz[3 * j]);
-      hit_shard.push_back(static_cast<int>(i));
-    }
-    int from = hits.empty() ? -1
-               : hits.size() == 1
-                   ? hit_shard[0]
-                   : hit_shard[first_on_walk(&origins[3 * j], &directions[3 * j], max_range, resolution_, hits)];
-    if (from < 0) {  // no shard hit: every walk ended at the same place; its owner knows its state
-      for (uint32_t i = 0; i < set_.count && from < 0; ++i)
-        if (got[i] && got[i]->num_rays == static_cast<int32_t>(n)) from = static_cast<int>(i);
-      if (from < 0) continue;
-      const float* e = &got[from]->end_xyz[3 * j];
-      const uint32_t owner = shard_of_point(e[0], e[1], e[2]);
-      if (owner < set_.count && got[owner] && got[owner]->num_rays == static_cast<int32_t>(n))
-        from = static_cast<int>(owner);
-    }
-    const auto& g = *got[from];
-    r.hit[j] = g.hit[j], r.end_state[j] = g.end_state[j];
-    std::copy(&g.end_xyz[3 * j], &g.end_xyz[3 * j] + 3, &r.end_xyz[3 * j]);
-  }
-  for (const auto& g : got)
-    if (g && g->cut != Occ::CUT_NONE && (r.cut_at < 0 || g->cut_at < r.cut_at)) r.cut = g->cut, r.cut_at = g->cut_at;
+  merged_header(out.reply, got);
+  merge_shard_rays(out.reply, got, origins, set_, resolution_);
   return out;
 }
 

@@ -1,8 +1,8 @@
 // Queries across a shard set (docs/PROTOCOL.md, "Shards"): each shard answers for its own
 // regions, so a point goes to the shard owning its region (a coarse depth above the region
 // depth asks every shard and takes the largest value, as OctoMap's inner nodes do), a box is
-// counted on every shard and summed, and a ray is cast on every shard and gets the hit the ray
-// enters first; a distance is the smallest of the shards' within reach (shard_distance.h). A
+// counted on every shard and summed, and a ray is cast on every shard, each stopping in its own
+// regions, and gets the stop the ray meets first (shard_rays.h); a distance is the smallest of the shards' within reach (shard_distance.h). A
 // shard that does not answer leaves its part unknown, and the answer says so.
 #pragma once
 
@@ -42,8 +42,7 @@ class ShardQueries {
 
   Routed<octomap_rt::occupancy_reply_t> points(const std::vector<float>& xyz, int depth = 0);
   Routed<octomap_rt::box_reply_t> boxes(const std::vector<Box>& boxes, int8_t mode);
-  // Only with `ignore_unknown` (each shard knows only its own unknown space); throws
-  // std::invalid_argument otherwise.
+  // The one map's castRay answers, stopping at unknown space unless `ignore_unknown` (shard_rays.h).
   Routed<octomap_rt::ray_reply_t> rays(const std::vector<float>& origins, const std::vector<float>& directions,
                                        float max_range, bool ignore_unknown);
 

@@ -127,6 +127,7 @@ void MappingServer::start() {
   map_service_->open();
   QueryServiceConfig query_cfg = cfg_.queries;
   query_cfg.distance.shard = cfg_.shard;  // a shard's distances count its own regions' obstacles
+  query_cfg.shard = cfg_.shard;           // and its rays stop in its own regions only
   queries_ = std::make_unique<QueryService>(query_cfg, map_, queue_, *loop_, server_id_, cfg_.engine.resolution, log_);
   queries_->open();
   log_.info(text("distance queries run their EDT on ", queries_->distance_backend()));

@@ -1,6 +1,7 @@
 #include "query/ray_query.h"
 
 #include <cmath>
+#include <limits>
 
 #include "query/key_box.h"
 
@@ -15,6 +16,60 @@ uint64_t key_steps(const octomap::OcTree& tree, const octomap::point3d& a, const
     n += clamped_key(tree, b(i)) > clamped_key(tree, a(i)) ? clamped_key(tree, b(i)) - clamped_key(tree, a(i))
                                                            : clamped_key(tree, a(i)) - clamped_key(tree, b(i));
   return n;
+}
+
+// castRay's walk (OccupancyOcTreeBase::castRay of OctoMap 1.9: the same float and double
+// arithmetic, step for step, so a shard's walk visits the keys the one map's castRay visits)
+// stopping only at voxels `owns` accepts. The origin's key is checked by the caller.
+bool walk_owned(const octomap::OcTree& tree, const octomap::point3d& origin, const octomap::point3d& direction_in,
+                const RayBatchOptions& opt, octomap::OcTreeKey key, octomap::point3d& end) {
+  // true: the walk stops at `k` (end is set); `hit` says whether it stopped at an occupied voxel.
+  bool hit = false;
+  const auto stops_at = [&](const octomap::OcTreeKey& k) {
+    if (!opt.owns(k)) return false;
+    const octomap::OcTreeNode* n = tree.search(k);
+    if (n) hit = tree.isNodeOccupied(n);
+    return hit || (!n && !opt.ignore_unknown);
+  };
+  if (stops_at(key)) {
+    end = tree.keyToCoord(key);
+    return hit;
+  }
+  const octomap::point3d direction = direction_in.normalized();
+  const double res = tree.getResolution();
+  const unsigned top = (1u << tree.getTreeDepth()) - 1;  // castRay's 2 * tree_max_val - 1
+  int step[3];
+  double t_max[3], t_delta[3];
+  for (int i = 0; i < 3; ++i) {
+    step[i] = direction(i) > 0.0 ? 1 : direction(i) < 0.0 ? -1 : 0;
+    if (step[i] != 0) {
+      double border = tree.keyToCoord(key[i]);
+      border += double(step[i] * res * 0.5);
+      t_max[i] = (border - origin(i)) / direction(i);
+      t_delta[i] = res / std::fabs(direction(i));
+    } else {
+      t_max[i] = t_delta[i] = std::numeric_limits<double>::max();
+    }
+  }
+  if (step[0] == 0 && step[1] == 0 && step[2] == 0) return false;
+  const bool max_range_set = opt.max_range > 0.0;
+  const double max_range_sq = opt.max_range * opt.max_range;
+  for (;;) {
+    const int dim = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
+    if ((step[dim] < 0 && key[dim] == 0) || (step[dim] > 0 && key[dim] == top)) {
+      end = tree.keyToCoord(key);
+      return false;
+    }
+    key[dim] = static_cast<octomap::key_type>(key[dim] + step[dim]);
+    t_max[dim] += t_delta[dim];
+    end = tree.keyToCoord(key);
+    if (max_range_set) {
+      double dist_sq = 0.0;
+      for (int j = 0; j < 3; ++j) dist_sq += ((end(j) - origin(j)) * (end(j) - origin(j)));
+      if (dist_sq > max_range_sq) return false;
+    }
+    if (stops_at(key)) return hit;
+  }
 }
 }  // namespace
 
@@ -34,7 +89,8 @@ RayAnswer cast_ray(const octomap::OcTree& tree, const octomap::point3d& origin, 
     a.end = origin;
     return a;
   }
-  a.hit = tree.castRay(origin, direction, a.end, opt.ignore_unknown, opt.max_range);
+  a.hit = opt.owns ? walk_owned(tree, origin, direction, opt, key, a.end)
+                   : tree.castRay(origin, direction, a.end, opt.ignore_unknown, opt.max_range);
   if (!checked_key(tree, a.end, key)) return a;
   if (const octomap::OcTreeNode* n = tree.search(key))
     a.end_state = tree.isNodeOccupied(n) ? VoxelState::kOccupied : VoxelState::kFree;

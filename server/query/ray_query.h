@@ -3,6 +3,7 @@
 // max_range, or at the key range's edge), plus the state of the voxel where it stopped.
 #pragma once
 
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -16,9 +17,14 @@ namespace ort::query {
 struct RayBatchOptions {
   bool ignore_unknown = false;
   double max_range = -1;  // <= 0: no limit (castRay's default)
+  // A shard's voxels (docs/PROTOCOL.md, "Shards"): when set, the ray takes castRay's walk but
+  // passes every voxel it does not own as free (another shard answers for it), so it stops at
+  // the first occupied voxel, or unknown one unless ignore_unknown, among its own only; past
+  // max_range and at the key range's edge as castRay. Empty: castRay itself.
+  std::function<bool(const octomap::OcTreeKey&)> owns;
 };
 
-// One ray. An origin outside the map's key range gives hit = false, end = origin, unknown
+// One ray. With opt.owns, castRay's walk restricted to the owned voxels (see above). An origin outside the map's key range gives hit = false, end = origin, unknown
 // (castRay would return false there too, after printing a warning). Throws QueryError for a
 // non-finite origin or direction, or a zero direction.
 RayAnswer cast_ray(const octomap::OcTree& tree, const octomap::point3d& origin, const octomap::point3d& direction,

@@ -11,16 +11,12 @@
 #include <cstring>
 #include <limits>
 
-#include "daemon/pipeline/shard_filter.h"
 #include "daemon/queries/distance_answers.h"
 #include "distance/squared_edt.h"
-#include "engine/map_engine.h"
 #include "octomap_rt/distance_box_chunk_t.hpp"
 #include "octomap_rt/distance_query_t.hpp"
-#include "scene/scan_set.h"
-#include "server/scan_fixtures.h"
+#include "server/shard_maps.h"
 #include "shard_client/shard_distance.h"
-#include "support/test_data.h"
 
 namespace ort::test {
 namespace {
@@ -61,66 +57,19 @@ DQ query(int8_t mode, bool unknown_occupied) {
   return q;
 }
 
-struct ShardMaps {
-  std::string what;
-  std::vector<ShardSet> sets;
-  std::vector<std::unique_ptr<octomap::OcTree>> trees;
-};
-
 class ShardDistance : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    const std::string path = data_file("3dtk_dat/3dtk_3scans.graph");
-    if (path.empty()) return;
-    scans_ = std::make_unique<ScanSet>(load_scan_graph(path));
-    const auto cfg = test_config(kRes, false);
-    MapEngine engine(cfg.engine);
-    std::vector<ShotScan> shots(scans_->scans.size());
-    whole_ = engine.make_tree();
-    for (size_t k = 0; k < shots.size(); ++k) {
-      const octomap::Pointcloud pts = world_points(scans_->scans[k]);
-      std::vector<octomap::point3d> points(pts.begin(), pts.end());
-      engine.shoot(sensor_origin(scans_->scans[k]), points, cfg.engine.max_range, shots[k]);
-      ShotScan copy = shots[k];
-      engine.apply(copy, *whole_);
-    }
-    const double inf = std::numeric_limits<double>::infinity();
-    const double lo[3] = {-inf, -inf, -inf}, hi[3] = {inf, inf, inf}, cut_max[3] = {inf, 0.0, inf},
-                 cut_min[3] = {-inf, 0.0, -inf};
-    sharded_.resize(2);
-    sharded_[0].what = "3 hashed shards, regions at depth 12";
-    for (uint32_t i = 0; i < 3; ++i) {
-      ShardSet s;
-      s.index = i, s.count = 3, s.rule = ShardRule::kHash, s.region_depth = 12;
-      sharded_[0].sets.push_back(s);
-    }
-    sharded_[1].what = "2 box shards cut at y = 0";
-    for (uint32_t i = 0; i < 2; ++i) {
-      ShardSet s;
-      s.index = i, s.count = 2, s.rule = ShardRule::kBoxes, s.region_depth = 11;
-      s.boxes = {protocol::region_box_of(lo, cut_max, kRes, 11), protocol::region_box_of(cut_min, hi, kRes, 11)};
-      sharded_[1].sets.push_back(s);
-    }
-    for (ShardMaps& m : sharded_)
-      for (const ShardSet& s : m.sets) {
-        m.trees.push_back(engine.make_tree());
-        for (const ShotScan& shot : shots) {
-          ShotScan mine = shot;
-          daemon::ShardFilter(s).keep_owned(mine);
-          engine.apply(mine, *m.trees.back());
-        }
-      }
-  }
-  static void TearDownTestSuite() { scans_.reset(), whole_.reset(), sharded_.clear(); }
+  static void SetUpTestSuite() { map_ = sharded_3dtk(kRes); }
+  static void TearDownTestSuite() { map_.reset(); }
   void SetUp() override {
-    if (!scans_) GTEST_SKIP() << "3dtk_3scans.graph not found";
+    if (!map_) GTEST_SKIP() << "3dtk_3scans.graph not found";
   }
 
   // Points near the scans' surfaces (every 97th end point, shifted off them by up to a metre).
   static std::vector<float> points() {
     std::vector<float> xyz;
     size_t n = 0;
-    for (const PosedScan& s : scans_->scans) {
+    for (const PosedScan& s : map_->scans->scans) {
       const octomap::Pointcloud w = world_points(s);
       for (size_t i = 0; i < w.size() && xyz.size() < 3 * 600; i += 97, ++n) {
         const float shift = 0.1f * float(n % 11) - 0.5f;
@@ -130,24 +79,19 @@ class ShardDistance : public ::testing::Test {
     return xyz;
   }
 
-  static std::unique_ptr<ScanSet> scans_;
-  static std::unique_ptr<octomap::OcTree> whole_;
-  static std::vector<ShardMaps> sharded_;
+  static inline std::unique_ptr<ShardedScans> map_;
 };
-std::unique_ptr<ScanSet> ShardDistance::scans_;
-std::unique_ptr<octomap::OcTree> ShardDistance::whole_;
-std::vector<ShardMaps> ShardDistance::sharded_;
 
 TEST_F(ShardDistance, PointsWithTheGradientEqualTheOneDaemon) {
   const std::vector<float> xyz = points();
   for (const bool unknown_occupied : {false, true}) {
     DQ q = query(DQ::MODE_POINTS, unknown_occupied);
     q.with_gradient = 1, q.xyz = xyz, q.num_xyz = int32_t(xyz.size());
-    const auto want = decoded<octomap_rt::distance_points_reply_t>(answer(*whole_, q, {}).at(0));
+    const auto want = decoded<octomap_rt::distance_points_reply_t>(answer(*map_->whole, q, {}).at(0));
     ASSERT_EQ(want.status, 0) << want.error;
     DQ asked = q;  // what the shard client sends: the points and their neighbours, no gradient
     asked.with_gradient = 0, asked.xyz = client::with_neighbours(xyz, kRes), asked.num_xyz = int32_t(asked.xyz.size());
-    for (const ShardMaps& m : sharded_) {
+    for (const ShardMaps& m : map_->sharded) {
       std::vector<octomap_rt::distance_points_reply_t> got;
       for (size_t i = 0; i < m.sets.size(); ++i)
         got.push_back(decoded<octomap_rt::distance_points_reply_t>(answer(*m.trees[i], asked, m.sets[i]).at(0)));
@@ -176,13 +120,13 @@ TEST_F(ShardDistance, BoxesAndPathsEqualTheOneDaemon) {
       DQ q = query(DQ::MODE_BOX, unknown_occupied);
       q.cell_voxels = m, q.with_gradient = 1;
       std::copy(box.min, box.min + 3, q.box_min), std::copy(box.max, box.max + 3, q.box_max);
-      const client::DistanceBox want = box_of(answer(*whole_, q, {}));
+      const client::DistanceBox want = box_of(answer(*map_->whole, q, {}));
       ASSERT_EQ(want.header.status, 0) << want.header.error;
       DQ asked = q;
       asked.with_gradient = 0;
       const client::Box grown = client::grown_distance_box(box, kRes, m);
       std::copy(grown.min, grown.min + 3, asked.box_min), std::copy(grown.max, grown.max + 3, asked.box_max);
-      for (const ShardMaps& sm : sharded_) {
+      for (const ShardMaps& sm : map_->sharded) {
         std::vector<client::DistanceBox> got;
         for (size_t i = 0; i < sm.sets.size(); ++i) got.push_back(box_of(answer(*sm.trees[i], asked, sm.sets[i])));
         std::vector<const client::DistanceBox*> views;
@@ -206,9 +150,9 @@ TEST_F(ShardDistance, BoxesAndPathsEqualTheOneDaemon) {
   for (const bool unknown_occupied : {false, true}) {
     DQ q = query(DQ::MODE_PATH, unknown_occupied);
     q.xyz = v, q.num_xyz = int32_t(v.size());
-    const auto want = decoded<octomap_rt::distance_path_reply_t>(answer(*whole_, q, {}).at(0));
+    const auto want = decoded<octomap_rt::distance_path_reply_t>(answer(*map_->whole, q, {}).at(0));
     ASSERT_EQ(want.status, 0) << want.error;
-    for (const ShardMaps& sm : sharded_) {
+    for (const ShardMaps& sm : map_->sharded) {
       std::vector<octomap_rt::distance_path_reply_t> got;
       for (size_t i = 0; i < sm.sets.size(); ++i)
         got.push_back(decoded<octomap_rt::distance_path_reply_t>(answer(*sm.trees[i], q, sm.sets[i]).at(0)));
@@ -231,8 +175,8 @@ TEST_F(ShardDistance, UnknownSpaceCountsOnlyWhereTheShardOwnsIt) {
   DQ q = query(DQ::MODE_BOX, true);
   const double lo[3] = {-4.0, -6.0, -1.0}, hi[3] = {6.0, 5.0, 1.5};
   std::copy(lo, lo + 3, q.box_min), std::copy(hi, hi + 3, q.box_max);
-  const client::DistanceBox want = box_of(answer(*whole_, q, {}));
-  const ShardMaps& sm = sharded_[0];
+  const client::DistanceBox want = box_of(answer(*map_->whole, q, {}));
+  const ShardMaps& sm = map_->sharded[0];
   std::vector<client::DistanceBox> owned, unowned;
   for (size_t i = 0; i < sm.sets.size(); ++i) {
     owned.push_back(box_of(answer(*sm.trees[i], q, sm.sets[i])));

@@ -81,6 +81,9 @@ octomap_rt_add_test(server_shard_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/shard_te
 octomap_rt_add_test(server_distance_query_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/distance_query_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
 octomap_rt_lcm_handler_sources(server_distance_query_test ${CMAKE_CURRENT_LIST_DIR}/distance_query_test.cpp)
+# Issue 26: rays across shards (each stopping in its own regions), merged, equal one daemon's castRay.
+octomap_rt_add_test(server_shard_ray_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/shard_ray_test.cpp
+                    ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon octomap_rt_shard_client TIMEOUT 120)
 # Issues 26 + 27: distances across shards, merged as the shard client merges them, equal one daemon's.
 octomap_rt_add_test(server_shard_distance_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/shard_distance_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon octomap_rt_shard_client TIMEOUT 120)

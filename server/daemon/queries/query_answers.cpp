@@ -12,6 +12,7 @@
 #include "octomap_rt/region_chunk_t.hpp"
 #include "protocol/inbound_checks.h"
 #include "protocol/limits.h"
+#include "protocol/shards/shard_set.h"
 #include "query/box_count.h"
 #include "query/point_query.h"
 #include "query/projected_grid.h"
@@ -125,10 +126,15 @@ EncodedReplies refused_by_budget(const QueryMessage& q, const query::WorkBudget&
 }
 
 EncodedReplies rays(const octomap::OcTree& t, const octomap_rt::ray_query_t& q, const QueryHeader& h, const MapStamp& s,
-                    const std::string& id, const QueryBounds& bounds, query::WorkBudget& budget) {
+                    const std::string& id, const QueryBounds& bounds, query::WorkBudget& budget,
+                    const protocol::ShardSet& shard) {
   query::RayBatchOptions opt;
   opt.ignore_unknown = q.ignore_unknown != 0;
   opt.max_range = q.max_range;
+  if (shard.sharded())  // a shard's share of the walk: its own regions (PROTOCOL.md, "Shards")
+    opt.owns = [&shard](const octomap::OcTreeKey& k) {
+      return protocol::shard_of(shard, protocol::region_coords(shard.region_depth, k[0], k[1], k[2])) == shard.index;
+    };
   const auto answers = query::cast_rays(t, q.origin_xyz, q.direction_xyz, opt, &budget);
   const size_t asked = q.origin_xyz.size() / 3;
   if (answers.empty() && asked > 0 && budget.cut == query::Cut::kWork)
@@ -263,11 +269,11 @@ std::string validate_query(const QueryMessage& q, double resolution) {
 }
 
 EncodedReplies answer_query(const octomap::OcTree& t, const QueryMessage& q, const MapStamp& s, const std::string& id,
-                            const QueryBounds& bounds, query::WorkBudget& budget) {
+                            const QueryBounds& bounds, query::WorkBudget& budget, const protocol::ShardSet& shard) {
   const QueryHeader h = header_of(q);
   // Points are bounded by the message (at most 64 KiB of them, one search each).
   if (auto* p = std::get_if<octomap_rt::occupancy_query_t>(&q)) return points(t, *p, h, s, id);
-  if (auto* p = std::get_if<octomap_rt::ray_query_t>(&q)) return rays(t, *p, h, s, id, bounds, budget);
+  if (auto* p = std::get_if<octomap_rt::ray_query_t>(&q)) return rays(t, *p, h, s, id, bounds, budget, shard);
   if (auto* p = std::get_if<octomap_rt::box_query_t>(&q))
     return p->mode == Box::MODE_REGION ? region(t, *p, h, s, id, bounds, budget)
                                        : box_counts(t, *p, h, s, id, bounds, budget);

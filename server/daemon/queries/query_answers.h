@@ -43,10 +43,12 @@ struct EncodedReplies {
 };
 
 // Under the map lock, within `budget` (its max_work and deadline; regions and grids also
-// within bounds.max_reply_bytes). Throws query::QueryError (the caller replies BAD_REQUEST
+// within bounds.max_reply_bytes). A shard (`shard` sharded) answers a ray for its own regions
+// only (docs/PROTOCOL.md, "Shards"). Throws query::QueryError (the caller replies BAD_REQUEST
 // with it).
 EncodedReplies answer_query(const octomap::OcTree& tree, const QueryMessage& q, const MapStamp& stamp,
-                            const std::string& server_id, const QueryBounds& bounds, query::WorkBudget& budget);
+                            const std::string& server_id, const QueryBounds& bounds, query::WorkBudget& budget,
+                            const protocol::ShardSet& shard = {});
 // Why a budget cut a query, with the bound's flag ("the work bound of 4000000 node visits or
 // ray steps (--query-max-work)").
 std::string cut_reason(const query::WorkBudget& budget, const QueryBounds& bounds);

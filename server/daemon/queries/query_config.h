@@ -71,6 +71,9 @@ struct QueryServiceConfig {
   QueryBounds bounds;
   GridPublishConfig grid;
   DistanceServiceConfig distance;
+  // The server's shard set (ServerConfig::shard, set where the query service is made): a
+  // shard's rays stop only in its own regions (query/ray_query.h's RayBatchOptions::owns).
+  protocol::ShardSet shard;
 };
 
 }  // namespace ort::daemon

@@ -281,7 +281,7 @@ bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& o
       out.push_back(read_distance(*map.tree, *d, stamp, server_id_, cfg_.distance, edt_));
       return true;
     }
-    out.push_back(answer_query(*map.tree, q.msg, stamp, server_id_, cfg_.bounds, budget));
+    out.push_back(answer_query(*map.tree, q.msg, stamp, server_id_, cfg_.bounds, budget, cfg_.shard));
   } catch (const std::exception& e) {  // query::QueryError: a query the map cannot answer
     clients_.count(h.client_id, Count::kBad, e.what());
     out.push_back(error_reply(q.msg, Reply::REPLY_BAD_REQUEST, e.what(), stamp, server_id_));
