@@ -96,6 +96,13 @@ int run_get_shards(const MapArgs& a, const std::string& out_path, bool partial) 
 }
 
 int run_status_shards(const std::string& url, const std::string& ns, double timeout_s, bool json) {
+  std::string text;
+  const int rc = shard_status_screen(url, ns, timeout_s, json, text);
+  std::cout << text;
+  return rc;
+}
+
+int shard_status_screen(const std::string& url, const std::string& ns, double timeout_s, bool json, std::string& text) {
   const client::ShardRoster roster = client::discover_shards(url, ns, timeout_s);
   if (!roster.set())
     throw std::runtime_error("no status in namespace '" + ns + "' within " + std::to_string(timeout_s) + " s");
@@ -142,7 +149,7 @@ int run_status_shards(const std::string& url, const std::string& ns, double time
     if (!shortfall.empty()) out << "\nPARTIAL: " << shortfall << "\n";
     for (const auto& [why, n] : roster.refused()) out << "statuses refused (" << why << "): " << n << "\n";
   }
-  std::cout << out.str();
+  text = out.str();
   return shortfall.empty() ? 0 : 3;
 }
 

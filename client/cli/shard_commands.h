@@ -20,6 +20,8 @@ int run_get_shards(const MapArgs& a, const std::string& out_path, bool partial);
 // `status --shards`: the shards side by side (text) or one JSON object; 0, or 3 when a shard is
 // missing or late.
 int run_status_shards(const std::string& url, const std::string& ns, double timeout_s, bool json);
+// The same into `text` (what `status --watch --shards` redraws); returns the exit status.
+int shard_status_screen(const std::string& url, const std::string& ns, double timeout_s, bool json, std::string& text);
 
 // The shard set of namespace `ns` for `query --shards` (throws when none is heard); a missing
 // shard is said on stderr.

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <iostream>
 #include <optional>
+#include <thread>
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -121,10 +122,29 @@ int run_watch(const StatusArgs& a, lcm::LCM& lc, const std::string& url, Inbox& 
   return 0;
 }
 
+// `--watch --shards`: the shards side by side, heard afresh and redrawn about once a second (a
+// missing shard: every 3 s, the wait for it); the exit status of the last screen.
+int run_watch_shards(const StatusArgs& a, const std::string& url, const std::string& ns) {
+  const bool terminal = !a.json && isatty(STDOUT_FILENO);
+  if (terminal) std::cout << "\x1b[2J";
+  int rc = 0;
+  for (int64_t shown = 0; a.count == 0 || shown < a.count; ++shown) {
+    std::string text;
+    rc = shard_status_screen(url, ns, std::min(a.timeout_s, 3.0), a.json, text);
+    if (a.json)
+      std::cout << text << std::flush;
+    else
+      redraw("octomap-rt status --watch --shards on " + url + " (Ctrl-C quits)\n\n" + text, terminal);
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  }
+  return rc;
+}
+
 int run_status(StatusArgs a) {
-  if (a.shards)
-    return run_status_shards(protocol::lcm_url_or_default(a.lcm_url), protocol::namespace_from(a.ns),
-                             std::min(a.timeout_s, 3.0), a.json);
+  if (a.shards) {
+    const std::string url = protocol::lcm_url_or_default(a.lcm_url), ns = protocol::namespace_from(a.ns);
+    return a.watch ? run_watch_shards(a, url, ns) : run_status_shards(url, ns, std::min(a.timeout_s, 3.0), a.json);
+  }
   a.channel = protocol::in_namespace(protocol::channels_in(protocol::namespace_from(a.ns)).ns, a.channel);
   const std::string url = ort::protocol::lcm_url_or_default(a.lcm_url);
   std::optional<lcm::LCM> slot;
@@ -145,14 +165,14 @@ void register_status_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "One line of JSON per status instead of text");
   cmd->add_flag("--shards", args->shards,
                 "The namespace's shards (octomap-rt-server --shard) side by side, each one's newest status; "
-                "says which shard is missing or late (exit status 3)");
+                "says which shard is missing or late (exit status 3); with --watch, refreshed");
   cmd->add_option("--lcm-url", args->lcm_url, "LCM URL (default: $LCM_DEFAULT_URL, else the host-local udpm URL)");
   cmd->add_option("--channel", args->channel, "Status channel (in the --namespace)")->capture_default_str();
   add_namespace_flag(cmd, args->ns);
   cmd->add_option("--timeout", args->timeout_s, "Without --watch: seconds to wait for a status")
       ->check(CLI::Range(0.1, 3600.0))
       ->capture_default_str();
-  cmd->add_option("--count", args->count, "With --watch: stop after N statuses (0: never)")
+  cmd->add_option("--count", args->count, "With --watch: stop after N statuses (--shards: N screens; 0: never)")
       ->check(CLI::NonNegativeNumber);
   cmd->callback([args] {
     if (const int rc = run_status(*args); rc != 0) throw CLI::RuntimeError(rc);

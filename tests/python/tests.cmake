@@ -25,6 +25,8 @@ if(PYTHON3 AND LCM_LOGGER)
   octomap_rt_add_python_test(python_edits_test test_edits 300)
   # A mirror that follows deltas, and resyncs on a new epoch (a reset).
   octomap_rt_add_python_test(python_map_mirror_test test_map_mirror 300)
+  # Issue 26: the Python shard client against three shards and one whole daemon.
+  octomap_rt_add_python_test(python_shards_test test_shards 300)
 else()
   message(WARNING "octomap-rt: python3 or lcm-logger missing: the Python client tests are not registered")
 endif()

@@ -104,6 +104,14 @@ TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
   ASSERT_EQ(stat.wait(30), 0) << stat.log();
   EXPECT_NE(stat.log().find("\"count\": 3"), std::string::npos) << stat.log();
   EXPECT_NE(stat.log().find("\"shortfall\": \"\""), std::string::npos) << stat.log();
+  // --watch: one screen a refresh, each with every shard (two here, then it stops).
+  ChildProcess watch({client_program(), "status", "--watch", "--shards", "--count", "2", "--namespace", kNs,
+                      "--lcm-url", client_url, "--json"},
+                     dir + "/watch.log");
+  ASSERT_EQ(watch.wait(30), 0) << watch.log();
+  size_t screens = 0;
+  for (size_t at = 0; (at = watch.log().find("\"count\": 3", at)) != std::string::npos; ++at) ++screens;
+  EXPECT_EQ(screens, 2u) << watch.log();
 
   // Points and rays routed by region: OctoMap's answers.
   const client::ShardRoster roster = client::discover_shards(client_url, kNs, 5);
@@ -124,22 +132,27 @@ TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
     origins.insert(origins.end(), {o.x(), o.y(), o.z()});
     directions.insert(directions.end(), {xyz[i] - o.x(), xyz[i + 1] - o.y(), xyz[i + 2] - o.z()});
   }
-  const auto rays = q.rays(origins, directions, 60.0f, true);
-  ASSERT_FALSE(rays.shards.partial()) << rays.shards.shortfall();
-  EXPECT_EQ(rays.reply.cut, 0) << rays.reply.error;
-  query::RayBatchOptions opt;
-  opt.ignore_unknown = true, opt.max_range = 60.0;
-  const auto cast = query::cast_rays(*reference, origins, directions, opt);
-  int ray_differing = 0, hits = 0;
-  for (size_t i = 0; i < cast.size(); ++i) {
-    hits += cast[i].hit;
-    ray_differing += rays.reply.hit[i] != cast[i].hit || rays.reply.end_xyz[3 * i] != cast[i].end.x() ||
-                     rays.reply.end_xyz[3 * i + 1] != cast[i].end.y() ||
-                     rays.reply.end_xyz[3 * i + 2] != cast[i].end.z();
+  // Rays passing unknown space, and stopping at it (each shard stops in its own regions only).
+  for (const bool ignore_unknown : {true, false}) {
+    const auto rays = q.rays(origins, directions, 60.0f, ignore_unknown);
+    ASSERT_FALSE(rays.shards.partial()) << rays.shards.shortfall();
+    EXPECT_EQ(rays.reply.cut, 0) << rays.reply.error;
+    query::RayBatchOptions opt;
+    opt.ignore_unknown = ignore_unknown, opt.max_range = 60.0;
+    const auto cast = query::cast_rays(*reference, origins, directions, opt);
+    ASSERT_EQ(rays.reply.num_rays, static_cast<int32_t>(cast.size()));
+    int ray_differing = 0, hits = 0;
+    for (size_t i = 0; i < cast.size(); ++i) {
+      hits += cast[i].hit;
+      ray_differing += rays.reply.hit[i] != cast[i].hit || rays.reply.end_xyz[3 * i] != cast[i].end.x() ||
+                       rays.reply.end_xyz[3 * i + 1] != cast[i].end.y() ||
+                       rays.reply.end_xyz[3 * i + 2] != cast[i].end.z() ||
+                       rays.reply.end_state[i] != int8_t(cast[i].end_state);
+    }
+    EXPECT_EQ(ray_differing, 0) << "of " << cast.size() << " rays, ignore unknown " << ignore_unknown << "; cut "
+                                << int(rays.reply.cut) << " at " << rays.reply.cut_at << ": " << rays.reply.error;
+    EXPECT_GT(hits, static_cast<int>(cast.size() / (ignore_unknown ? 2 : 10)));
   }
-  EXPECT_EQ(ray_differing, 0) << "of " << cast.size() << " rays; cut " << int(rays.reply.cut) << " at "
-                              << rays.reply.cut_at << ": " << rays.reply.error;
-  EXPECT_GT(hits, static_cast<int>(cast.size() / 2));
 
   // Distances routed to the shards within reach, the smallest of theirs: the distance on
   // OctoMap's map (server/distance/ on it is the one daemon's answer: distance_query_test).

@@ -1,0 +1,151 @@
+"""The Python shard client (issue 26): three shards of one namespace (octomap-rt-server --shard i/3,
+small regions so every wall crosses many) and one whole daemon in another namespace get the same
+scans; octomap_rt.shards.ShardClient finds the shards by their statuses, and its routed points,
+rays (stopping at unknown space and passing it), box counts, grid and merged snapshot equal the
+whole daemon's answers. With a shard stopped the answers say it is missing (partial)."""
+
+import os
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+import unittest
+
+import numpy as np
+
+import octomap_rt
+from octomap_rt.shards import ShardClient
+from server_fixture import SERVER, test_url
+
+SHARDS = 3
+ROBOT = "pyshard"
+
+
+def leaf_voxels(leaves, sizes, resolution):
+    """The finest voxel keys (minus 32768) the leaves cover."""
+    out = set()
+    for c, s in zip(leaves, sizes):
+        n = int(round(s / resolution))
+        lo = np.floor(c / resolution + 1e-6 - n / 2).astype(int)
+        for i in range(n):
+            for j in range(n):
+                for k in range(n):
+                    out.add((lo[0] + i, lo[1] + j, lo[2] + k))
+    return out
+
+
+class ShardSetTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.mkdtemp(prefix="ort-py-shards-")
+        cls.url = test_url(20000 + (os.getpid() * 13 + 7) % 20000)
+        cls.log = open(os.path.join(cls.dir, "servers.log"), "w")
+        common = [SERVER, "-r", "0.1", "--lcm-url", cls.url, "--backend", "cpu", "--warm-up-points", "0",
+                  "--query-lock-ms", "2000"]
+        cls.servers = [subprocess.Popen(common + ["--namespace", "campus", "--shard", f"{i}/{SHARDS}",
+                                                  "--shard-region-depth", "14", "--server-id", f"shard-{i}"],
+                                        stdout=cls.log, stderr=subprocess.STDOUT) for i in range(SHARDS)]
+        cls.servers.append(subprocess.Popen(common + ["--namespace", "one", "--server-id", "whole"],
+                                            stdout=cls.log, stderr=subprocess.STDOUT))
+        cls.whole = octomap_rt.MapClient(cls.url, namespace="one")
+        cls.feed = octomap_rt.MapClient(cls.url, namespace="campus")
+        cls.whole.status(timeout_s=60)
+        cls.shards = ShardClient(transport=octomap_rt.open_transport(cls.url), namespace="campus", timeout_s=60)
+        # Two walls and a floor patch from two sensor positions, to both maps.
+        walls = [(np.array([[4.0, y, z] for y in np.linspace(-2, 2, 41) for z in np.linspace(0, 1.5, 16)]),
+                  (0.0, 0.0, 0.5)),
+                 (np.array([[x, 3.0, z] for x in np.linspace(-1, 3, 41) for z in np.linspace(0, 1.5, 16)]),
+                  (0.5, -0.5, 0.8))]
+        for pts, origin in walls:
+            for c in (cls.whole, cls.feed):
+                c.publish_scan(pts - np.asarray(origin), robot_id=ROBOT, origin=origin)
+        want = len(walls)
+
+        def applied(s):
+            return any(r.robot_id.lower() == ROBOT and r.scans_applied == want for r in s.robots)
+
+        cls.whole.wait_for(cls.whole.channels.status, octomap_rt.server_status_t.decode, applied, timeout_s=60)
+        done, deadline = set(), time.monotonic() + 60
+        while len(done) < SHARDS and time.monotonic() < deadline:
+            s = cls.feed.wait_for(cls.feed.channels.status, octomap_rt.server_status_t.decode, applied, timeout_s=60)
+            done.add(s.shard_index)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.whole.close(), cls.feed.close(), cls.shards.close()
+        codes = []
+        for s in cls.servers:
+            if s.poll() is None:
+                s.send_signal(signal.SIGTERM)
+            codes.append(s.wait(timeout=60))
+        cls.log.close()
+        if all(c == 0 for c in codes) and not os.environ.get("OCTOMAP_RT_KEEP_TEST_DIRS"):
+            shutil.rmtree(cls.dir, ignore_errors=True)
+
+    def test_1_routed_answers_equal_the_whole_daemon(self):
+        self.assertEqual(self.shards.set.count, SHARDS)
+        self.assertEqual(sorted(self.shards.statuses), list(range(SHARDS)))
+        # The merged snapshot covers the whole map's voxels, each with its state.
+        merged = self.shards.fetch_map(timeout_s=60)
+        self.assertFalse(merged.partial, merged.missing)
+        m, ids = merged.value
+        self.assertEqual(sorted(ids), list(range(SHARDS)))
+        w = self.whole.fetch_map(timeout_s=60)
+        occupied = leaf_voxels(w.occupied, w.occupied_size, 0.1)
+        self.assertGreater(len(occupied), 500)
+        self.assertEqual(leaf_voxels(m.occupied, m.occupied_size, 0.1), occupied)
+        self.assertEqual(leaf_voxels(m.free, m.free_size, 0.1), leaf_voxels(w.free, w.free_size, 0.1))
+        # Points: a grid through both walls and the free space in front of them.
+        pts = np.array([[x, y, z] for x in np.arange(-1.05, 4.5, 0.2) for y in np.arange(-2.05, 3.5, 0.2)
+                        for z in (0.25, 0.75, 1.25)] + w.occupied[::7].tolist())
+        got = self.shards.query_points(pts)
+        self.assertFalse(got.partial, got.missing)
+        want = self.whole.query_points(pts)
+        np.testing.assert_array_equal(got.value[0], want[0])
+        np.testing.assert_array_equal(got.value[1], want[1])
+        self.assertEqual(len(set(want[0].tolist())), 3)  # unknown, free and occupied points
+        # Rays from the first sensor over a fan: stopping at unknown space, and passing it.
+        dirs = np.array([[np.cos(a), np.sin(a), e] for a in np.linspace(-0.9, 1.6, 60) for e in (-0.2, 0.0, 0.3)])
+        for ignore in (False, True):
+            got = self.shards.cast_rays((0.0, 0.0, 0.5), dirs, max_range=12.0, ignore_unknown=ignore)
+            self.assertFalse(got.partial, got.missing)
+            want = self.whole.cast_rays((0.0, 0.0, 0.5), dirs, max_range=12.0, ignore_unknown=ignore)
+            for g, w_ in zip(got.value, want):
+                np.testing.assert_array_equal(g, w_)
+            self.assertTrue(want[0].any())
+        # Boxes and the grid of a band.
+        boxes = [[3.5, -2.5, 0.0, 4.5, 2.5, 1.6], [-1.0, -1.0, 0.0, 3.5, 3.5, 1.0]]
+        got = self.shards.box(boxes)
+        want = self.whole.box(boxes)
+        for k in ("occupied", "free", "unknown"):
+            np.testing.assert_array_equal(got.value[k], want[k])
+        got = self.shards.grid(0.45, 1.05)
+        cells, origin, size = self.whole.grid(0.45, 1.05)
+        g_cells, g_origin, g_size = got.value
+        self.assertEqual(g_size, size)
+        # The merged grid spans the union of the shards' extents: the whole grid lies inside it.
+        i0, j0 = round((origin[0] - g_origin[0]) / size), round((origin[1] - g_origin[1]) / size)
+        np.testing.assert_array_equal(g_cells[j0:j0 + cells.shape[0], i0:i0 + cells.shape[1]], cells)
+
+    def test_2_a_missing_shard_makes_the_answers_partial(self):
+        self.servers[2].send_signal(signal.SIGTERM)
+        self.servers[2].wait(timeout=60)
+        time.sleep(1.5)  # its last status is gone from the bus
+        c = ShardClient(transport=octomap_rt.open_transport(self.url), namespace="campus", timeout_s=2.5,
+                        partial=True)
+        try:
+            self.assertEqual(c.set.count, SHARDS)
+            got = c.cast_rays((0.0, 0.0, 0.5), [[1.0, 0.0, 0.0]], max_range=10.0)
+            self.assertEqual(list(got.missing), [2])
+            self.assertTrue(got.partial)
+            t = octomap_rt.open_transport(self.url)
+            with self.assertRaises(octomap_rt.ServerTimeout):  # without partial: refused
+                ShardClient(transport=t, namespace="campus", timeout_s=2.5)
+            t.close()
+        finally:
+            c.close()
+
+
+if __name__ == "__main__":
+    unittest.main()
