@@ -56,6 +56,19 @@ void add_scan_cost_flags(CLI::App& app, ScanCostBounds& c) {
   app.add_option("--map-new-node-burst", c.map_new_node_burst, "see --max-map-new-nodes-per-s")
       ->capture_default_str()
       ->check(number_in(0.0, 1e13));
+  app.add_option("--producer-share", c.producer_share,
+                 "share the stages' time among producers: each robot with history (--share-history-scans over "
+                 "--share-history) has a share, robot ids without share one; a scan that waits past the latency "
+                 "bound while others were served in its turn is dropped as 'over its share'; false: one FIFO in "
+                 "arrival order")
+      ->capture_default_str();
+  app.add_option("--share-history-scans", c.share_history_scans,
+                 "scans a robot must have had applied (over --share-history) before it has a share of its own")
+      ->capture_default_str()
+      ->check(CLI::Range(int64_t{0}, int64_t{1'000'000'000}));
+  app.add_option("--share-history", c.share_history_s, "see --share-history-scans [s]")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e9));
 }
 
 }  // namespace ort::daemon

@@ -41,6 +41,8 @@ ProducerPolicy producer_policy(const ServerConfig& c) {
   p.max_producers = c.max_producers;
   p.idle_release = std::chrono::duration<double>(c.producer_idle_release_s);
   p.allowed_robots = c.allowed_robots;
+  p.history_scans = c.scan_costs.share_history_scans;
+  p.history = std::chrono::duration<double>(c.scan_costs.share_history_s);
   return p;
 }
 

@@ -4,9 +4,7 @@
 // voxel bound is refused whole; each refusal is counted with its reason for that producer;
 // a scan stamped years ahead does not pin the map's utime.
 #include <chrono>
-#include <cmath>
 #include <map>
-#include <random>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -31,20 +29,6 @@ int64_t applied(const daemon::MappingServer& s) {
   int64_t n = 0;
   for (const auto& p : s.producer_stats()) n += p.applied;
   return n;
-}
-
-// `n` points `distance` metres from a sensor at `at`, in random directions (seeded by seq).
-octomap_rt::scan_t reaching_scan(int64_t seq, const octomap::point3d& at, double distance, int n) {
-  std::mt19937 rng(static_cast<unsigned>(seq) + 11);
-  std::normal_distribution<double> g(0.0, 1.0);
-  PosedScan s;
-  s.pose = octomap::pose6d(at.x(), at.y(), at.z(), 0.0, 0.0, 0.0);
-  for (int i = 0; i < n; ++i) {
-    const double d[3] = {g(rng), g(rng), g(rng)};
-    const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    s.points.push_back(float(d[0] / len * distance), float(d[1] / len * distance), float(d[2] / len * distance));
-  }
-  return scan_message(s, "alpha", seq);
 }
 
 int64_t nodes(daemon::MappingServer& s) {

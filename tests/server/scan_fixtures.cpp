@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
+#include <random>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -40,6 +42,19 @@ octomap_rt::scan_t small_scan(const std::string& robot_id, int64_t seq, int poin
   s.pose = octomap::pose6d(1.0f, 2.0f, 0.5f, 0.0, 0.0, 0.3);
   for (int i = 0; i < points; ++i) s.points.push_back(2.0f, 0.05f * static_cast<float>(i - points / 2), 0.1f);
   return scan_message(s, robot_id, seq);
+}
+
+octomap_rt::scan_t reaching_scan(int64_t seq, const octomap::point3d& at, double distance, int n) {
+  std::mt19937 rng(static_cast<unsigned>(seq) + 11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  PosedScan s;
+  s.pose = octomap::pose6d(at.x(), at.y(), at.z(), 0.0, 0.0, 0.0);
+  for (int i = 0; i < n; ++i) {
+    const double d[3] = {g(rng), g(rng), g(rng)};
+    const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    s.points.push_back(float(d[0] / len * distance), float(d[1] / len * distance), float(d[2] / len * distance));
+  }
+  return scan_message(s, "alpha", seq);
 }
 
 std::vector<uint8_t> encode(const octomap_rt::scan_t& msg) {

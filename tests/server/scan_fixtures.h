@@ -27,6 +27,9 @@ namespace ort::test {
 octomap_rt::scan_t scan_message(const PosedScan& scan, const std::string& robot_id, int64_t seq);
 // A small valid scan: `points` points 2 m in front of a sensor at (1, 2, 0.5).
 octomap_rt::scan_t small_scan(const std::string& robot_id, int64_t seq, int points = 30);
+// `n` points `distance` metres from a sensor at `at`, in random directions (seeded by seq),
+// robot id "alpha": what a scan far-reaching for its size costs (issue 21's far scans).
+octomap_rt::scan_t reaching_scan(int64_t seq, const octomap::point3d& at, double distance, int n);
 std::vector<uint8_t> encode(const octomap_rt::scan_t& msg);
 void put_be32(std::vector<uint8_t>& buf, size_t offset, int32_t v);
 

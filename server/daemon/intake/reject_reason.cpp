@@ -37,6 +37,7 @@ const char* to_string(Reject r) {
     case Reject::kDuplicateSeq: return "duplicate seq";
     case Reject::kQueueFull: return "queue full";
     case Reject::kOverLatencyBound: return "over latency bound";
+    case Reject::kOverShare: return "over its share";
     case Reject::kLeftAtShutdown: return "left at shutdown";
     case Reject::kCount_: break;
   }

@@ -47,6 +47,7 @@ enum class Reject {
   // Why a valid scan was dropped (counted as dropped, not rejected).
   kQueueFull,         // the producer's queue budget was full on arrival
   kOverLatencyBound,  // waited in the queue longer than --max-queue-age (overload shedding)
+  kOverShare,         // waited past --latency-bound while other producers were served in its turn (intake/scan_queue.h)
   kLeftAtShutdown,    // still queued when the drain deadline passed at stop
   kCount_
 };

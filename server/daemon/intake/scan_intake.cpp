@@ -49,6 +49,7 @@ void ScanIntake::on_message(const lcm::ReceiveBuffer& rbuf, const std::string& c
     return;
   }
   item.producer = producer;
+  item.established = producers_.has_history(producer, received);
   item.received = received;
   item.decoded = SteadyClock::now();
   item.bytes = queued_bytes(item.msg);

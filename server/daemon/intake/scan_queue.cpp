@@ -12,8 +12,15 @@ size_t queued_bytes(const octomap_rt::scan_t& msg) {
   return sizeof(QueuedScan) + msg.xyz.capacity() * sizeof(float) + msg.robot_id.size() + msg.map_frame.size();
 }
 
-ScanQueue::ScanQueue(uint64_t per_producer_budget, uint64_t total_budget)
-    : per_producer_budget_(per_producer_budget), total_budget_(total_budget) {}
+ScanQueue::ScanQueue(uint64_t per_producer_budget, uint64_t total_budget, bool fair)
+    : per_producer_budget_(per_producer_budget), total_budget_(total_budget), fair_(fair) {}
+
+size_t ScanQueue::class_for(const QueuedScan& s) const {
+  if (!fair_ || !s.established) return kNewProducersClass;
+  // A producer that just earned its history keeps its waiting scans' class until they have
+  // left, so that its scans still leave in its order.
+  return new_class_depth_[s.producer] > 0 ? kNewProducersClass : s.producer;
+}
 
 bool ScanQueue::try_push(QueuedScan&& s) {
   {
@@ -22,14 +29,25 @@ bool ScanQueue::try_push(QueuedScan&& s) {
     if (s.producer >= bytes_by_producer_.size()) {
       bytes_by_producer_.resize(s.producer + 1, 0);
       depth_by_producer_.resize(s.producer + 1, 0);
+      new_class_depth_.resize(s.producer + 1, 0);
     }
     if (bytes_by_producer_[s.producer] + s.bytes > per_producer_budget_) return false;
     if (total_bytes_ + s.bytes > total_budget_) return false;
+    const size_t cls = class_for(s);
+    ShareClass& c = classes_[cls];
+    // Fresh ids are free to make: together they hold what one producer may.
+    if (fair_ && cls == kNewProducersClass && c.bytes + s.bytes > per_producer_budget_) return false;
+    if (c.scans.empty()) c.used_ms = std::max(c.used_ms, virtual_ms_);  // no credit saved while idle
     bytes_by_producer_[s.producer] += s.bytes;
     depth_by_producer_[s.producer]++;
+    if (cls == kNewProducersClass) new_class_depth_[s.producer]++;
     total_bytes_ += s.bytes;
+    c.bytes += s.bytes;
+    depth_++;
+    s.share_class = cls;
+    s.deferrals_at_push = c.deferrals;
     s.arrival = next_arrival_++;
-    fifo_.push_back(std::move(s));
+    c.scans.push_back(std::move(s));
   }
   ready_.notify_one();
   return true;
@@ -43,38 +61,122 @@ bool ScanQueue::push_edit(std::shared_ptr<MapEditItem> edit) {
     s.edit = std::move(edit);
     s.received = SteadyClock::now();
     s.arrival = next_arrival_++;
-    fifo_.push_back(std::move(s));
+    edits_.push_back(std::move(s));
   }
   ready_.notify_one();
   return true;
 }
 
-std::optional<QueuedScan> ScanQueue::pop() {
-  std::unique_lock lock(mutex_);
-  ready_.wait(lock, [&] { return closed_ || !fifo_.empty(); });
-  if (fifo_.empty()) return std::nullopt;
-  QueuedScan s = std::move(fifo_.front());
-  fifo_.pop_front();
-  if (s.edit) return s;
+bool ScanQueue::empty_locked() const { return depth_ == 0 && edits_.empty(); }
+
+bool ScanQueue::streams(const ShareClass& c, SteadyClock::time_point now) const {
+  return !c.scans.empty() || c.in_stages > 0 ||
+         (c.served != SteadyClock::time_point{} && now - c.served < kStreamingWindow);
+}
+
+ScanQueue::ShareClass* ScanQueue::next_class(SteadyClock::time_point now) {
+  ShareClass* best = nullptr;
+  for (auto& [key, c] : classes_) {
+    if (c.scans.empty()) continue;
+    if (fair_ && c.in_stages > 0) {  // one scan in the stages while a class that used less streams
+      bool behind = false;
+      for (const auto& [other_key, other] : classes_)
+        behind = behind || (&other != &c && other.used_ms < c.used_ms && streams(other, now));
+      if (behind) continue;
+    }
+    if (!best || c.used_ms < best->used_ms ||
+        (c.used_ms == best->used_ms && c.scans.front().arrival < best->scans.front().arrival))
+      best = &c;
+  }
+  return best;
+}
+
+void ScanQueue::forget(const QueuedScan& s) {
   bytes_by_producer_[s.producer] -= s.bytes;
   depth_by_producer_[s.producer]--;
+  if (s.share_class == kNewProducersClass) new_class_depth_[s.producer]--;
   total_bytes_ -= s.bytes;
+  depth_--;
+}
+
+std::optional<QueuedScan> ScanQueue::pop() {
+  std::unique_lock lock(mutex_);
+  ShareClass* c = nullptr;
+  for (;;) {
+    ready_.wait(lock, [&] { return closed_ || !empty_locked(); });
+    if (empty_locked()) return std::nullopt;
+    uint64_t oldest_scan = UINT64_MAX;
+    for (const auto& [key, other] : classes_)
+      if (!other.scans.empty()) oldest_scan = std::min(oldest_scan, other.scans.front().arrival);
+    if (!edits_.empty() && edits_.front().arrival < oldest_scan) {  // every scan before it has left
+      QueuedScan e = std::move(edits_.front());
+      edits_.pop_front();
+      return e;
+    }
+    const auto now = SteadyClock::now();
+    if ((c = next_class(now))) break;
+    // Every waiting class has its scan in the stages: until one leaves (leave() wakes this)
+    // or the others stop streaming.
+    ready_.wait_for(lock, std::chrono::milliseconds(50));
+  }
+  // Classes whose oldest scan arrived before the one served now lose this turn to their share.
+  for (auto& [key, other] : classes_)
+    if (&other != c && !other.scans.empty() && other.scans.front().arrival < c->scans.front().arrival)
+      other.deferrals++;
+  virtual_ms_ = c->used_ms;
+  c->in_stages++;
+  c->served = SteadyClock::now();
+  QueuedScan s = std::move(c->scans.front());
+  c->scans.pop_front();
+  c->bytes -= s.bytes;
+  s.passed_over = c->deferrals != s.deferrals_at_push;
+  forget(s);
   return s;
+}
+
+void ScanQueue::charge(size_t share_class, double ms) {
+  if (!(ms > 0)) return;
+  std::lock_guard lock(mutex_);
+  if (auto it = classes_.find(share_class); it != classes_.end()) it->second.used_ms += ms;
+}
+
+void ScanQueue::leave(size_t share_class, bool edit) {
+  if (edit) return;
+  {
+    std::lock_guard lock(mutex_);
+    if (auto it = classes_.find(share_class); it != classes_.end() && it->second.in_stages > 0) it->second.in_stages--;
+  }
+  ready_.notify_all();
 }
 
 std::vector<QueuedScan> ScanQueue::take_all() {
   std::lock_guard lock(mutex_);
-  std::vector<QueuedScan> out(std::make_move_iterator(fifo_.begin()), std::make_move_iterator(fifo_.end()));
-  fifo_.clear();
+  std::vector<QueuedScan> out(std::make_move_iterator(edits_.begin()), std::make_move_iterator(edits_.end()));
+  edits_.clear();
+  for (auto& [key, c] : classes_) {
+    std::move(c.scans.begin(), c.scans.end(), std::back_inserter(out));
+    c.scans.clear();
+    c.bytes = 0;
+  }
+  std::sort(out.begin(), out.end(), [](const QueuedScan& a, const QueuedScan& b) { return a.arrival < b.arrival; });
   std::fill(bytes_by_producer_.begin(), bytes_by_producer_.end(), 0);
   std::fill(depth_by_producer_.begin(), depth_by_producer_.end(), 0);
+  std::fill(new_class_depth_.begin(), new_class_depth_.end(), 0);
   total_bytes_ = 0;
+  depth_ = 0;
   return out;
 }
 
 SteadyClock::duration ScanQueue::oldest_age(SteadyClock::time_point now) const {
   std::lock_guard lock(mutex_);
-  return fifo_.empty() ? SteadyClock::duration::zero() : now - fifo_.front().received;
+  bool any = !edits_.empty();
+  SteadyClock::time_point oldest = any ? edits_.front().received : now;
+  for (const auto& [key, c] : classes_)
+    if (!c.scans.empty()) {
+      oldest = any ? std::min(oldest, c.scans.front().received) : c.scans.front().received;
+      any = true;
+    }
+  return any ? now - oldest : SteadyClock::duration::zero();
 }
 
 void ScanQueue::close() {
@@ -87,7 +189,7 @@ void ScanQueue::close() {
 
 size_t ScanQueue::depth() const {
   std::lock_guard lock(mutex_);
-  return fifo_.size();
+  return depth_ + edits_.size();
 }
 
 uint64_t ScanQueue::bytes() const {
@@ -106,10 +208,15 @@ size_t ScanQueue::producer_depth(size_t producer) const {
 }
 
 std::string ScanQueue::policy() const {
-  return "per-producer byte budget " + std::to_string(per_producer_budget_ >> 20) + " MiB (total " +
-         std::to_string(total_budget_ >> 20) +
-         " MiB); when full the newest scan is dropped (counted as dropped: queue full); queued scans are "
-         "never evicted, so scans are applied in arrival order";
+  const std::string budget = "per-producer byte budget " + std::to_string(per_producer_budget_ >> 20) + " MiB (total " +
+                             std::to_string(total_budget_ >> 20) +
+                             " MiB); when full the newest scan is dropped "
+                             "(counted as dropped: queue full); queued scans are never evicted; ";
+  if (!fair_) return budget + "one FIFO: scans are applied in arrival order";
+  return budget +
+         "each producer with history has its share of the stages' time, producers without share one (and one "
+         "byte budget): scans are applied in arrival order per producer, by share across producers; a scan that "
+         "waited past the latency bound while others were served in its turn is dropped as 'over its share'";
 }
 
 }  // namespace ort::daemon

@@ -1,16 +1,35 @@
-// The queue between the LCM thread and stage 1: one FIFO, so scans leave in ARRIVAL order
-// across producers, with a byte budget PER PRODUCER (one flooding robot cannot starve the
-// others of memory) and a total budget.
+// The queue between the LCM thread and stage 1, with a byte budget PER PRODUCER (one
+// flooding robot cannot starve the others of memory) and a total budget.
+//
+// Share of the stages (docs/RELIABILITY.md, "Bounded cost"): scans wait in one queue per
+// share class, and the stages serve the class that has used the least of their time
+// (start-time fair queuing on measured stage time: the pipeline charges each scan's shoot and
+// apply time to its class). A producer with history (ScanCostBounds' share_history_*) is a
+// class of its own; every producer without (a robot id never seen, or seen only briefly) is
+// in ONE class together, so fresh ids cost nothing to make but share one turn. While a known
+// robot streams, one class, however expensive its scans, takes at most its share of the
+// stages' time; what it sends beyond waits, and a scan that waited past the latency bound
+// while other classes were served in its turn is dropped as "over its share". A class that
+// was idle comes back at the others' level (no saved credit). And while a class that used
+// less streams (has scans waiting or in the stages, or had one served within
+// kStreamingWindow), a class has at most one scan in the stages: a scan is applied whole, so
+// what a robot's scan may wait for is one scan of each class ahead of it, not one in each
+// stage. fair = false: one FIFO.
+//
+// Order: each producer's scans leave in its arrival order (a producer's scans all stay in
+// the class they started in while any of them waits); across producers, by share. A map edit
+// leaves only after every scan that arrived before it, and before any that arrived after.
 //
 // Policy when a producer's budget is full: the NEWEST scan is refused (the caller counts it
-// as dropped: queue full). Older queued scans are never evicted, so what is applied is
-// always a prefix-preserving subsequence of the arrival order and nothing reorders.
+// as dropped: queue full). The producers without history are held to one producer's budget
+// together. Older queued scans are never evicted.
 #pragma once
 
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -25,9 +44,18 @@ namespace ort::daemon {
 // applied are the map's (daemon/map/map_edit_item.h): the queue only holds it.
 struct MapEditItem;
 
+// The share class of every producer without history.
+inline constexpr size_t kNewProducersClass = SIZE_MAX;
+// A class served this recently still streams (a robot at 1 Hz or faster).
+inline constexpr std::chrono::seconds kStreamingWindow{2};
+
 struct QueuedScan {
   size_t producer = 0;
+  bool established = false;          // set by the intake: the producer has history (its own class)
   uint64_t arrival = 0;              // global arrival number, set by the queue
+  size_t share_class = 0;            // set by the queue: whose turn it waits for
+  uint64_t deferrals_at_push = 0;    // set by the queue: its class's deferrals when it arrived
+  bool passed_over = false;          // set by pop(): other classes were served in its class's turn
   SteadyClock::time_point received;  // when the LCM thread got it
   SteadyClock::time_point decoded;   // when the LCM thread had decoded and checked it (unset: = received)
   size_t bytes = 0;                  // what it holds against the budget
@@ -40,15 +68,20 @@ size_t queued_bytes(const octomap_rt::scan_t& msg);
 
 class ScanQueue {
  public:
-  ScanQueue(uint64_t per_producer_budget, uint64_t total_budget);
+  ScanQueue(uint64_t per_producer_budget, uint64_t total_budget, bool fair = true);
 
   // False when the producer's (or the total) budget would be exceeded, or after close().
   bool try_push(QueuedScan&& s);
   // Queues a map edit in arrival order with the scans, outside every byte budget (edits are
   // small and rate-limited by the query service). False after close().
   bool push_edit(std::shared_ptr<MapEditItem> edit);
-  // Blocks until a scan is there; nullopt once closed and empty.
+  // Blocks until a scan may be served; nullopt once closed and empty.
   std::optional<QueuedScan> pop();
+  // What serving a scan of `share_class` took of a stage (the pipeline's measured time).
+  void charge(size_t share_class, double ms);
+  // A scan pop() returned has left the stages (applied, refused or dropped): once for each.
+  void leave(const QueuedScan& s) { leave(s.share_class, s.edit != nullptr); }
+  void leave(size_t share_class, bool edit = false);
   // No more pushes; pop() drains what is left, then returns nullopt.
   void close();
   // Removes and returns every queued scan (the drain deadline passed: the caller counts
@@ -66,14 +99,34 @@ class ScanQueue {
   std::string policy() const;
 
  private:
+  struct ShareClass {
+    std::deque<QueuedScan> scans;  // arrival order
+    double used_ms = 0;            // stage time served so far (its start tag while waiting)
+    uint64_t deferrals = 0;        // times another class was served while this one waited
+    uint64_t bytes = 0;
+    int in_stages = 0;  // popped, not yet left
+    SteadyClock::time_point served;
+  };
+  size_t class_for(const QueuedScan& s) const;  // under mutex_
+  // The class to serve next (least used; ties: oldest head), or nullptr when no scan may be.
+  ShareClass* next_class(SteadyClock::time_point now);  // under mutex_
+  bool streams(const ShareClass& c, SteadyClock::time_point now) const;
+  bool empty_locked() const;
+  void forget(const QueuedScan& s);  // its bytes and depth, once it left the queue
+
   mutable std::mutex mutex_;
   std::condition_variable ready_;
-  std::deque<QueuedScan> fifo_;
+  std::map<size_t, ShareClass> classes_;
+  std::deque<QueuedScan> edits_;  // arrival order
   std::vector<uint64_t> bytes_by_producer_;
   std::vector<size_t> depth_by_producer_;
+  std::vector<size_t> new_class_depth_;  // by producer: its scans waiting in kNewProducersClass
+  size_t depth_ = 0;
   uint64_t total_bytes_ = 0;
   uint64_t next_arrival_ = 0;
+  double virtual_ms_ = 0;  // the used time of the class served last, when it was served
   uint64_t per_producer_budget_, total_budget_;
+  bool fair_;
   bool closed_ = false;
 };
 

@@ -44,6 +44,12 @@ struct ScanCostBounds {
   // The map's utime follows its newest scan's, but never more than this ahead of the
   // daemon's clock (a scan stamped years ahead would pin it there).
   double max_future_s = 60;
+  // The stages' time shared among producers (intake/scan_queue.h): a producer has a share of
+  // its own once it has had share_history_scans scans applied over share_history_s seconds;
+  // before, it shares one with every other producer without history. false: one FIFO.
+  bool producer_share = true;
+  int64_t share_history_scans = 20;
+  double share_history_s = 30;
 };
 
 class ScanCostGate {

@@ -54,7 +54,7 @@ bool ScanPipeline::shed_if_stale(const QueuedScan& item) {
   // An edit is never shed for age: its sender waits for the ack, and it belongs to no producer.
   if (item.edit) return false;
   if (max_queue_age_.count() <= 0 || SteadyClock::now() - item.received <= max_queue_age_) return false;
-  producers_.count_dropped_in_flight(item.producer, Reject::kOverLatencyBound);
+  producers_.count_dropped_in_flight(item.producer, item.passed_over ? Reject::kOverShare : Reject::kOverLatencyBound);
   shed_++;
   return true;
 }
@@ -113,6 +113,7 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
       refuse_cost(item.producer, refusal, detail);
       metrics_.overlap().end(0, token);
       set_busy(0, false);
+      queue_.charge(item.share_class, ms_since(t0));
       return false;
     }
     if (filters_.active()) {
@@ -157,6 +158,7 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
   metrics_.overlap().end(0, token);
   set_busy(0, false);
   job.producer = item.producer;
+  job.share_class = item.share_class;
   job.robot_id = item.msg.robot_id;
   job.seq = item.msg.seq;
   job.utime = item.msg.utime;
@@ -164,6 +166,7 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
   job.received = item.received;
   job.shot_at = SteadyClock::now();
   job.shoot_ms = ms_between(t0, job.shot_at);
+  queue_.charge(item.share_class, job.shoot_ms);
   return ok;
 }
 
@@ -247,12 +250,14 @@ void ScanPipeline::apply(ShotJob& job) {
   } catch (const std::exception& e) {
     set_busy(1, false);
     metrics_.overlap().end(1, token);
+    queue_.charge(job.share_class, ms_since(t0));
     reject(job.producer, Reject::kEngineError, e.what());
     return;
   }
   set_busy(1, false);
   map_.changed.notify_all();
   const auto t1 = SteadyClock::now();
+  queue_.charge(job.share_class, ms_between(t0, t1));
   const double overlap_s = metrics_.overlap().end(1, token);
   AppliedTiming t;
   t.shoot_ms = job.shoot_ms;
@@ -276,24 +281,36 @@ void ScanPipeline::apply(ShotJob& job) {
                            static_cast<int64_t>(job.shot.prepare.read_as_zero));
 }
 
+// Every scan the queue hands out leaves it again exactly once (ScanQueue::leave), when it has
+// left the stages: its class's next scan may then be served while another class streams.
 void ScanPipeline::run_stage1() {
   while (auto item = queue_.pop()) {
-    if (shed_if_stale(*item)) continue;
     ShotJob job;
-    if (shoot(*item, job)) handoff_.push(std::move(job));
+    if (!shed_if_stale(*item) && shoot(*item, job)) {
+      handoff_.push(std::move(job));
+    } else {
+      queue_.leave(*item);
+    }
   }
   handoff_.close();
 }
 
 void ScanPipeline::run_stage2() {
-  while (auto job = handoff_.pop()) apply(*job);
+  while (auto job = handoff_.pop()) {
+    apply(*job);
+    queue_.leave(job->share_class, job->edit != nullptr);
+  }
 }
 
 void ScanPipeline::run_sequential() {
   while (auto item = queue_.pop()) {
-    if (shed_if_stale(*item)) continue;
     ShotJob job;
-    if (shoot(*item, job)) apply(job);
+    if (!shed_if_stale(*item) && shoot(*item, job)) {
+      apply(job);
+      queue_.leave(job.share_class, job.edit != nullptr);
+    } else {
+      queue_.leave(*item);
+    }
   }
 }
 

@@ -26,6 +26,7 @@ namespace ort::daemon {
 
 struct ShotJob {
   size_t producer = 0;
+  size_t share_class = 0;  // whose share of the stages its time is charged to (intake/scan_queue.h)
   std::string robot_id;
   int64_t seq = 0, utime = 0, points = 0;
   SteadyClock::time_point received;
@@ -74,7 +75,8 @@ class ScanPipeline {
   void run_stage1();
   void run_stage2();
   void run_sequential();
-  // True (and counted as dropped) when the scan waited longer than max_queue_age_.
+  // True (and counted as dropped: over its share when other producers were served in its
+  // turn, else over latency bound) when the scan waited longer than max_queue_age_.
   bool shed_if_stale(const QueuedScan& item);
   void set_busy(int stage, bool busy);
 
