@@ -89,7 +89,7 @@ void MappingServer::load_or_create_map() {
   map_.epoch = new_map_epoch();
   if (!cfg_.prior_path.empty()) {
     // The prior is the new map's first change: state id 1.
-    map_.tree = load_prior_map(cfg_.prior_path, res, cfg_.engine.sensor);
+    map_.tree = load_prior_map(cfg_.prior_path, res, cfg_.engine.sensor, map_load_bound());
     map_.version = 1;
     log_.info(text("new map from the prior ", cfg_.prior_path, " (", map_.tree->size(), " nodes)",
                    cfg_.map_path.empty() ? "" : ", will be saved to " + cfg_.map_path));

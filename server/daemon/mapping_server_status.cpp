@@ -48,6 +48,12 @@ StatusInputs MappingServer::gather_status() {
     in.region_evictions = static_cast<int64_t>(r.evictions);
     in.region_restores = static_cast<int64_t>(r.restores);
     in.region_store_failures = static_cast<int64_t>(r.evict_failures + r.restore_failures);
+    in.evict_passes = static_cast<int64_t>(r.enforce_passes);
+    in.evict_ms = r.enforce_ms;
+    in.evict_count_ms = r.walk_ms;
+    in.evict_ms_max = r.longest_enforce_ms;
+    in.restore_ms = r.touch_ms;
+    in.restore_ms_max = r.longest_touch_ms;
     // The tree's memory as the bound counts it (between walks, the status' own leaf count lags).
     in.memory_bytes = static_cast<int64_t>(r.resident_bytes);
   }

@@ -186,6 +186,38 @@ TEST(StatusText, ShowsWhyARobotsScansWereDropped) {
       << status_json(s);
 }
 
+TEST(StatusText, ShowsWhatTheMemoryBoundCosts) {
+  auto s = example_status();
+  EXPECT_EQ(format_status(s, s.utime).find("  bound "), std::string::npos) << "nothing without a bound";
+  s.map_memory_bound = 8 << 20;
+  s.resident_regions = 120;
+  s.evicted_regions = 40;
+  s.evicted_bytes = 3 << 20;
+  s.region_evictions = 450;
+  s.region_restores = 204;
+  s.rss_bytes = 71 << 20;
+  s.evict_passes = 61;
+  s.evict_ms = 1450.5;
+  s.evict_count_ms = 420;
+  s.evict_ms_max = 148;
+  s.restore_ms = 760.25;
+  s.restore_ms_max = 107;
+  const std::string text = format_status(s, s.utime);
+  EXPECT_NE(text.find("  memory    bound 8.0 MiB: 10.0 MiB resident in 120 regions, 40 regions evicted (3.0 MiB in the "
+                      "store); 450 evictions, 204 restores"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("  bound     61 passes 1450.5 ms (exact counts 420.0, longest 148.0); restores 760.2 ms (longest "
+                      "107.0 a scan)\n"),
+            std::string::npos)
+      << text;
+  const std::string json = status_json(s);
+  for (const char* field :
+       {"\"evict_passes\":61", "\"evict_ms\":1450.5", "\"evict_count_ms\":420", "\"evict_ms_max\":148",
+        "\"restore_ms\":760.25", "\"restore_ms_max\":107", "\"evicted_bytes\":3145728", "\"map_memory_bound\":8388608"})
+    EXPECT_NE(json.find(field), std::string::npos) << field << " in " << json;
+}
+
 TEST(StatusJson, EveryFieldAndEscapedStrings) {
   const std::string json = status_json(example_status());
   EXPECT_EQ(json.front(), '{');

@@ -166,6 +166,18 @@ TEST(MemoryBound, ScansQueriesSavesAndRestartsPastTheBoundKeepOctomapsMap) {
     EXPECT_GT(st.evictions, 5u);
     EXPECT_GT(st.evicted_regions, 0u);
     EXPECT_EQ(st.max_bytes, bound);
+    // What the bound cost, in the status message (octomap-rt status shows it).
+    const octomap_rt::server_status_t msg = server.status();
+    EXPECT_EQ(msg.map_memory_bound, static_cast<int64_t>(bound));
+    EXPECT_GE(msg.region_evictions, static_cast<int64_t>(st.evictions));
+    EXPECT_GT(msg.evicted_bytes, 0);
+    EXPECT_LE(msg.memory_bytes, static_cast<int64_t>(bound + bound / 10)) << "resident, as the bound counts it";
+    EXPECT_GT(msg.evict_passes, 0);
+    EXPECT_GT(msg.evict_ms_max, 0);
+    EXPECT_GE(msg.evict_ms, msg.evict_ms_max);
+    EXPECT_GE(msg.evict_ms, msg.evict_count_ms);
+    EXPECT_GT(msg.restore_ms_max, 0);
+    EXPECT_GE(msg.restore_ms, msg.restore_ms_max);
     expect_octomaps(*server.whole_map(), *reference, "the whole map (a snapshot's copy)");
     ASSERT_TRUE(server.stop());
     expect_counts_balance(server.producer_stats());
@@ -187,6 +199,20 @@ TEST(MemoryBound, ScansQueriesSavesAndRestartsPastTheBoundKeepOctomapsMap) {
     EXPECT_EQ(st.evictions, 0u) << "the whole map was built, then evicted: " << log.str();
     EXPECT_LE(server.with_map([](const octomap::OcTree& t) { return t.memoryUsage(); }), bound);
     expect_octomaps(*server.whole_map(), *reference, "after a restart");
+  }
+  // The saved map as the --prior of a new map: loaded within the bound too (split like the
+  // map file, never built whole).
+  {
+    auto from_prior = cfg;
+    from_prior.prior_path = dir + "/map.ot";
+    from_prior.map_path = dir + "/from-prior.ot";
+    std::ostringstream log;
+    daemon::MappingServer server(from_prior, lc, log);
+    const daemon::MapResidencyStats st = server.residency_stats();
+    EXPECT_GT(st.evicted_regions, 0u) << log.str();
+    EXPECT_EQ(st.evictions, 0u) << "the prior was built whole, then evicted: " << log.str();
+    EXPECT_LE(server.with_map([](const octomap::OcTree& t) { return t.memoryUsage(); }), bound);
+    expect_octomaps(*server.whole_map(), *reference, "a new map from the prior");
   }
 }
 

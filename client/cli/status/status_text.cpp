@@ -62,7 +62,11 @@ void queue_and_kernel(std::ostringstream& o, const Status& s) {
       << with_commas(s.resident_regions) << " regions, " << with_commas(s.evicted_regions) << " regions evicted ("
       << bytes_text(s.evicted_bytes) << " in the store); " << with_commas(s.region_evictions) << " evictions, "
       << with_commas(s.region_restores) << " restores, " << with_commas(s.region_store_failures)
-      << " refused by the store; RSS " << (s.rss_bytes < 0 ? std::string("unknown") : bytes_text(s.rss_bytes)) << "\n";
+      << " refused by the store; RSS " << (s.rss_bytes < 0 ? std::string("unknown") : bytes_text(s.rss_bytes)) << "\n"
+      << fmt("  bound     %s passes %.1f ms (exact counts %.1f, longest %.1f); restores %.1f ms (longest %.1f a "
+             "scan)\n",
+             with_commas(s.evict_passes).c_str(), s.evict_ms, s.evict_count_ms, s.evict_ms_max, s.restore_ms,
+             s.restore_ms_max);
 }
 
 // The map service (snapshots, chunks) and the delta stream: what mirrors and map clients got.

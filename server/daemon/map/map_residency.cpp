@@ -58,9 +58,11 @@ void MapResidency::note_costs(double touch_ms, double enforce_ms, double walk_ms
       stats_.enforce_ms += enforce_ms;
       stats_.walk_ms += walk_ms;
       stats_.max_enforce_ms = std::max(stats_.max_enforce_ms, enforce_ms);
+      stats_.longest_enforce_ms = std::max(stats_.longest_enforce_ms, enforce_ms);
     }
     stats_.touch_ms += touch_ms;
     stats_.max_touch_ms = std::max(stats_.max_touch_ms, touch_ms);
+    stats_.longest_touch_ms = std::max(stats_.longest_touch_ms, touch_ms);
     if (seconds_since(reported_at_) < kCostReportS) return;
     if (stats_.evictions != reported_.evictions || stats_.restores != reported_.restores)
       line = residency_cost_line(reported_, stats_);

@@ -52,7 +52,8 @@ struct MapResidencyStats {
   // they start with, the scans' restores, and the octree layer's parts of both.
   uint64_t enforce_passes = 0;
   double enforce_ms = 0, walk_ms = 0, touch_ms = 0;
-  double max_enforce_ms = 0, max_touch_ms = 0;
+  double max_enforce_ms = 0, max_touch_ms = 0;          // since the last cost line
+  double longest_enforce_ms = 0, longest_touch_ms = 0;  // since start
   ResidencyCosts costs;
   uint64_t regions_recounted = 0, regions_reused = 0;  // by the exact counts (octree/region_tally.h)
 };

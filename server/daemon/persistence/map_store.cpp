@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <utility>
 
 #include "core/clock.h"
 #include "core/file_checks/octree_file_check.h"
@@ -123,6 +124,26 @@ std::unique_ptr<octomap::OcTree> load_map(const std::string& path, double resolu
   return load_map_file(path, resolution).tree;
 }
 
+namespace {
+
+// A checked .ot file's regions past the bound go to its spill, and `bytes` becomes the file
+// of the tree that stays (the whole file's bytes are dropped before any tree is built).
+MapFileSplit keep_within_bound(std::string& bytes, size_t data_offset, const MapLoadBound& bound,
+                               const std::string& what) {
+  MapFileSplit split;
+  try {
+    split = split_map_file(bytes, data_offset, bound.grid, bound.keep_bytes, bound.spill);
+  } catch (const MapStoreError&) {
+    throw;
+  } catch (const std::runtime_error& e) {  // the spill refused (the region store says why) or the data
+    throw MapStoreError(Kind::kRead, what + " could not be loaded within the memory bound: " + e.what());
+  }
+  bytes = std::move(split.kept);
+  return split;
+}
+
+}  // namespace
+
 LoadedMapFile load_map_file(const std::string& path, double resolution, const MapLoadBound* bound) {
   std::string bytes = read_whole(path);
   const OctreeFileCheck check = check_octree_file(bytes, /*inner_is_max=*/true);
@@ -138,22 +159,13 @@ LoadedMapFile load_map_file(const std::string& path, double resolution, const Ma
   LoadedMapFile loaded;
   loaded.bytes = bytes.size();
   loaded.hash = map_file_hash(bytes);
-  MapFileSplit split;
   if (bound) {
-    try {
-      split = split_map_file(bytes, check.data_offset, bound->grid, bound->keep_bytes, bound->spill);
-    } catch (const MapStoreError&) {
-      throw;
-    } catch (const std::runtime_error& e) {  // the spill refused (the region store says why) or the data
-      throw MapStoreError(Kind::kRead, "map '" + path + "' could not be loaded within the memory bound: " + e.what());
-    }
+    const MapFileSplit split = keep_within_bound(bytes, check.data_offset, *bound, "map '" + path + "'");
     loaded.spilled_regions = split.spilled_regions;
     loaded.spilled_nodes = split.spilled_nodes;
-    std::string().swap(bytes);  // the tree is built from the kept part alone
   }
   try {
-    loaded.tree = read_octree_file_bytes(bound ? std::string_view(split.kept) : std::string_view(bytes),
-                                         "map '" + path + "'", /*inner_is_max=*/true);
+    loaded.tree = read_octree_file_bytes(bytes, "map '" + path + "'", /*inner_is_max=*/true);
   } catch (const std::runtime_error& e) {
     // The file was checked whole above: a kept part that does not read is this server's
     // fault, not the file's (never moved aside as corrupt; regions already went to the spill).
@@ -164,14 +176,19 @@ LoadedMapFile load_map_file(const std::string& path, double resolution, const Ma
   return loaded;
 }
 
-std::unique_ptr<octomap::OcTree> load_prior_map(const std::string& path, double resolution, const SensorModel& sensor) {
-  const std::string bytes = read_whole(path);
+std::unique_ptr<octomap::OcTree> load_prior_map(const std::string& path, double resolution, const SensorModel& sensor,
+                                                const MapLoadBound* bound) {
+  std::string bytes = read_whole(path);
   const OctreeFileCheck check = check_octree_file(bytes);
   if (!check.ok) {
     const bool other_tree = !check.tree_type.empty() && check.tree_type != "OcTree";
     throw MapStoreError(other_tree ? Kind::kWrongType : Kind::kCorrupt,
                         "prior map '" + path + "' is not a complete OctoMap OcTree file (.bt or .ot): " + check.error);
   }
+  // A .ot prior is split like the map file; a .bt one (another body) is loaded whole, and the
+  // bound's first pass takes it down.
+  if (bound && check.format == OctreeFileFormat::kFull)
+    keep_within_bound(bytes, check.data_offset, *bound, "prior map '" + path + "'");
   std::unique_ptr<octomap::OcTree> tree;
   try {
     tree = read_octree_file_bytes(bytes, "prior map '" + path + "'");

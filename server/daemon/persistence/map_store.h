@@ -75,7 +75,9 @@ LoadedMapFile load_map_file(const std::string& path, double resolution, const Ma
 // kept) or .bt (maximum likelihood: each node at `sensor`'s clamping maximum if occupied,
 // minimum if free, as OctoMap's readBinary would give with that sensor model), checked whole
 // before OctoMap reads it. Throws MapStoreError like load_map (kWrongResolution: not `resolution`).
-std::unique_ptr<octomap::OcTree> load_prior_map(const std::string& path, double resolution, const SensorModel& sensor);
+// With `bound`, a .ot prior is loaded within it as load_map_file loads the map file.
+std::unique_ptr<octomap::OcTree> load_prior_map(const std::string& path, double resolution, const SensorModel& sensor,
+                                                const MapLoadBound* bound = nullptr);
 
 // The resolution in an OctoMap file's header (.ot or .bt), read without loading the tree:
 // what the server maps at when started without -r. Throws MapStoreError (kOpen, kCorrupt).

@@ -163,10 +163,12 @@ void print_run_summary(std::ostream& out, const RunSummaryInputs& in) {
   if (s.map_memory_bound > 0) {
     std::snprintf(line, sizeof line,
                   "  memory bound: %.1f MiB; %lld regions evicted (%.1f MiB in the store), %lld evictions, %lld "
-                  "restores, %lld refused by the store; RSS %.1f MiB\n",
+                  "restores, %lld refused by the store; RSS %.1f MiB; %lld passes %.0f ms (exact counts %.0f, "
+                  "longest %.1f), restores %.0f ms (longest %.1f a scan)\n",
                   s.map_memory_bound / 1048576.0, (long long)s.evicted_regions, s.evicted_bytes / 1048576.0,
                   (long long)s.region_evictions, (long long)s.region_restores, (long long)s.region_store_failures,
-                  s.rss_bytes / 1048576.0);
+                  s.rss_bytes / 1048576.0, (long long)s.evict_passes, s.evict_ms, s.evict_count_ms, s.evict_ms_max,
+                  s.restore_ms, s.restore_ms_max);
     out << line;
   }
   print_serving(out, in);

@@ -143,6 +143,12 @@ octomap_rt::server_status_t make_status(const StatusInputs& in) {
   s.region_restores = in.region_restores;
   s.region_store_failures = in.region_store_failures;
   s.rss_bytes = in.rss_bytes;
+  s.evict_passes = in.evict_passes;
+  s.evict_ms = in.evict_ms;
+  s.evict_count_ms = in.evict_count_ms;
+  s.evict_ms_max = in.evict_ms_max;
+  s.restore_ms = in.restore_ms;
+  s.restore_ms_max = in.restore_ms_max;
   s.map_saves = in.map_saves;
   s.last_save_utime = in.last_save_utime;
   s.latest_snapshot_id = in.latest_snapshot_id;

@@ -31,6 +31,8 @@ struct StatusInputs {
   // The memory bound (daemon/map/map_residency.h) and the process's RSS.
   int64_t map_memory_bound = 0, resident_regions = 0, evicted_regions = 0, evicted_bytes = 0;
   int64_t region_evictions = 0, region_restores = 0, region_store_failures = 0, rss_bytes = -1;
+  int64_t evict_passes = 0;
+  double evict_ms = 0, evict_count_ms = 0, evict_ms_max = 0, restore_ms = 0, restore_ms_max = 0;
   int64_t map_saves = 0, last_save_utime = 0;
   int64_t map_version = 0, map_epoch = 0, latest_snapshot_id = 0, requests_served = 0, requests_rejected = 0;
   int64_t snapshots_taken = 0, chunks_sent = 0, deltas_sent = 0, last_delta_seq = -1;
