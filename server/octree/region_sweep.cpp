@@ -63,7 +63,12 @@ RegionSweep::RegionSweep(const octomap::OcTree& tree, const RegionGrid& grid) : 
 }
 
 void RegionSweep::visit_unit(octomap::OcTree& tree, const Unit& unit, const RegionVisit& visit) {
-  if (spill_.visiting) spill_.visiting(unit.min_key, unit.depth);
+  const size_t nodes = tree.size();  // OctoMap's counter: every node made or deleted changes it
+  sweep_unit(tree, unit, visit);
+  if (spill_.reshaped && tree.size() != nodes) spill_.reshaped(unit.min_key, unit.depth);
+}
+
+void RegionSweep::sweep_unit(octomap::OcTree& tree, const Unit& unit, const RegionVisit& visit) {
   if (unit.depth == grid_.depth && spill_.bring_back) spill_.bring_back(tree, region_of(grid_, unit.min_key));
   octomap::OcTreeNode* root = tree.getRoot();
   if (root == nullptr) return;

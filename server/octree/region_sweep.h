@@ -45,12 +45,13 @@ octomap::OcTreeKey child_min_key(const octomap::OcTreeKey& min_key, unsigned dep
 // With a memory bound (octree/region_residency.h) some regions are stand-ins for subtrees on
 // disk: a sweep brings each back before it visits it, and its closing prune leaves alone every
 // node with a stand-in below it (the same map without the bound has a subtree there).
-// `visiting` hears of every listed region (or coarse leaf: its min-corner key and depth) before
-// the sweep may change it (the bound's memory tally, octree/region_tally.h).
+// `reshaped` hears of every listed region (or coarse leaf: its min-corner key and depth) whose
+// visit made or deleted nodes (the bound's memory tally, octree/region_tally.h: a visit that
+// only changed values leaves every node's children as they were).
 struct SweepSpill {
   std::function<void(octomap::OcTree&, RegionId)> bring_back;
   std::function<bool(RegionId)> spilled;
-  std::function<void(const octomap::OcTreeKey& min_key, unsigned depth)> visiting;
+  std::function<void(const octomap::OcTreeKey& min_key, unsigned depth)> reshaped;
 };
 
 class RegionSweep {
@@ -73,6 +74,7 @@ class RegionSweep {
     unsigned depth;
   };
   void visit_unit(octomap::OcTree& tree, const Unit& unit, const RegionVisit& visit);
+  void sweep_unit(octomap::OcTree& tree, const Unit& unit, const RegionVisit& visit);
 
   RegionGrid grid_;
   SweepSpill spill_;

@@ -154,7 +154,7 @@ TEST(Eviction, ExactMemoryCountEqualsTheWalkAfterEveryChange) {
   hooks.spilled = [&](RegionId id) {
     return !residency.spilled_in(region_min_key(sweep_grid, id), region_max_key(sweep_grid, id)).empty();
   };
-  hooks.visiting = [&](const octomap::OcTreeKey& k, unsigned depth) {
+  hooks.reshaped = [&](const octomap::OcTreeKey& k, unsigned depth) {
     const auto last = static_cast<uint16_t>((1u << (16 - depth)) - 1);
     residency.changed_box(k, octomap::OcTreeKey(uint16_t(k[0] | last), uint16_t(k[1] | last), uint16_t(k[2] | last)));
   };

@@ -194,7 +194,7 @@ SweepSpill MapResidency::sweep_hooks(const RegionGrid& sweep) {
     for (RegionId r : inside) residency_.bring_back(tree, r);  // throws when the store refuses: the sweep stops
     count_residency_change();
   };
-  s.visiting = [this](const octomap::OcTreeKey& min_key, unsigned depth) {
+  s.reshaped = [this](const octomap::OcTreeKey& min_key, unsigned depth) {
     std::lock_guard lock(mutex_);
     const auto last = static_cast<uint16_t>((1u << (16 - depth)) - 1);
     residency_.changed_box(min_key, octomap::OcTreeKey(uint16_t(min_key[0] | last), uint16_t(min_key[1] | last),
