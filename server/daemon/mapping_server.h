@@ -107,6 +107,13 @@ class MappingServer {
     std::unique_lock lock(map_.mutex);
     while (!release) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
+  // Who held the map of record's lock (and the replica's) the longest, and whom stage 2's
+  // longest wait for it waited for (daemon/map/map_lock_holders.h).
+  std::vector<LockHolderFigures> map_lock_holders() { return map_.holders.figures(); }
+  std::vector<LockHolderFigures> replica_lock_holders() {
+    return replica_ ? replica_->state().holders.figures() : std::vector<LockHolderFigures>{};
+  }
+  MetricsSnapshot pipeline_metrics() { return metrics_.snapshot(); }
   std::optional<ReplicaStats> replica_stats() const {
     return replica_ ? std::optional<ReplicaStats>(replica_->stats()) : std::nullopt;
   }

@@ -202,6 +202,9 @@ int run(const Args& a) {
   const double seconds = seconds_since(t0);
   r.stop();
   const auto st = server.status();
+  const daemon::MetricsSnapshot metrics = server.pipeline_metrics();
+  const auto holders = server.map_lock_holders();
+  const auto replica_holders = server.replica_lock_holders();
   const double rss_end = rss_mib("VmRSS:"), hwm = rss_mib("VmHWM:");
   const bench::ReaderStats rs = r.stats();
   server.stop();
@@ -213,8 +216,18 @@ int run(const Args& a) {
       readers ? "on" : "off", a.replica.c_str(), (long long)loaded.num_nodes, load_s, (long long)st.scans_applied,
       (long long)published.load(), seconds, a.producers, a.rate, a.preset.c_str(), a.stream_point_scale,
       st.backend.c_str());
-  std::printf("  octree stage: lock wait max %.1f ms, p99 %.2f ms; octree p50 %.1f ms p99 %.1f ms\n",
-              st.octree_lock_wait_ms_max, st.octree_lock_wait_ms_p99, st.octree_ms_p50, st.octree_ms_p99);
+  std::printf("  octree stage: lock wait max %.1f ms (waited for: %s), p99 %.2f ms; octree p50 %.1f ms p99 %.1f ms\n",
+              st.octree_lock_wait_ms_max, metrics.lock_wait_max_holder, st.octree_lock_wait_ms_p99, st.octree_ms_p50,
+              st.octree_ms_p99);
+  auto print_holders = [](const char* what, const std::vector<daemon::LockHolderFigures>& hs) {
+    std::printf("  %s lock held by (longest first):", what);
+    for (const auto& h : hs)
+      std::printf(" %s: %llu holds, max %.1f ms, %.0f ms in all;", h.name, (unsigned long long)h.holds, h.max_ms,
+                  h.total_ms);
+    std::printf("\n");
+  };
+  print_holders("map of record's", holders);
+  if (!replica_holders.empty()) print_holders("read replica's", replica_holders);
   std::printf("  scans end to end: p50 %.1f ms, p99 %.1f ms\n", st.end_to_end_ms_p50, st.end_to_end_ms_p99);
   std::printf("  queries: %lld sent, %zu answered, p50 %.2f ms, p99 %.2f ms, %lld unanswered\n",
               (long long)rs.queries_sent, rs.query_ms.size(), percentile(rs.query_ms, 0.5),

@@ -25,11 +25,13 @@ map=${MAP:-${TMPDIR:-/tmp}/issue23-bigmap-$$.ot}
 [ -f "$map" ] || "$B" grow "${E[@]}" --point-scale 0.2 --target-nodes 5000000 --map "$map" > "$out/grow.txt" 2>&1
 R=(--map "$map" --stream-point-scale 0.01 --producers 3 --rate 0.2 --duration 40)
 run() { local name=$1; shift; "$B" run "${E[@]}" "${R[@]}" "$@" > "$out/run-$name.txt" 2>&1; uptime >> "$out/machine.txt"; }
+# RUNS picks the kinds of run (default all four), e.g. RUNS="off after" for the shorter variant.
+has() { case " ${RUNS:-off after nice0 unbatched} " in *" $1 "*) return 0;; esac; return 1; }
 for round in ${ROUNDS:-a b c}; do
-  run "off-$round" --readers off --read-replica off
-  run "after-$round" --readers on --read-replica on --snapshot-period 10
-  run "nice0-$round" --readers on --read-replica on --snapshot-period 10 --replica-nice 0
-  run "unbatched-$round" --readers on --read-replica on --snapshot-period 10 --replica-batch-voxels 0 --replica-nice 0 --replica-threads 1
+  has off && run "off-$round" --readers off --read-replica off
+  has after && run "after-$round" --readers on --read-replica on --snapshot-period 10
+  has nice0 && run "nice0-$round" --readers on --read-replica on --snapshot-period 10 --replica-nice 0
+  has unbatched && run "unbatched-$round" --readers on --read-replica on --snapshot-period 10 --replica-batch-voxels 0 --replica-nice 0 --replica-threads 1
 done
 if [ -z "${SKIP_SNAPSHOT_1S:-}" ]; then
   run before-1s --readers on --read-replica off --snapshot-period 1

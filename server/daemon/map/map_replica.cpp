@@ -5,6 +5,7 @@
 #include <optional>
 #include <shared_mutex>
 #include <span>
+#include <thread>
 
 #include "core/clock.h"
 #include "core/thread_priority.h"
@@ -22,6 +23,7 @@ MapReplica::MapReplica(const MapState& map, const OctreeUpdateOptions& octree, u
   state_.newest_scan = map.newest_scan;
   state_.leaves.store(map.leaves.load(std::memory_order_relaxed), std::memory_order_relaxed);
   stats_.version = map.version;
+  record_version_ = applied_version_ = map.version;
   thread_ = std::thread([this, nice] {
     lower_this_thread_priority(nice);
     run();
@@ -77,6 +79,7 @@ void MapReplica::push(Item item) {
   stats_.pending_items++;
   stats_.pending_bytes += item.bytes;
   stats_.max_pending_bytes_seen = std::max(stats_.max_pending_bytes_seen, stats_.pending_bytes);
+  record_version_.store(item.version, std::memory_order_release);
   queue_.push_back(std::move(item));
   work_.notify_one();
 }
@@ -101,6 +104,7 @@ void MapReplica::apply_batch(std::deque<Item>& batch) {
     voxels = joined_;
   }
   std::unique_lock lock(state_.mutex);
+  const MapHoldNote note(state_.holders, "replica update");
   // The leaf count as the map of record keeps it (daemon/map/map_identity.h): the octree
   // stage says how the batch changed it; a step does not (0 if it left the tree empty).
   std::optional<int64_t> leaf_change;
@@ -146,6 +150,7 @@ void MapReplica::run() {
       stats_.pending_items -= std::min(stats_.pending_items, items);
       stats_.pending_bytes -= std::min(stats_.pending_bytes, bytes);
       stats_.version = state_.version;
+      applied_version_.store(state_.version, std::memory_order_release);
     }
     room_.notify_all();
     progress_.notify_all();
@@ -166,29 +171,35 @@ ReplicaStats MapReplica::stats() const {
 
 MapState& readable_map(MapState& map) {
   if (!map.replica) return map;
-  uint64_t version;
-  {
-    std::shared_lock lock(map.mutex);
-    version = map.version;
-  }
-  map.replica->wait_for(version, 1e9);
+  // The map of record's id without its lock: a reader never holds the octree stage up.
+  map.replica->wait_for(map.replica->record_version(), 1e9);
   return map.replica->state();
 }
 
 MapState& lock_for_short_read(MapState& map, uint64_t min_version, std::shared_lock<std::shared_mutex>& lock) {
-  lock = std::shared_lock(map.mutex, std::try_to_lock);
-  if (lock.owns_lock() || !map.replica) {
-    if (!lock.owns_lock()) lock = std::shared_lock(map.mutex);
+  if (!map.replica) {
+    lock = std::shared_lock(map.mutex);
     return map;
   }
   MapState& replica = map.replica->state();
-  lock = std::shared_lock(replica.mutex, std::try_to_lock);
-  if (lock.owns_lock() && replica.version >= min_version) return replica;
-  // Never wait for the map of record while holding the replica: stage 2 may be waiting (under
-  // the map lock) for the replica's thread to make room, and that thread for this lock.
-  if (lock.owns_lock()) lock.unlock();
-  lock = std::shared_lock(map.mutex);
-  return map;
+  auto try_replica = [&] {
+    lock = std::shared_lock(replica.mutex, std::try_to_lock);
+    if (lock.owns_lock() && replica.version >= min_version) return true;
+    if (lock.owns_lock()) lock.unlock();
+    return false;
+  };
+  // A replica that caught up is the map of record's state: read it, and leave the map of
+  // record's lock to stage 2 (every reader that takes it may hold stage 2 up).
+  if (map.replica->caught_up() && try_replica()) return replica;
+  // Else whichever is free first. Never wait for one while holding the other: stage 2 may be
+  // waiting (under the map lock) for the replica's thread to make room, and that thread for
+  // the replica's lock; so both are tried, and tried again until one is free.
+  for (;;) {
+    lock = std::shared_lock(map.mutex, std::try_to_lock);
+    if (lock.owns_lock()) return map;
+    if (try_replica()) return replica;
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
 }
 
 }  // namespace ort::daemon

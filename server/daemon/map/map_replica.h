@@ -27,6 +27,7 @@
 // replica catches up, a batch at a time, when the stage waits for scans.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -82,6 +83,13 @@ class MapReplica {
   MapState& state() { return state_; }
   // Waits until the replica reached `version` (or stopped); false on the timeout.
   bool wait_for(uint64_t version, double timeout_s);
+  // The map of record's state id as of the last change handed over (stage 2 hands each over
+  // under the map lock right after counting it), read without the map of record's lock;
+  // and whether the replica has applied everything up to it (its tree is the map of record's).
+  uint64_t record_version() const { return record_version_.load(std::memory_order_acquire); }
+  bool caught_up() const {
+    return applied_version_.load(std::memory_order_acquire) == record_version_.load(std::memory_order_acquire);
+  }
   ReplicaStats stats() const;
   void stop();
 
@@ -112,6 +120,7 @@ class MapReplica {
   std::deque<Item> queue_;
   bool stop_ = false;
   ReplicaStats stats_;
+  std::atomic<uint64_t> record_version_{0}, applied_version_{0};
   std::thread thread_;
 };
 

@@ -18,6 +18,7 @@
 #include "core/clock.h"
 #include "core/voxel_update.h"
 #include "daemon/map/applied_order.h"
+#include "daemon/map/map_lock_holders.h"
 #include "octree/leaf_changes.h"
 
 namespace ort::daemon {
@@ -49,6 +50,8 @@ inline std::string robot_key(std::string id) {
 struct MapState {
   // Writers (stage 2, edits) lock it exclusively; queries read under a shared lock.
   std::shared_mutex mutex;
+  // Who held `mutex` and for how long (daemon/map/map_lock_holders.h): each holder names itself.
+  MapLockHolders holders;
   std::unique_ptr<octomap::OcTree> tree;
   AppliedOrder order;
   // The map's identity (daemon/map/map_identity.h): `version` is the map state id, +1 for

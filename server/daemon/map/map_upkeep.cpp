@@ -84,6 +84,7 @@ void MapUpkeep::run_sweep(std::function<std::unique_ptr<Sweep>(const octomap::Oc
     const auto t0 = SteadyClock::now();
     {
       std::unique_lock lock(map_.mutex);
+      const MapHoldNote note(map_.holders, "upkeep slice");
       try {
         apply_slice(slice);
         done = slices->on(*map_.tree)->done();

@@ -22,9 +22,10 @@ struct ScanWaits {
 // Stage 2's parts: octree_ms = lock_wait_ms + update_ms + publish_ms (and a few bookkeeping
 // microseconds).
 struct Stage2Parts {
-  double lock_wait_ms = 0;  // waiting for the map lock (a snapshot copy, a status count, a query)
-  double update_ms = 0;     // MapEngine::apply: the octree update (and its change log)
-  double publish_ms = 0;    // the map observer (deltas, grid) on the scan's changes
+  double lock_wait_ms = 0;       // waiting for the map lock (a snapshot copy, a status count, a query)
+  double update_ms = 0;          // MapEngine::apply: the octree update (and its change log)
+  double publish_ms = 0;         // the map observer (deltas, grid) on the scan's changes
+  const char* lock_holder = "";  // who let go of the map lock last before stage 2 got it
 };
 
 struct AppliedTiming {

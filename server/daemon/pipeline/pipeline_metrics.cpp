@@ -16,7 +16,10 @@ void PipelineMetrics::record(const AppliedTiming& t) {
   queue_wait_.add(t.waits.queue_ms);
   handoff_wait_.add(t.waits.handoff_ms);
   lock_wait_.add(t.stage2.lock_wait_ms);
-  lock_wait_max_ = std::max(lock_wait_max_, t.stage2.lock_wait_ms);
+  if (t.stage2.lock_wait_ms > lock_wait_max_) {
+    lock_wait_max_ = t.stage2.lock_wait_ms;
+    lock_wait_max_holder_ = t.stage2.lock_holder;
+  }
   stage1_total_.add(t.stage1);
   slowest_.add(t);
   scans_++;
@@ -46,6 +49,7 @@ MetricsSnapshot PipelineMetrics::snapshot() {
   s.handoff_wait = both(handoff_wait_);
   s.lock_wait = both(lock_wait_);
   s.lock_wait_max = lock_wait_max_;
+  s.lock_wait_max_holder = lock_wait_max_holder_;
   s.stage1_total = stage1_total_;
   s.slowest = slowest_.slowest();
   while (!recent_.empty() && std::chrono::duration<double>(now - recent_.front().first).count() > kRateWindowS)

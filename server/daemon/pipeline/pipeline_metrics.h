@@ -33,8 +33,9 @@ struct MetricsSnapshot {
   // counts, queries): over the window, and the longest since start.
   Percentiles lock_wait;
   double lock_wait_max = 0;
-  StageTimes stage1_total;        // the engine's parts of stage 1, summed over every scan
-  std::vector<SlowScan> slowest;  // the run's slowest scans end to end, slowest first
+  const char* lock_wait_max_holder = "";  // whom the longest wait waited for (map_lock_holders.h)
+  StageTimes stage1_total;                // the engine's parts of stage 1, summed over every scan
+  std::vector<SlowScan> slowest;          // the run's slowest scans end to end, slowest first
 };
 
 class PipelineMetrics {
@@ -48,6 +49,7 @@ class PipelineMetrics {
   std::mutex mutex_;
   LatencyWindow shoot_, octree_, e2e_, decode_, queue_wait_, handoff_wait_, lock_wait_;
   double lock_wait_max_ = 0;
+  const char* lock_wait_max_holder_ = "";
   StageTimes stage1_total_;
   SlowestScans slowest_;
   std::deque<std::pair<SteadyClock::time_point, int64_t>> recent_;  // applied scans: time, points

@@ -179,6 +179,7 @@ void ScanPipeline::apply_edit(MapEditItem& edit) {
   try {
     std::unique_lock lock(map_.mutex);
     const auto locked = SteadyClock::now();
+    const MapHoldNote note(map_.holders, "map edit");
     r = apply_map_edit(map_, edit);
     r.locked_ms = ms_since(locked);
   } catch (const std::exception& e) {
@@ -224,6 +225,9 @@ void ScanPipeline::apply(ShotJob& job) {
   try {
     std::lock_guard lock(map_.mutex);
     const auto locked = SteadyClock::now();
+    // The holder it waited for let go of the lock last (daemon/map/map_lock_holders.h).
+    const char* waited_for = map_.holders.last_released();
+    const MapHoldNote note(map_.holders, "scan update (stage 2)");
     // Spilled regions the scan updates come back first (daemon/map/map_residency.h).
     if (std::string why; map_.residency && !map_.residency->touch_scan(*map_.tree, job.shot.voxels, why))
       throw std::runtime_error(why);
@@ -246,7 +250,7 @@ void ScanPipeline::apply(ShotJob& job) {
     note_robot_seen(map_, robot, job.origin);
     if (map_.residency) map_.residency->enforce(*map_.tree);
     if (map_.replica) map_.replica->scan_applied(job.shot.voxels, map_, robot);
-    parts = {ms_between(t0, locked), ms_between(locked, updated), ms_between(updated, SteadyClock::now())};
+    parts = {ms_between(t0, locked), ms_between(locked, updated), ms_between(updated, SteadyClock::now()), waited_for};
   } catch (const std::exception& e) {
     set_busy(1, false);
     metrics_.overlap().end(1, token);

@@ -39,6 +39,7 @@ void GridPublisher::compute_if_changed() {
   q.reply_channel = cfg_.channel;
   const QueryMessage msg(q);
   std::shared_lock lock(map_.mutex);
+  const MapHoldNote note(map_.holders, "grid publisher");
   if (map_.version == computed_version_) return;
   computed_version_ = map_.version;
   const MapStamp stamp{static_cast<int64_t>(map_.version), map_.last_scan_utime, static_cast<int64_t>(map_.epoch)};

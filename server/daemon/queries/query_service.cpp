@@ -335,6 +335,7 @@ void QueryService::run() {
         turn_map_ = &lock_for_short_read(map_, answered_version_, lock);
       }
       answered_version_ = std::max(answered_version_, turn_map_->version);
+      const MapHoldNote note(turn_map_->holders, "query turn");
       const auto turn_end = SteadyClock::now() + kReadTurn;
       for (size_t i = 0; i < parked.size();) {
         if (answer_locked(parked[i], out)) {
@@ -373,6 +374,7 @@ void QueryService::run() {
 // they are answered, and the bound holds again (daemon/map/map_residency.h).
 void QueryService::answer_restoring(std::vector<PendingQuery>& parked, std::vector<EncodedReplies>& out) {
   std::unique_lock lock(map_.mutex);
+  const MapHoldNote note(map_.holders, "query restoring regions");
   turn_map_ = &map_;
   exclusive_turn_ = true;
   for (PendingQuery& q : to_restore_) {

@@ -113,6 +113,7 @@ protocol::SnapshotClock MapService::snapshot_clock() {
       std::chrono::duration<double>(std::max(cfg_.fresh_interval_s, cfg_.snapshots.min_interval_s)));
   if (store_.latest_id() >= 0) {
     std::shared_lock lock(map_.mutex);
+    const MapHoldNote note(map_.holders, "snapshot freshness check");
     c.newest_is_current = static_cast<int64_t>(map_.version) == store_.latest_id();
   }
   return c;
@@ -257,6 +258,7 @@ void MapService::publish_info() {
   m.utime = now_utime();
   {
     std::shared_lock lock(map_.mutex);
+    const MapHoldNote note(map_.holders, "map info");
     m.map_version = static_cast<int64_t>(map_.version);
     m.map_epoch = static_cast<int64_t>(map_.epoch);
   }

@@ -38,6 +38,7 @@ MapCopy copy_map(MapState& map) {
   MapCopy c;
   {
     std::shared_lock lock(map.mutex);  // a reader: queries may read at the same time
+    const MapHoldNote note(map.holders, "map copy (snapshot, save)");
     c = copy_locked(map, t0, spilled);
   }
   fill_spilled(map, c, spilled);
@@ -50,6 +51,7 @@ std::optional<MapCopy> copy_map_if_changed(MapState& map, uint64_t unchanged_sin
   MapCopy c;
   {
     std::shared_lock lock(map.mutex);  // a reader: queries may read at the same time
+    const MapHoldNote note(map.holders, "map copy (viewer map)");
     if (map.version == unchanged_since) return std::nullopt;
     c = copy_locked(map, t0, spilled);
   }

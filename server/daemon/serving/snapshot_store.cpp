@@ -19,7 +19,8 @@ std::shared_ptr<const SnapshotBlob> SnapshotStore::latest(MapState& map, int8_t 
   if (old_enough) {
     uint64_t version;
     {
-      std::lock_guard lock(map.mutex);
+      std::shared_lock lock(map.mutex);
+      const MapHoldNote note(map.holders, "snapshot id check");
       version = map.version;
     }
     if (kept_.empty() || version != kept_.back().contents.snapshot_id) {

@@ -39,12 +39,14 @@ MapSize MapFigures::read(MapState& map, bool pipeline_drained) {
   if (map.replica) {
     MapState& r = map.replica->state();
     if (std::shared_lock rl = try_shared(r.mutex); rl.owns_lock()) {
+      const MapHoldNote note(r.holders, "status (leaf count)");
       if (r.leaves.load(std::memory_order_relaxed) < 0) recount(*r.tree, r.leaves, pipeline_drained);
       replica_leaves = r.leaves.load(std::memory_order_relaxed);
       replica_version = r.version;
     }
   }
   if (std::shared_lock lock = try_shared(map.mutex); lock.owns_lock()) {
+    const MapHoldNote note(map.holders, "status (map size)");
     const octomap::OcTree& t = *map.tree;
     // Two trees at one state id are the same tree: the map of record takes the replica's count.
     if (map.leaves.load(std::memory_order_relaxed) < 0 && replica_leaves >= 0 && replica_version == map.version)
