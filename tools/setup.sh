@@ -24,8 +24,9 @@ groups[tests]="python3-zstandard liblcm-java default-jdk-headless bzip2 gnuplot-
 groups[fuzz]="clang-14 libclang-rt-14-dev"
 # The format check of every C++ file (tools/check-format, run by tools/run-tests).
 groups[format]="clang-format-14"
-# lcm-spy (tools/octomap-rt-spy: a JRE with AWT, jchart2d) and the screenshot tools (Xvfb, xdotool).
-groups[viewers]="liblcm-java libjchart2d-java default-jre xvfb xdotool"
+# lcm-spy (tools/octomap-rt-spy: a JRE with AWT, jchart2d) and the screenshot tools (Xvfb, xdotool,
+# ImageMagick's import: tools/spy-screenshot/).
+groups[viewers]="liblcm-java libjchart2d-java default-jre xvfb xdotool imagemagick"
 
 install_groups() {
   local missing=() p g
