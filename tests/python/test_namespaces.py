@@ -1,7 +1,8 @@
 """Two servers in two namespaces on one LCM URL (issue 24, item 3): each client talks only to
-its own server, every channel (status, map info, queries, scans, the viewer's OCTOMAP) carries
-its namespace, nothing goes out under today's names, and a namespace that would make a channel
-longer than LCM's 63 characters stops the server at start."""
+its own server (the CLI, Python and the Java examples), every channel (status, map info,
+queries, edits, scans, the viewer's OCTOMAP) carries its namespace, nothing goes out under
+today's names, and a namespace that would make a channel longer than LCM's 63 characters stops
+the server at start."""
 
 import json
 import os
@@ -16,6 +17,8 @@ import numpy as np
 
 import octomap_rt
 from server_fixture import CLI, SERVER, test_url
+
+JAVA_CP = os.environ.get("OCTOMAP_RT_JAVA_CP", "")  # lcm.jar, our types jar, the examples' jar
 
 
 def start_server(url, ns, server_id, log, use_env=False):
@@ -102,6 +105,25 @@ class TwoNamespacesOnOneUrl(unittest.TestCase):
         info = subprocess.run([CLI, "map", "info", "--json", "--lcm-url", self.url, "--namespace", "lab_b"],
                               capture_output=True, text=True, timeout=60)
         self.assertEqual(info.returncode, 0, info.stderr)
+
+    @unittest.skipUnless(JAVA_CP, "no JDK: the Java examples were not built")
+    def test_the_java_examples_take_the_namespace_from_the_environment(self):
+        java = ["java", "-Djava.net.preferIPv4Stack=true", "-cp", JAVA_CP]
+        env = dict(os.environ, OCTOMAP_RT_NAMESPACE="lab_b")
+        run = subprocess.run(java + ["StatusListener", self.url, "2"], capture_output=True, text=True, timeout=60,
+                             env=env)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        heard = [line for line in run.stdout.splitlines() if ": state " in line]
+        self.assertEqual(len(heard), 2, run.stdout)
+        self.assertTrue(all(line.startswith("server-b: ") for line in heard), run.stdout)
+        # An edit goes to the namespace's edit channel, signed for it, and its acknowledgement
+        # comes back on the namespace's reply channel: server-a has no control token, so it
+        # refuses the edit and says why (without the namespace nobody answers: exit 2).
+        env["OCTOMAP_RT_NAMESPACE"] = "lab_a"
+        edit = subprocess.run(java + ["MapEdit", self.url, "any-token", "reset"], capture_output=True, text=True,
+                              timeout=60, env=env)
+        self.assertEqual(edit.returncode, 3, edit.stdout + edit.stderr)
+        self.assertIn("map edits are off", edit.stdout)
 
     def test_a_namespace_too_long_for_lcm_stops_the_server_at_start(self):
         run = subprocess.run([SERVER, "-r", "0.1", "--lcm-url", self.url, "--backend", "cpu",

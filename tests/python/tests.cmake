@@ -5,6 +5,10 @@ set(ORT_PY_TEST_ENV "PYTHONPATH=${CMAKE_BINARY_DIR}/python:${CMAKE_CURRENT_LIST_
     "OCTOMAP_RT_CLI=$<TARGET_FILE:octomap-rt>" "OCTOMAP_RT_SERVER=$<TARGET_FILE:octomap-rt-server>"
     "PYTHONDONTWRITEBYTECODE=1" "OCTOMAP_RT_DATA=${OCTOMAP_RT_DATA_DIR}"
     "OCTOMAP_RT_PUBLISH_EXAMPLE=$<TARGET_FILE:octomap-rt-publish-example>")
+# The Java examples (client/bindings/java/), when a JDK built them: test_namespaces runs them.
+if(TARGET octomap_rt_java_examples)
+  list(APPEND ORT_PY_TEST_ENV "OCTOMAP_RT_JAVA_CP=${LCM_JAR}:$<TARGET_PROPERTY:octomap_rt_lcmtypes_jar,JAR_FILE>:$<TARGET_PROPERTY:octomap_rt_java_examples,JAR_FILE>")
+endif()
 
 # octomap_rt_add_python_test(<name> <module> <timeout>): `python3 -m unittest <module>` in its namespace.
 function(octomap_rt_add_python_test name module timeout)
@@ -23,6 +27,7 @@ if(PYTHON3 AND LCM_LOGGER)
   # README's "Connect your robot": the C++ and the Python producer examples against a real server.
   octomap_rt_add_python_test(python_producers_test test_producers 300)
   octomap_rt_add_python_test(python_edits_test test_edits 300)
+  octomap_rt_add_python_test(python_cli_edges_test test_cli_edges 300)
   # A mirror that follows deltas, and resyncs on a new epoch (a reset).
   octomap_rt_add_python_test(python_map_mirror_test test_map_mirror 300)
   # Issue 26: the Python shard client against three shards and one whole daemon.

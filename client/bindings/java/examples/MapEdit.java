@@ -5,6 +5,7 @@
 //   java -cp /usr/share/java/lcm.jar:/usr/local/share/java/lcmtypes_octomap_rt.jar:octomap_rt_java_examples.jar \
 //        MapEdit URL TOKEN free|free-include-unknown|unknown X0 Y0 Z0 X1 Y1 Z1
 //   java ... MapEdit URL TOKEN reset
+//   (OCTOMAP_RT_NAMESPACE=NS: the server's --namespace; the edit, its MAC and its reply channel are NS's)
 //   java ... MapEdit --mac-of TOKEN UTIME REQUEST_ID NONCE OP FLAGS X0 Y0 Z0 X1 Y1 Z1 CLIENT REPLY_CHANNEL
 //        (prints the MAC in hex: the test vector of docs/PROTOCOL.md)
 import java.io.ByteArrayOutputStream;
@@ -116,12 +117,14 @@ public class MapEdit implements LCMSubscriber {
     e.request_id = e.utime;
     e.nonce = new SecureRandom().nextLong();
     e.client_id = "java-" + ProcessHandle.current().pid();
-    e.reply_channel = ProtocolTable.QUERY_REPLY_PREFIX + e.client_id.toUpperCase().replace('-', '_');
-    sign(e, args[1], CHANNEL);
+    String channel = StatusListener.inNamespace(CHANNEL);
+    e.reply_channel =
+        StatusListener.inNamespace(ProtocolTable.QUERY_REPLY_PREFIX + e.client_id.toUpperCase().replace('-', '_'));
+    sign(e, args[1], channel);  // the MAC covers the channel: an edit for one namespace is refused in another
     LCM lcm = new LCM(args[0]);
     MapEdit waiter = new MapEdit(e.request_id);
     lcm.subscribe(e.reply_channel, waiter);
-    lcm.publish(CHANNEL, e);
+    lcm.publish(channel, e);
     map_edit_ack_t a = waiter.await(10000);
     lcm.close();
     if (a == null) {
