@@ -91,6 +91,7 @@ class ShardSetTest(unittest.TestCase):
         self.assertFalse(merged.partial, merged.missing)
         m, ids = merged.value
         self.assertEqual(sorted(ids), list(range(SHARDS)))
+        self.assertTrue(all(epoch != 0 for _, epoch in ids.values()), ids)  # each shard's epoch beside it
         w = self.whole.fetch_map(timeout_s=60)
         occupied = leaf_voxels(w.occupied, w.occupied_size, 0.1)
         self.assertGreater(len(occupied), 500)

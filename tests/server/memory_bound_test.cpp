@@ -18,6 +18,8 @@
 #include "daemon/map/applied_order.h"
 #include "daemon/persistence/region_store.h"
 #include "octomap_rt/box_reply_t.hpp"
+#include "octomap_rt/distance_points_reply_t.hpp"
+#include "octomap_rt/distance_query_t.hpp"
 #include "octomap_rt/ray_query_t.hpp"
 #include "octomap_rt/ray_reply_t.hpp"
 #include "octree/decay.h"
@@ -71,6 +73,9 @@ daemon::ServerConfig bounded_config(const std::string& dir, uint64_t bound) {
   auto cfg = test_config(0.1, true);
   cfg.map_path = dir + "/map.ot";
   cfg.max_map_memory = bound;
+  // These tests check answers, not the lock bound: a loaded machine (CI's sanitizers) must not
+  // cut a box count at the default 10 ms.
+  cfg.queries.bounds.lock_ms = 2000;
   return cfg;
 }
 
@@ -88,9 +93,63 @@ void send_pass(lcm::LCM& lc, daemon::MappingServer& server, const ScanSet& set, 
   }
 }
 
+// The distance (metres, clamped at max_m) from the centre of p's voxel to the nearest occupied
+// voxel centre of `tree`, by a search of every occupied leaf: the definition (PROTOCOL.md).
+float brute_force_distance(const octomap::OcTree& tree, const octomap::point3d& p, double max_m) {
+  const octomap::OcTreeKey k = tree.coordToKey(p);
+  int64_t best = -1;
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
+    const int64_t side = int64_t(1) << (16 - it.getDepth()), half = side / 2;
+    int64_t sq = 0;
+    for (int a = 0; a < 3; ++a) {  // the nearest voxel of the leaf's cube, axis by axis
+      const int64_t lo = int64_t(it.getKey()[a]) - half, hi = lo + side - 1;
+      const int64_t c = k[a], d = c < lo ? lo - c : c > hi ? c - hi : 0;
+      sq += d * d;
+    }
+    if (best < 0 || sq < best) best = sq;
+  }
+  const double d = best < 0 ? max_m : std::sqrt(double(best)) * tree.getResolution();
+  return float(std::min(d, max_m));
+}
+
+// Distances into evicted regions: the read brings them back, and the answers are the
+// brute-force search's on OctoMap's map.
+void expect_distances_answer_as_octomap(lcm::LCM& lc, daemon::MappingServer& server, Replies& replies,
+                                        const ScanSet& set, const octomap::OcTree& reference) {
+  const uint64_t restores = server.residency_stats().restores;
+  ASSERT_GT(server.residency_stats().evicted_regions, 0u);
+  octomap_rt::distance_query_t q{};
+  address(q, 4);
+  q.mode = octomap_rt::distance_query_t::MODE_POINTS, q.max_distance = 1.5, q.cell_voxels = 1;
+  for (const PosedScan& scan : set.scans) {
+    const octomap::Pointcloud w = world_points(scan);
+    for (size_t i = 0; i < w.size(); i += 211) {
+      const float shift = 0.07f * float(q.xyz.size() % 13) - 0.4f;
+      q.xyz.insert(q.xyz.end(), {w[i].x() + shift, w[i].y() - shift, w[i].z() + 0.5f * shift});
+    }
+  }
+  q.num_xyz = int32_t(q.xyz.size());
+  lc.publish(ort::protocol::kQueryDistanceChannel, &q);
+  const auto r = replies.wait_for<octomap_rt::distance_points_reply_t>(4);
+  ASSERT_EQ(r.status, Reply::REPLY_OK) << r.error;
+  ASSERT_EQ(size_t(r.num_points), q.xyz.size() / 3);
+  int differ = 0, near = 0;
+  for (int i = 0; i < r.num_points; ++i) {
+    const float want = brute_force_distance(
+        reference, octomap::point3d(q.xyz[3 * i], q.xyz[3 * i + 1], q.xyz[3 * i + 2]), q.max_distance);
+    differ += std::abs(r.distance[i] - want) > 1e-5f;
+    near += want < 1.5f;
+  }
+  EXPECT_EQ(differ, 0) << "of " << r.num_points << " points";
+  EXPECT_GT(near, r.num_points / 2);
+  EXPECT_GT(server.residency_stats().restores, restores) << "the distance read brought evicted regions back";
+}
+
 // Queries into evicted regions: points, rays and boxes answer as OctoMap's map does.
 void expect_queries_answer_as_octomap(lcm::LCM& lc, daemon::MappingServer& server, Replies& replies, const ScanSet& set,
                                       const octomap::OcTree& reference) {
+  expect_distances_answer_as_octomap(lc, server, replies, set, reference);
   const uint64_t restores = server.residency_stats().restores;
   ASSERT_GT(server.residency_stats().evicted_regions, 0u);
   std::vector<float> pts;

@@ -182,6 +182,11 @@ int main(int argc, char** argv) {
                   r.dynamic_edt_ms, r.dynamic_edt_ms / (r.read_ms + r.cpu_edt_ms), (long long)r.dynamic_edt_differ);
     else
       std::printf("; DynamicEDTOctomap not built in (libdynamicedt3d-dev)");
+    if (r.dynamic_edt_differ > 0)
+      std::printf(
+          "\n  of those, ours = a brute-force search at %lld, DynamicEDTOctomap's the larger at %lld; "
+          "(cell) ours theirs brute: %s",
+          (long long)r.differ_ours_brute, (long long)r.differ_theirs_larger, r.differ_examples.c_str());
     std::printf("\n");
   }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -48,12 +49,27 @@ std::unique_ptr<DynamicEDTOctomap> dynamic_edt(octomap::OcTree& tree, const dist
   return edt;
 }
 
-int64_t count_differences(const octomap::OcTree& tree, DynamicEDTOctomap& edt, const distance::BoxDistances& ours,
-                          const distance::DistanceOptions& opt) {
+// The squared distance (cells) from padded cell (i, j, k) to the nearest obstacle of the grid
+// within `radius` cells a side: the definition, searched cell by cell.
+int64_t brute_force(const distance::OccupancyGrid& g, int i, int j, int k, int radius) {
+  const auto& d = g.box.dims;
+  int64_t best = -1;
+  for (int z = std::max(0, k - radius); z <= std::min(d.nz - 1, k + radius); ++z)
+    for (int y = std::max(0, j - radius); y <= std::min(d.ny - 1, j + radius); ++y)
+      for (int x = std::max(0, i - radius); x <= std::min(d.nx - 1, i + radius); ++x)
+        if (g.occupied[(size_t(z) * d.ny + y) * d.nx + x]) {
+          const int64_t s = int64_t(x - i) * (x - i) + int64_t(y - j) * (y - j) + int64_t(z - k) * (z - k);
+          if (best < 0 || s < best) best = s;
+        }
+  return best;
+}
+
+void count_differences(const octomap::OcTree& tree, DynamicEDTOctomap& edt, const distance::BoxRead& read,
+                       const distance::BoxDistances& ours, const distance::DistanceOptions& opt, ReferenceTimes& t) {
   const double res = tree.getResolution();
   const double clamp_sq = (opt.max_distance / res) * (opt.max_distance / res);
   const auto& d = ours.cells.dims;
-  int64_t differ = 0;
+  t.dynamic_edt_differ = t.differ_ours_brute = t.differ_theirs_larger = 0;
   size_t c = 0;
   for (int k = 0; k < d.nz; ++k)
     for (int j = 0; j < d.ny; ++j)
@@ -63,9 +79,19 @@ int64_t count_differences(const octomap::OcTree& tree, DynamicEDTOctomap& edt, c
                                  float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[2] + k))));
         const int64_t theirs = edt.getSquaredDistanceInCells(p);
         const uint32_t mine = ours.squared[c];
-        if (mine != distance::kNoObstacle && double(mine) <= clamp_sq && theirs != int64_t(mine)) ++differ;
+        if (mine == distance::kNoObstacle || double(mine) > clamp_sq || theirs == int64_t(mine)) continue;
+        ++t.dynamic_edt_differ;
+        const int radius = int(std::ceil(std::sqrt(double(std::max<int64_t>(mine, theirs))))) + 1;
+        const auto& lo = read.grid.box.key_lo;  // the padded grid's first cell, in keys
+        const int64_t brute =
+            brute_force(read.grid, int(ours.cells.key_lo[0] - lo[0] + i), int(ours.cells.key_lo[1] - lo[1] + j),
+                        int(ours.cells.key_lo[2] - lo[2] + k), radius);
+        t.differ_ours_brute += brute == int64_t(mine);
+        t.differ_theirs_larger += theirs > int64_t(mine);
+        if (t.dynamic_edt_differ <= 4)
+          t.differ_examples += "(" + std::to_string(i) + "," + std::to_string(j) + "," + std::to_string(k) + ") " +
+                               std::to_string(mine) + " " + std::to_string(theirs) + " " + std::to_string(brute) + "; ";
       }
-  return differ;
 }
 #endif
 
@@ -98,7 +124,7 @@ ReferenceTimes time_reference(const octomap::OcTree& tree, const double lo[3], c
   octomap::OcTree copy(tree);
   t.dynamic_edt_ms = median_ms(reps, [&] { (void)dynamic_edt(copy, read, opt); });
   const auto edt = dynamic_edt(copy, read, opt);
-  t.dynamic_edt_differ = count_differences(copy, *edt, distance::answer_box(read, cpu, false), opt);
+  count_differences(copy, *edt, read, distance::answer_box(read, cpu, false), opt, t);
 #endif
   return t;
 }

@@ -24,6 +24,11 @@ struct ReferenceTimes {
   // Cells of the box where DynamicEDTOctomap's squared distance differs from ours below our
   // clamp (their definitions agree there: tests/distance/dynamic_edt_test.cpp): expected 0.
   int64_t dynamic_edt_differ = -1;
+  // Of those, the cells where a brute-force search of the padded grid's obstacles gives our
+  // value, and where DynamicEDTOctomap's is the larger; the first few as "(i,j,k) ours theirs
+  // brute" (squared cells).
+  int64_t differ_ours_brute = -1, differ_theirs_larger = -1;
+  std::string differ_examples;
 };
 
 // Medians over `reps` runs (after one untimed run of each). `tree` is copied for

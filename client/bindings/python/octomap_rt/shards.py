@@ -251,9 +251,8 @@ class ShardClient:
         import numpy as np
 
         def one(_i, c):
-            info = c.map_info(timeout_s=min(timeout_s, 5.0))
             snap = c.fetch_snapshot("bt", timeout_s)
-            return read_bt(snap.data), (snap.snapshot_id, info.map_epoch)
+            return read_bt(snap.data), (snap.snapshot_id, snap.map_epoch)
 
         a = self._ask(range(self.set.count), one)
         if not a.value:
