@@ -7,7 +7,9 @@
 // cut, and the octree update of the busiest shard against one daemon's; then whether the
 // merged map equals the one-daemon map node for node. Times are of this process on this
 // machine; with a core per daemon, a set's rate is bounded by decode + walk + cut + its
-// busiest shard's update (docs/BENCHMARKS.md, "Shards").
+// busiest shard's update (docs/BENCHMARKS.md, "Shards"). With --only-shard i the process keeps
+// shard i of each set only: N such processes pinned to N cores side by side are the set with a
+// core per daemon (docs/bench/gpu/issue26-pinned.sh sums them up).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -45,7 +47,7 @@ int main(int argc, char** argv) {
   std::string input, backend = "cpu-grid", shards = "1,2,3,4";
   double res = 0.1, max_range = -1;
   unsigned depth = 10;
-  int repeat = 1;
+  int repeat = 1, only = -1;
   app.add_option("input", input, "ScanGraph file (.graph)")->required();
   app.add_option("-r,--resolution", res, "[m]")->capture_default_str();
   app.add_option("--max-range", max_range, "[m]; < 0: none")->capture_default_str();
@@ -53,6 +55,7 @@ int main(int argc, char** argv) {
   app.add_option("--depth", depth, "region depth (1..16)")->capture_default_str();
   app.add_option("--backend", backend, "ray back end (cpu, cpu-grid, vulkan)")->capture_default_str();
   app.add_option("--repeat", repeat, "go over the scans this many times")->capture_default_str();
+  app.add_option("--only-shard", only, "keep only shard i of each set (-1: every shard)")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   const ort::ScanSet set = ort::load_scan_graph(input);
@@ -65,6 +68,12 @@ int main(int argc, char** argv) {
   opts.octree.threads = 1;  // one core per daemon
   ort::MapEngine engine(opts);
   const std::vector<int> sizes = parse_list(shards);
+  for (int n : sizes)
+    if (n < 1 || (only >= 0 && only >= n)) {
+      std::fprintf(stderr, "octomap-rt-shard-bench: set size %d (--only-shard %d needs every size above it)\n", n,
+                   only);
+      return 2;
+    }
   struct PerSize {
     std::vector<std::unique_ptr<octomap::OcTree>> trees;
     std::vector<ort::daemon::ShardFilter> filters;
@@ -103,6 +112,7 @@ int main(int argc, char** argv) {
       walk_ms += ms_since(t);
       for (PerSize& run : runs)
         for (size_t i = 0; i < run.trees.size(); ++i) {
+          if (only >= 0 && i != size_t(only)) continue;
           ort::ShotScan mine = shot;
           t = SteadyClock::now();
           run.filters[i].keep_owned(mine);
@@ -128,16 +138,18 @@ int main(int argc, char** argv) {
     const double upd_max = *std::max_element(r.apply_ms.begin(), r.apply_ms.end()) / n;
     double upd_sum = 0;
     for (double a : r.apply_ms) upd_sum += a;
+    if (only >= 0) upd_sum = upd_max * n;  // the one shard kept: the mean is its own
     const uint64_t vox = *std::max_element(r.voxels.begin(), r.voxels.end());
     std::string merged = "-";
-    if (whole && sizes[s] > 1) {
+    if (whole && sizes[s] > 1 && only < 0) {
       std::vector<const octomap::OcTree*> views;
       for (const auto& t : r.trees) views.push_back(t.get());
       const auto m = ort::client::merge_shard_trees(views, depth);
       merged = (m->size() == whole->size() && *m == *whole) ? "identical" : "DIFFERS";
     }
-    std::printf("%6d %12.2f %14.2f %14.2f %12.0f %14.1f %10s\n", sizes[s], cut, upd_max, upd_sum / n / r.trees.size(),
-                vox / n, 1000.0 / (decode_ms / n + walk_ms / n + cut + upd_max), merged.c_str());
+    std::printf("%6d %12.2f %14.2f %14.2f %12.0f %14.1f %10s\n", sizes[s], cut, upd_max,
+                upd_sum / n / (only >= 0 ? 1 : r.trees.size()), vox / n,
+                1000.0 / (decode_ms / n + walk_ms / n + cut + upd_max), merged.c_str());
   }
   return 0;
 }
