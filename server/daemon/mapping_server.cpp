@@ -87,9 +87,9 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
   sources.signals = [this](const StatusInputs& in) { return degraded_signals(in); };
   // The viewers' map cut or skipped for its size: said in every status.
   sources.note = [this] { return raw_publisher_ ? raw_publisher_->note() : std::string(); };
-  status_ = std::make_unique<StatusReporter>(
-      StatusReporterConfig{cfg_.status_channel, cfg_.status_period_s, "serving " + cfg_.scan_channels}, *loop_,
-      std::move(sources), log_);
+  StatusReporterConfig status = cfg_.status;
+  status.running_message = "serving " + cfg_.scan_channels;
+  status_ = std::make_unique<StatusReporter>(status, *loop_, std::move(sources), log_);
 }
 
 MappingServer::~MappingServer() {
@@ -161,13 +161,10 @@ void MappingServer::warm_up_engine() {
 }
 
 void MappingServer::open_map_serving() {
-  if (cfg_.delta_rate_hz > 0) {
-    DeltaConfig d;
-    d.channel = cfg_.map_delta_channel;
-    d.max_rate_hz = cfg_.delta_rate_hz;
-    d.exact = cfg_.delta_exact;
-    d.zstd_level = cfg_.snapshot_zstd_level;
-    d.part_interval_ms = cfg_.chunk_interval_ms;
+  if (cfg_.deltas.max_rate_hz > 0) {
+    DeltaConfig d = cfg_.deltas;
+    d.zstd_level = cfg_.serving.snapshots.zstd_level;  // one level and one pacing for all map bytes
+    d.part_interval_ms = cfg_.serving.chunk_interval_ms;
     d.server_id = server_id_;
     d.resolution = cfg_.engine.resolution;
     deltas_ = std::make_unique<DeltaPublisher>(
@@ -175,15 +172,7 @@ void MappingServer::open_map_serving() {
     map_.observer = deltas_.get();
     deltas_->start(map_.version, map_.epoch);
   }
-  MapServiceConfig m;
-  m.request_channel = cfg_.map_request_channel;
-  m.info_channel = cfg_.map_info_channel;
-  m.reply_prefix = cfg_.map_reply_prefix;
-  m.snapshots = SnapshotPolicy{cfg_.snapshots_kept, cfg_.snapshot_zstd_level, cfg_.snapshot_min_interval_s};
-  m.fresh_interval_s = cfg_.fresh_snapshot_interval_s;
-  m.request_queue = cfg_.map_request_queue;
-  m.requests_per_client = cfg_.map_requests_per_client;
-  m.chunk_interval_ms = cfg_.chunk_interval_ms;
+  MapServiceConfig m = cfg_.serving;
   m.server_id = server_id_;
   m.resolution = cfg_.engine.resolution;
   // The part of space this server maps: the whole key space of its tree, or its shard box.

@@ -43,8 +43,8 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
   app.add_option("--scan-channels", s.scan_channels,
                  "regex of scan channels; the part after its literal prefix is the robot id")
       ->capture_default_str();
-  app.add_option("--status-channel", s.status_channel, "channel of server_status_t heartbeats")->capture_default_str();
-  app.add_option("--status-period", s.status_period_s, "seconds between status messages")->capture_default_str();
+  app.add_option("--status-channel", s.status.channel, "channel of server_status_t heartbeats")->capture_default_str();
+  app.add_option("--status-period", s.status.period_s, "seconds between status messages")->capture_default_str();
   app.add_option("--octomap-raw-rate", s.octomap_raw.rate_hz,
                  "publish the map as octomap.raw_t (LCM's OctoMap viewers) at this rate [Hz]; 0: off")
       ->check(CLI::Range(0.0, 100.0))
@@ -112,34 +112,35 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                  "overload bound [s]: a scan queued longer is dropped ('over latency bound') and the status is "
                  "DEGRADED while the end-to-end p99 exceeds it; 0: never drop for age")
       ->capture_default_str();
-  app.add_option("--snapshot-zstd-level", s.snapshot_zstd_level, "zstd level of served snapshots (0: uncompressed)")
+  app.add_option("--snapshot-zstd-level", s.serving.snapshots.zstd_level,
+                 "zstd level of served snapshots (0: uncompressed)")
       ->capture_default_str();
-  app.add_option("--snapshots-kept", s.snapshots_kept, "snapshots kept for re-sends")->capture_default_str();
-  app.add_option("--snapshot-min-interval", s.snapshot_min_interval_s,
+  app.add_option("--snapshots-kept", s.serving.snapshots.kept, "snapshots kept for re-sends")->capture_default_str();
+  app.add_option("--snapshot-min-interval", s.serving.snapshots.min_interval_s,
                  "seconds between two new snapshots, however many clients ask")
       ->capture_default_str();
-  app.add_option("--fresh-snapshot-interval", s.fresh_snapshot_interval_s,
+  app.add_option("--fresh-snapshot-interval", s.serving.fresh_interval_s,
                  "seconds between two new snapshots for fresh requests (snapshot_id -1): every fresh request "
                  "waiting gets the next one, so a flood of them copies the map at most this often")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 3600.0));
-  app.add_option("--map-request-queue", s.map_request_queue,
+  app.add_option("--map-request-queue", s.serving.request_queue,
                  "map requests waiting, all clients; more are refused as busy (with a retry time)")
       ->capture_default_str()
       ->check(CLI::Range(size_t{1}, size_t{65536}));
-  app.add_option("--map-requests-per-client", s.map_requests_per_client,
+  app.add_option("--map-requests-per-client", s.serving.requests_per_client,
                  "map requests of one client waiting; more are refused as busy (one client cannot fill the queue)")
       ->capture_default_str()
       ->check(CLI::Range(size_t{1}, size_t{1024}));
-  app.add_option("--chunk-interval-ms", s.chunk_interval_ms,
+  app.add_option("--chunk-interval-ms", s.serving.chunk_interval_ms,
                  "pause between two snapshot chunks or delta parts (pacing for clients' receive buffers)")
       ->capture_default_str();
-  app.add_option("--delta-rate", s.delta_rate_hz, "most map deltas a second (changes coalesced); 0: no deltas")
+  app.add_option("--delta-rate", s.deltas.max_rate_hz, "most map deltas a second (changes coalesced); 0: no deltas")
       ->capture_default_str();
-  app.add_option("--map-request-channel", s.map_request_channel, "channel of map requests")->capture_default_str();
-  app.add_option("--map-info-channel", s.map_info_channel, "channel of map_info_t")->capture_default_str();
-  app.add_option("--map-delta-channel", s.map_delta_channel, "channel of map deltas")->capture_default_str();
-  app.add_flag("--delta-exact", s.delta_exact,
+  app.add_option("--map-request-channel", s.serving.request_channel, "channel of map requests")->capture_default_str();
+  app.add_option("--map-info-channel", s.serving.info_channel, "channel of map_info_t")->capture_default_str();
+  app.add_option("--map-delta-channel", s.deltas.channel, "channel of map deltas")->capture_default_str();
+  app.add_flag("--delta-exact", s.deltas.exact,
                "deltas carry every changed leaf with its log-odds (an exact mirror), not only class changes");
   app.add_option("--drain-timeout", s.drain_timeout_s,
                  "at SIGTERM/SIGINT, apply queued scans for at most this long [s]; the rest are dropped ('left at "
@@ -175,15 +176,16 @@ void apply_namespace(ServerConfig& c, const std::string& ns) {
   }
   c.ns = ns;
   for (std::string* channel :
-       {&c.status_channel, &c.map_request_channel, &c.map_info_channel, &c.map_delta_channel, &c.map_reply_prefix,
-        &c.octomap_raw.channel, &c.queries.points_channel, &c.queries.rays_channel, &c.queries.boxes_channel,
-        &c.queries.grid_channel, &c.queries.distance_channel, &c.queries.edit_channel, &c.queries.grid.channel}) {
+       {&c.status.channel, &c.serving.request_channel, &c.serving.info_channel, &c.deltas.channel,
+        &c.serving.reply_prefix, &c.octomap_raw.channel, &c.queries.points_channel, &c.queries.rays_channel,
+        &c.queries.boxes_channel, &c.queries.grid_channel, &c.queries.distance_channel, &c.queries.edit_channel,
+        &c.queries.grid.channel}) {
     *channel = protocol::in_namespace(ns, *channel);
     if (const std::string why = protocol::check_channel_length(*channel); !why.empty())
       throw CLI::ValidationError("--namespace", why);
   }
   c.scan_channels = protocol::in_namespace(ns, c.scan_channels);
-  c.queries.status_channel = c.status_channel;
+  c.queries.status_channel = c.status.channel;
   c.queries.scan_prefix = protocol::in_namespace(ns, protocol::kScanChannelPrefix);
 }
 
@@ -277,16 +279,16 @@ ServerConfig to_server_config(const ServerFlags& f) {
       !(c.octomap_raw.occupancy_min_z < c.octomap_raw.occupancy_max_z))
     throw CLI::ValidationError("--occupancy-min-z/--occupancy-max-z", "must be numbers with min < max");
   c.octomap_raw.max_bytes = static_cast<size_t>(f.octomap_raw_max_kib * 1024.0);
-  if (!(c.status_period_s > 0 && c.status_period_s < 1e6))
+  if (!(c.status.period_s > 0 && c.status.period_s < 1e6))
     throw CLI::ValidationError("--status-period", "must be a number of seconds > 0");
   if (!std::isfinite(c.save_interval_s))
     throw CLI::ValidationError("--save-interval", "must be a finite number of seconds");
   if (c.max_points == 0) throw CLI::ValidationError("--max-points", "must be > 0");
   if (c.max_producers == 0) throw CLI::ValidationError("--max-producers", "must be > 0");
-  if (c.snapshot_zstd_level < 0 || c.snapshot_zstd_level > 19)
+  if (c.serving.snapshots.zstd_level < 0 || c.serving.snapshots.zstd_level > 19)
     throw CLI::ValidationError("--snapshot-zstd-level", "must be within 0..19");
-  if (c.snapshots_kept == 0) throw CLI::ValidationError("--snapshots-kept", "must be > 0");
-  if (!(c.chunk_interval_ms >= 0)) throw CLI::ValidationError("--chunk-interval-ms", "must be >= 0");
+  if (c.serving.snapshots.kept == 0) throw CLI::ValidationError("--snapshots-kept", "must be > 0");
+  if (!(c.serving.chunk_interval_ms >= 0)) throw CLI::ValidationError("--chunk-interval-ms", "must be >= 0");
   if (const std::string bad = check_point_filters(c.point_filters); !bad.empty())
     throw CLI::ValidationError("--pointcloud-*/--sensor-*/--min-range", bad);
   // A rate of 0 (the default, also as --print-config writes it) needs no band; a rate above 0 does.

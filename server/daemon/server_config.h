@@ -11,7 +11,10 @@
 #include "daemon/pipeline/point_filters.h"
 #include "daemon/pipeline/scan_cost_gate.h"
 #include "daemon/queries/query_config.h"
+#include "daemon/serving/delta_publisher.h"
+#include "daemon/serving/map_service.h"
 #include "daemon/serving/octomap_raw_publisher.h"
+#include "daemon/status/status_reporter.h"
 #include "engine/map_engine.h"
 #include "protocol/channels.h"
 #include "protocol/limits.h"
@@ -19,6 +22,11 @@
 
 namespace ort::daemon {
 
+// One convention: a service's own settings are its config struct, nested here as the flags and
+// --config set them (serving, deltas, status, octomap_raw, queries, upkeep, scan_costs); the
+// server adds only what it learns at start (its id, the map's resolution) before handing
+// each one over. The flat fields are the server's own: transport, intake, persistence, the
+// pipeline's lifecycle, the memory bound and the replica.
 struct ServerConfig {
   PointFilters point_filters;  // octomap_server's pass-through and a min range, before preparation
   EngineOptions engine;        // resolution, sensor model, max range, back end
@@ -28,8 +36,7 @@ struct ServerConfig {
   uint64_t recv_buf_size = 16u << 20;  // udpm receive buffer wanted (capped by rmem_max)
   std::string scan_channels =
       (std::string(ort::protocol::kScanChannelPrefix) + ".*");  // regex; its literal prefix + robot id
-  std::string status_channel = ort::protocol::kStatusChannel;
-  std::string map_path;  // .ot; "": no persistence
+  std::string map_path;                                         // .ot; "": no persistence
   // A map to start from when map_path does not exist yet (or without map_path): .bt or .ot
   // (octomap_server's map file). "": none. A new history (docs/PROTOCOL.md "Ids").
   std::string prior_path;
@@ -38,8 +45,8 @@ struct ServerConfig {
   bool move_corrupt_map_aside = false;  // corrupt map: keep it as FILE.corrupt-<time>, start anew
   std::string applied_log;              // live applied-order log; "": none
   double save_interval_s = 30;          // <= 0: save only at exit
-  double status_period_s = 1.0;
-  bool pipeline = true;  // false: both stages on one thread
+  StatusReporterConfig status;          // the heartbeat's channel and period
+  bool pipeline = true;                 // false: both stages on one thread
   // Points of the synthetic scan the engine shoots and applies to a scratch tree before the
   // intake opens (engine/engine_warm_up.h), so the first scans pay no one-time costs; 0: none.
   // Default: one VGA depth image (640 x 480).
@@ -53,21 +60,12 @@ struct ServerConfig {
   std::vector<std::string> allowed_robots;  // --allow-robot; empty: any valid robot id
   int lcm_queue_capacity = 64;              // LCM's own per-subscription queue (messages)
   OctomapRawConfig octomap_raw;
-  // Serving the map (docs/PROTOCOL.md).
-  std::string map_request_channel = ort::protocol::kMapRequestChannel;
-  std::string map_info_channel = ort::protocol::kMapInfoChannel;
-  std::string map_delta_channel = ort::protocol::kMapDeltaChannel;
-  std::string map_reply_prefix = ort::protocol::kMapReplyPrefix;  // map requests must name a reply channel of it
-  int snapshot_zstd_level = 3;                                    // 0: snapshots uncompressed
-  size_t snapshots_kept = 4;                                      // for re-sends of chunks
-  double snapshot_min_interval_s = 0.5;                           // a new snapshot at most this often
-  double fresh_snapshot_interval_s = 2.0;  // a new snapshot for fresh requests at most this often
-  size_t map_request_queue = 256;          // map requests waiting, all clients; more: busy
-  size_t map_requests_per_client = 2;      // map requests of one client waiting; more: busy
-  double chunk_interval_ms = 1.5;          // pacing of snapshot chunks and delta parts
-  double delta_rate_hz = 10;               // most change sets a second; <= 0: no deltas
-  bool delta_exact = false;                // deltas carry every changed leaf's log-odds
-  QueryServiceConfig queries;              // queries and map edits (daemon/query_service.h)
+  // Serving the map (docs/PROTOCOL.md): snapshots on request and the info message; the server
+  // fills in its id, resolution, region and shard at start.
+  MapServiceConfig serving;
+  // Deltas (rate <= 0: none); their zstd level and pacing are the snapshots' (serving).
+  DeltaConfig deltas;
+  QueryServiceConfig queries;  // queries and map edits (daemon/query_service.h)
   // Overload: a scan that waited longer than this in the queue is dropped ("over latency
   // bound") instead of applied late, and the status is DEGRADED while the end-to-end p99
   // exceeds it. <= 0: never shed.

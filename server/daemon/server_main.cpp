@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
     ort::daemon::MappingServer server(cfg, log);
     server.start();
     log.info(ort::text("listening on ", server.lcm_url(), " for ", cfg.scan_channels, "; status on ",
-                       cfg.status_channel, "; pid ", ::getpid()));
+                       cfg.status.channel, "; pid ", ::getpid()));
     int sig = 0;
     while (sigwait(&sigs, &sig) != 0) {}
     if (sig == SIGQUIT) exit_now(server, sig, log);

@@ -71,8 +71,8 @@ protocol::ShardSet to_shard_set(const ShardFlags& f, double resolution) {
 
 void keep_shared_channels(ServerConfig& c, const ServerConfig& given, const std::string& ns) {
   c.scan_channels = protocol::in_namespace(ns, given.scan_channels);
-  c.status_channel = protocol::in_namespace(ns, given.status_channel);
-  c.queries.status_channel = c.status_channel;
+  c.status.channel = protocol::in_namespace(ns, given.status.channel);
+  c.queries.status_channel = c.status.channel;
   c.queries.scan_prefix = protocol::in_namespace(ns, protocol::kScanChannelPrefix);
   c.ns = ns;
 }

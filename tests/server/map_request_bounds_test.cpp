@@ -117,7 +117,7 @@ TEST(MapRequestBounds, AFloodOfFreshRequestsCopiesTheMapOncePerInterval) {
   lcm::LCM lc("memq://");
   std::ostringstream log;
   auto cfg = test_config(0.1, true);
-  cfg.fresh_snapshot_interval_s = 1.0;
+  cfg.serving.fresh_interval_s = 1.0;
   daemon::MappingServer server(cfg, lc, log);
   ChunkSink sink(server);
   server.start();

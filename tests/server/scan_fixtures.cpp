@@ -77,7 +77,7 @@ daemon::ServerConfig test_config(double res, bool pipelined) {
   c.engine.backend.kind = BackendKind::kCpu;
   c.pipeline = pipelined;
   c.save_interval_s = 0;
-  c.status_period_s = 0.2;
+  c.status.period_s = 0.2;
   c.server_id = "test-server";
   // Tests that publish bursts on a busy machine must not lose scans to the overload policy
   // or the drain deadline; the tests of those policies set them.

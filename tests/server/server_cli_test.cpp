@@ -49,8 +49,8 @@ TEST(ServerCli, ANamespacePrefixesEveryChannel) {
   ASSERT_EQ(p.error, "");
   const daemon::ServerConfig& c = p.config;
   for (const std::string* channel :
-       {&c.status_channel, &c.scan_channels, &c.map_request_channel, &c.map_info_channel, &c.map_delta_channel,
-        &c.map_reply_prefix, &c.octomap_raw.channel, &c.queries.points_channel, &c.queries.rays_channel,
+       {&c.status.channel, &c.scan_channels, &c.serving.request_channel, &c.serving.info_channel, &c.deltas.channel,
+        &c.serving.reply_prefix, &c.octomap_raw.channel, &c.queries.points_channel, &c.queries.rays_channel,
         &c.queries.boxes_channel, &c.queries.grid_channel, &c.queries.distance_channel, &c.queries.edit_channel,
         &c.queries.grid.channel, &c.queries.scan_prefix, &c.queries.status_channel})
     EXPECT_EQ(channel->rfind("lab2_", 0), 0u) << *channel;
@@ -59,7 +59,7 @@ TEST(ServerCli, ANamespacePrefixesEveryChannel) {
   // Without one, today's names.
   const Parsed plain = parse({"-r", "0.1"});
   ASSERT_EQ(plain.error, "");
-  EXPECT_EQ(plain.config.status_channel, "OCTOMAP_RT_STATUS");
+  EXPECT_EQ(plain.config.status.channel, "OCTOMAP_RT_STATUS");
   EXPECT_EQ(plain.config.ns, "");
 }
 
@@ -80,7 +80,10 @@ TEST(ServerCli, AMistypedConfigKeyIsRefusedWithTheNearestValidKey) {
 }
 
 TEST(ServerCli, ThePrintedConfigurationReadsBackAsTheSameConfiguration) {
-  const Parsed p = parse({"-r", "0.25", "--save-interval", "7", "--namespace", "lab3"});
+  // A flag of each nested service config (serving, deltas, status) as well as flat ones.
+  const Parsed p = parse({"-r", "0.25", "--save-interval", "7", "--namespace", "lab3", "--delta-rate", "4",
+                          "--delta-exact", "--snapshot-zstd-level", "5", "--map-request-queue", "17",
+                          "--chunk-interval-ms", "0.75", "--status-period", "0.5"});
   ASSERT_EQ(p.error, "");
   EXPECT_NE(p.printed.find("save-interval=7"), std::string::npos) << p.printed;
   EXPECT_NE(p.printed.find("namespace=\"lab3\""), std::string::npos) << p.printed;
@@ -93,7 +96,16 @@ TEST(ServerCli, ThePrintedConfigurationReadsBackAsTheSameConfiguration) {
   ASSERT_EQ(again.error, "") << text;
   EXPECT_EQ(again.config.engine.resolution, 0.25);
   EXPECT_EQ(again.config.save_interval_s, 7);
-  EXPECT_EQ(again.config.status_channel, "lab3_OCTOMAP_RT_STATUS");
+  EXPECT_EQ(again.config.status.channel, "lab3_OCTOMAP_RT_STATUS");
+  EXPECT_EQ(again.config.status.period_s, 0.5);
+  EXPECT_EQ(again.config.deltas.max_rate_hz, 4);
+  EXPECT_TRUE(again.config.deltas.exact);
+  EXPECT_EQ(again.config.deltas.channel, "lab3_OCTOMAP_RT_MAP_DELTA");
+  EXPECT_EQ(again.config.serving.snapshots.zstd_level, 5);
+  EXPECT_EQ(again.config.serving.request_queue, 17u);
+  EXPECT_EQ(again.config.serving.chunk_interval_ms, 0.75);
+  // Exact: the configuration read back prints the same text again, key for key.
+  EXPECT_EQ(again.printed, p.printed);
 }
 
 }  // namespace
@@ -112,10 +124,10 @@ TEST(ServerCli, AShardHearsTheNamespacesScansAndServesOnItsOwnChannels) {
   EXPECT_EQ(c.shard.index, 1u);
   EXPECT_EQ(c.shard.count, 3u);
   EXPECT_EQ(c.scan_channels, "lab2_OCTOMAP_RT_SCAN_.*");
-  EXPECT_EQ(c.status_channel, "lab2_OCTOMAP_RT_STATUS");
+  EXPECT_EQ(c.status.channel, "lab2_OCTOMAP_RT_STATUS");
   EXPECT_EQ(c.queries.status_channel, "lab2_OCTOMAP_RT_STATUS");
-  EXPECT_EQ(c.map_request_channel, "lab2_SHARD1_OCTOMAP_RT_MAP_REQUEST");
-  EXPECT_EQ(c.map_reply_prefix, "lab2_SHARD1_OCTOMAP_RT_MAP_REPLY_");
+  EXPECT_EQ(c.serving.request_channel, "lab2_SHARD1_OCTOMAP_RT_MAP_REQUEST");
+  EXPECT_EQ(c.serving.reply_prefix, "lab2_SHARD1_OCTOMAP_RT_MAP_REPLY_");
   EXPECT_EQ(c.queries.points_channel, "lab2_SHARD1_OCTOMAP_RT_QUERY");
   EXPECT_EQ(c.octomap_raw.channel, "lab2_SHARD1_OCTOMAP");
   const std::string west = "-inf,-inf,-inf:0,inf,inf", east = "0,-inf,-inf:inf,inf,inf";

@@ -124,7 +124,7 @@ TEST(ServerShutdown, StatusSaysDegradedAndWhy) {
   cfg.save_interval_s = 0.05;
   cfg.stuck_stage_s = 0.05;
   cfg.latency_bound_s = 0.05;
-  cfg.status_period_s = 0.02;
+  cfg.status.period_s = 0.02;
   std::ostringstream log;
   daemon::MappingServer server(cfg, lc, log);
   server.start();

@@ -34,7 +34,7 @@ TEST(ServerStatusCounts, BigMapIsExactOnceDrained) {
   const ScanSet set = load_scan_graph(path);
   lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
-  cfg.status_period_s = 0.02;
+  cfg.status.period_s = 0.02;
   std::ostringstream log;
   daemon::MappingServer server(cfg, lc, log);
   server.start();
@@ -70,7 +70,7 @@ TEST(ServerStatusCounts, LeafCountIsOctomapsAfterScansEditsResetsAndDecay) {
     auto cfg = test_config(0.1, true);
     cfg.read_replica = replica;
     cfg.queries.control_token = kToken;
-    cfg.status_period_s = 0.02;
+    cfg.status.period_s = 0.02;
     cfg.upkeep.decay_half_life_s = 10;
     cfg.upkeep.decay_step_s = 5;
     cfg.upkeep.manual = true;
@@ -199,7 +199,7 @@ TEST(ServerStatusCounts, SlowestScansAreAppliedScansWithTheirParts) {
 TEST(ServerStatusCounts, HandlerErrorsReachTheStatus) {
   lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
-  cfg.status_period_s = 0.02;
+  cfg.status.period_s = 0.02;
   std::ostringstream log;
   daemon::MappingServer server(cfg, lc, log);
   server.start();

@@ -97,7 +97,7 @@ daemon::ServerConfig server_config(const Args& a) {
   cfg.engine = cli::to_engine_options(a.engine);
   cfg.queue_budget_bytes = 1ull << 30;
   cfg.warm_up_points = 0;
-  cfg.chunk_interval_ms = 0.2;
+  cfg.serving.chunk_interval_ms = 0.2;
   cfg.latency_bound_s = 60;
   cfg.read_replica = a.replica == "on";
   cfg.replica_batch_voxels = a.replica_batch_voxels;

@@ -22,6 +22,7 @@
 #include "daemon/status/status_message.h"
 #include "daemon/transport/lcm_loop.h"
 #include "octomap_rt/server_status_t.hpp"
+#include "protocol/channels.h"
 
 namespace ort::daemon {
 
@@ -32,7 +33,7 @@ struct StatusSources {
 };
 
 struct StatusReporterConfig {
-  std::string channel;
+  std::string channel = ort::protocol::kStatusChannel;
   double period_s = 1.0;
   std::string running_message;  // what a RUNNING status says when it is no longer DEGRADED
 };
