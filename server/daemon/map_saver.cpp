@@ -26,35 +26,22 @@ void MapSaver::write_identity(const MapIdentityRecord& r) {
 }
 
 void MapSaver::start() {
-  if (path_.empty() || interval_s_ <= 0 || thread_.joinable()) return;
-  thread_ = std::thread([this] { run_periodic(); });
+  if (path_.empty() || interval_s_ <= 0) return;
+  periodic_.start(interval_s_, [this] { save_periodically(); });
 }
 
-void MapSaver::stop() {
-  {
-    std::lock_guard lock(loop_mutex_);
-    stopping_ = true;
-  }
-  wake_.notify_all();
-  if (thread_.joinable()) thread_.join();
-}
+void MapSaver::stop() { periodic_.stop(); }
 
-void MapSaver::run_periodic() {
-  const auto period = std::chrono::duration<double>(interval_s_);
-  std::unique_lock lock(loop_mutex_);
-  while (!stopping_) {
-    if (wake_.wait_for(lock, period, [&] { return stopping_; })) break;
-    lock.unlock();
-    std::string error;
-    try {
-      save(false);
-    } catch (const std::exception& e) {
-      error = e.what();
-      log_.error(text("save failed (the previous map file is intact): ", error));
-    }
-    lock.lock();
-    last_error_ = error;  // the status is DEGRADED while it is set
+void MapSaver::save_periodically() {
+  std::string error;
+  try {
+    save(false);
+  } catch (const std::exception& e) {
+    error = e.what();
+    log_.error(text("save failed (the previous map file is intact): ", error));
   }
+  std::lock_guard lock(error_mutex_);
+  last_error_ = error;  // the status is DEGRADED while it is set
 }
 
 void MapSaver::save(bool force, bool clean) {
@@ -100,7 +87,7 @@ SaveFigures MapSaver::figures() const {
   f.last_save_utime = last_save_utime_;
   f.last_save_ms = last_save_ms_;
   f.max_save_lock_ms = max_save_lock_ms_;
-  std::lock_guard lock(loop_mutex_);
+  std::lock_guard lock(error_mutex_);
   f.last_error = last_error_;
   return f;
 }

@@ -11,13 +11,12 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <mutex>
 #include <string>
-#include <thread>
 
 #include "core/log.h"
+#include "core/threads/periodic_thread.h"
 #include "daemon/map/map_state.h"
 #include "daemon/persistence/map_identity_file.h"
 
@@ -59,7 +58,7 @@ class MapSaver {
   SaveFigures figures() const;
 
  private:
-  void run_periodic();
+  void save_periodically();  // on the periodic thread: a save if the map changed, its error kept
 
   const std::string path_;
   const double interval_s_;
@@ -72,11 +71,9 @@ class MapSaver {
   std::atomic<int64_t> saves_{0}, last_save_utime_{0};
   std::atomic<double> max_save_lock_ms_{0}, last_save_ms_{0};
 
-  mutable std::mutex loop_mutex_;  // the periodic thread's wake-up and last error
-  std::condition_variable wake_;
-  bool stopping_ = false;
+  mutable std::mutex error_mutex_;  // last_error_
   std::string last_error_;
-  std::thread thread_;
+  PeriodicThread periodic_;  // last: stopped before the members its task uses go
 };
 
 }  // namespace ort::daemon

@@ -4,7 +4,8 @@ add_dependencies(engine_cli_parity_test octomap-rt)
 
 octomap_rt_add_test(engine_prepare_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/prepare_scan_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/exact_traversal_test.cpp
-                    ${CMAKE_CURRENT_LIST_DIR}/ground_helpers_test.cpp)
+                    ${CMAKE_CURRENT_LIST_DIR}/ground_helpers_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/periodic_thread_test.cpp)
 
 octomap_rt_add_test(engine_ray_walk_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/ray_walk_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/cpu_grid_test.cpp

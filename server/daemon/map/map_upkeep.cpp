@@ -44,19 +44,18 @@ MapUpkeep::MapUpkeep(MapState& map, const UpkeepConfig& cfg, Log log)
 MapUpkeep::~MapUpkeep() { stop(); }
 
 void MapUpkeep::start() {
-  if (cfg_.manual || (!cfg_.decay_on() && !cfg_.clearing_on()) || thread_.joinable()) return;
+  if (cfg_.manual || (!cfg_.decay_on() && !cfg_.clearing_on()) || periodic_.running()) return;
   start_ = SteadyClock::now();
-  thread_ = std::thread([this] { run(); });
+  next_clear_ =
+      start_ + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(cfg_.clear_period_s));
+  PeriodicOptions o;
+  o.run_first = true;
+  // Looks every 50 ms whether a sweep is due (sweeps are rare; the look is two comparisons).
+  periodic_.start(
+      0.05, [this] { run_due_sweeps(); }, o);
 }
 
-void MapUpkeep::stop() {
-  {
-    std::lock_guard lock(wake_mutex_);
-    stop_ = true;
-  }
-  wake_.notify_all();
-  if (thread_.joinable()) thread_.join();
-}
+void MapUpkeep::stop() { periodic_.stop(); }
 
 UpkeepStats MapUpkeep::stats() const {
   std::lock_guard lock(stats_mutex_);
@@ -112,11 +111,8 @@ void MapUpkeep::run_sweep(std::function<std::unique_ptr<Sweep>(const octomap::Oc
       deleted_counter += deleted - deleted_before;
     }
     deleted_before = deleted;
-    if (!done && !cfg_.manual) {
-      std::unique_lock lock(wake_mutex_);
-      // Scans and queries get the lock between slices; a stop ends the sweep here.
-      if (wake_.wait_for(lock, std::chrono::milliseconds(1), [this] { return stop_; })) return;
-    }
+    // Scans and queries get the lock between slices; a stop ends the sweep here.
+    if (!done && !cfg_.manual && !periodic_.pause(std::chrono::milliseconds(1))) return;
   }
 }
 
@@ -159,26 +155,20 @@ void MapUpkeep::clear_now() {
   if (cfg_.clearing_on()) run_clear_sweep();
 }
 
-void MapUpkeep::run() {
-  auto next_clear =
-      start_ + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(cfg_.clear_period_s));
-  for (;;) {
-    const auto now = SteadyClock::now();
-    if (cfg_.decay_on()) {
-      const auto due = static_cast<uint64_t>(std::chrono::duration<double>(now - start_).count() / cfg_.decay_step_s);
-      if (due > steps_started_) {
-        const uint64_t n = due - steps_started_;
-        steps_started_ = due;
-        run_decay_sweep(n);
-      }
+void MapUpkeep::run_due_sweeps() {
+  const auto now = SteadyClock::now();
+  if (cfg_.decay_on()) {
+    const auto due = static_cast<uint64_t>(std::chrono::duration<double>(now - start_).count() / cfg_.decay_step_s);
+    if (due > steps_started_) {
+      const uint64_t n = due - steps_started_;
+      steps_started_ = due;
+      run_decay_sweep(n);
     }
-    if (cfg_.clearing_on() && SteadyClock::now() >= next_clear) {
-      run_clear_sweep();
-      next_clear = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
-                                            std::chrono::duration<double>(cfg_.clear_period_s));
-    }
-    std::unique_lock lock(wake_mutex_);
-    if (wake_.wait_for(lock, std::chrono::milliseconds(50), [this] { return stop_; })) return;
+  }
+  if (cfg_.clearing_on() && SteadyClock::now() >= next_clear_) {
+    run_clear_sweep();
+    next_clear_ = SteadyClock::now() +
+                  std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(cfg_.clear_period_s));
   }
 }
 

@@ -15,15 +15,14 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <mutex>
-#include <thread>
 
 #include "core/clock.h"
 #include "core/log.h"
+#include "core/threads/periodic_thread.h"
 #include "daemon/map/map_identity.h"
 #include "daemon/map/map_state.h"
 #include "octree/region.h"
@@ -68,7 +67,7 @@ class MapUpkeep {
   UpkeepStats stats() const;
 
  private:
-  void run();
+  void run_due_sweeps();  // the periodic task: the decay steps and the clearing pass now due
   void run_decay_sweep(uint64_t steps);
   void run_clear_sweep();
   // Runs the sweep `make` makes (on each tree at its first slice), slice by slice.
@@ -82,14 +81,11 @@ class MapUpkeep {
   UpkeepConfig cfg_;
   Log log_;
   RegionGrid grid_;
-  SteadyClock::time_point start_;
+  SteadyClock::time_point start_, next_clear_;
   uint64_t steps_started_ = 0;
   mutable std::mutex stats_mutex_;
   UpkeepStats stats_;
-  std::mutex wake_mutex_;
-  std::condition_variable wake_;
-  bool stop_ = false;
-  std::thread thread_;
+  PeriodicThread periodic_;  // last: stopped before the members its task uses go
 };
 
 }  // namespace ort::daemon

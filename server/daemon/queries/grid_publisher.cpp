@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <thread>
 
 #include "core/clock.h"
 #include "daemon/queries/reply_stamp.h"
@@ -19,17 +20,15 @@ GridPublisher::GridPublisher(const GridPublishConfig& cfg, const QueryBounds& bo
 GridPublisher::~GridPublisher() { stop(); }
 
 void GridPublisher::start() {
-  if (cfg_.rate_hz > 0 && !thread_.joinable()) thread_ = std::thread([this] { run(); });
+  if (cfg_.rate_hz <= 0) return;
+  PeriodicOptions o;
+  o.run_first = true;
+  o.fixed_rate = true;  // a slow grid: the next one at once, no catch-up burst
+  periodic_.start(
+      1.0 / cfg_.rate_hz, [this] { publish_newest(); }, o);
 }
 
-void GridPublisher::stop() {
-  {
-    std::lock_guard lock(mutex_);
-    stop_ = true;
-  }
-  wake_.notify_all();
-  if (thread_.joinable()) thread_.join();
-}
+void GridPublisher::stop() { periodic_.stop(); }
 
 void GridPublisher::compute_if_changed() {
   octomap_rt::grid_query_t q{};
@@ -86,22 +85,14 @@ EncodedReplies GridPublisher::clipped_grid(octomap_rt::grid_query_t q, const Map
   }
 }
 
-void GridPublisher::run() {
-  const auto period = std::chrono::duration<double>(1.0 / cfg_.rate_hz);
-  auto next = SteadyClock::now();
-  for (;;) {
-    compute_if_changed();
-    for (size_t i = 0; i < grid_.messages.size(); ++i) {
-      // Paced like the answers: a burst of 60 KB datagrams overruns receive buffers.
-      if (i > 0) std::this_thread::sleep_for(std::chrono::microseconds(500));
-      loop_.publish(grid_.channel, grid_.messages[i].data(), grid_.messages[i].size());
-    }
-    published_++;
-    next = std::max(next + std::chrono::duration_cast<SteadyClock::duration>(period),
-                    SteadyClock::now());  // behind (a slow grid): no catch-up burst
-    std::unique_lock lock(mutex_);
-    if (wake_.wait_until(lock, next, [&] { return stop_; })) return;
+void GridPublisher::publish_newest() {
+  compute_if_changed();
+  for (size_t i = 0; i < grid_.messages.size(); ++i) {
+    // Paced like the answers: a burst of 60 KB datagrams overruns receive buffers.
+    if (i > 0) std::this_thread::sleep_for(std::chrono::microseconds(500));
+    loop_.publish(grid_.channel, grid_.messages[i].data(), grid_.messages[i].size());
   }
+  published_++;
 }
 
 }  // namespace ort::daemon

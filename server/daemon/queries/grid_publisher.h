@@ -9,12 +9,11 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <mutex>
 #include <string>
-#include <thread>
 
+#include "core/threads/periodic_thread.h"
 #include "daemon/map/map_state.h"
 #include "daemon/queries/query_answers.h"
 #include "daemon/queries/query_config.h"
@@ -39,7 +38,7 @@ class GridPublisher {
   int64_t clipped() const { return clipped_; }  // grids sent clipped to the bound
 
  private:
-  void run();
+  void publish_newest();  // the periodic task
   void compute_if_changed();
   EncodedReplies clipped_grid(octomap_rt::grid_query_t q, const MapStamp& stamp, const std::string& why);
 
@@ -48,13 +47,10 @@ class GridPublisher {
   MapState& map_;
   LcmLoop& loop_;
   std::string server_id_;
-  std::thread thread_;
-  std::mutex mutex_;  // stop_
-  std::condition_variable wake_;
-  bool stop_ = false;
   uint64_t computed_version_ = UINT64_MAX;
   EncodedReplies grid_;  // the newest grid's rows
   std::atomic<int64_t> published_{0}, clipped_{0};
+  PeriodicThread periodic_;  // last: stopped before the members its task uses go
 };
 
 }  // namespace ort::daemon

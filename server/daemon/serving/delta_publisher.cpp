@@ -33,17 +33,13 @@ DeltaPublisher::~DeltaPublisher() {
 void DeltaPublisher::start(uint64_t version, uint64_t epoch) {
   from_version_ = to_version_ = version;
   epoch_ = epoch;
-  if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
+  PeriodicOptions o;
+  o.run_on_stop = true;  // what is pending goes out
+  periodic_.start(
+      1.0 / std::max(cfg_.max_rate_hz, 1e-3), [this] { flush_or_log(); }, o);
 }
 
-void DeltaPublisher::stop() {
-  {
-    std::lock_guard lock(mutex_);
-    stop_ = true;
-  }
-  cv_.notify_all();
-  if (thread_.joinable()) thread_.join();
-}
+void DeltaPublisher::stop() { periodic_.stop(); }
 
 // Called by stage 2 under the map lock, so its time is the pipeline's: looking each voxel up
 // in the tree again cost stage 2 more than the rest of the delta work (the log's "map deltas
@@ -91,18 +87,11 @@ DeltaStats DeltaPublisher::stats() const {
   return s;
 }
 
-void DeltaPublisher::run() {
-  const auto period = std::chrono::duration<double>(1.0 / std::max(cfg_.max_rate_hz, 1e-3));
-  std::unique_lock lock(mutex_);
-  while (!stop_) {
-    cv_.wait_for(lock, period, [&] { return stop_; });
-    lock.unlock();
-    try {
-      flush();
-    } catch (const std::exception& e) {
-      log_.error(text("map delta failed: ", e.what()));
-    }
-    lock.lock();
+void DeltaPublisher::flush_or_log() {
+  try {
+    flush();
+  } catch (const std::exception& e) {
+    log_.error(text("map delta failed: ", e.what()));
   }
 }
 

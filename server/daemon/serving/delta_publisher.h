@@ -11,15 +11,14 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "core/log.h"
+#include "core/threads/periodic_thread.h"
 #include "daemon/map/map_state.h"
 #include "daemon/transport/lcm_loop.h"
 #include "octree/leaf_changes.h"
@@ -63,7 +62,7 @@ class DeltaPublisher : public MapChangeObserver {
   int64_t last_seq() const { return last_seq_; }
 
  private:
-  void run();
+  void flush_or_log();  // the periodic task
   void flush();
   // Keeps a few of the sent logs for applied() to hand back to stage 2.
   void give_back(std::vector<LeafChanges>& logs);
@@ -73,8 +72,7 @@ class DeltaPublisher : public MapChangeObserver {
   std::function<int64_t()> latest_snapshot_id_;
   Log log_;
 
-  mutable std::mutex mutex_;  // pending_, spare_, versions, stop_, stats_
-  std::condition_variable cv_;
+  mutable std::mutex mutex_;  // pending_, spare_, versions, stats_
   // The change logs of the scans applied since the last set, in the order applied: stage 2
   // only moves them in (it runs under the map lock); flush() classifies them.
   std::vector<LeafChanges> pending_;
@@ -83,11 +81,10 @@ class DeltaPublisher : public MapChangeObserver {
   uint64_t from_version_ = 0, to_version_ = 0, epoch_ = 0;
   int64_t pending_scans_ = 0;
   int64_t skip_seqs_ = 0;
-  bool stop_ = false;
   DeltaStats stats_;
   std::atomic<int64_t> last_seq_{-1};
   int64_t next_seq_ = 0;
-  std::thread thread_;
+  PeriodicThread periodic_;  // last: stopped before the members its task uses go
 };
 
 }  // namespace ort::daemon

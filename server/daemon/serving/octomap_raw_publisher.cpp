@@ -25,20 +25,16 @@ OctomapRawPublisher::OctomapRawPublisher(const OctomapRawConfig& cfg, MapState& 
 OctomapRawPublisher::~OctomapRawPublisher() { stop(); }
 
 void OctomapRawPublisher::start() {
-  if (cfg_.rate_hz <= 0 || thread_.joinable()) return;
+  if (cfg_.rate_hz <= 0 || periodic_.running()) return;
   log_.info(text("publishing the map as octomap.raw_t on ", cfg_.channel, " at ", cfg_.rate_hz, " Hz (cap ",
                  cfg_.max_bytes / 1024, " KiB)"));
-  thread_ = std::thread([this] { run(); });
+  PeriodicOptions o;
+  o.run_first = true;
+  periodic_.start(
+      1.0 / cfg_.rate_hz, [this] { publish_newest(); }, o);
 }
 
-void OctomapRawPublisher::stop() {
-  {
-    std::lock_guard lock(mutex_);
-    stop_ = true;
-  }
-  wake_.notify_all();
-  if (thread_.joinable()) thread_.join();
-}
+void OctomapRawPublisher::stop() { periodic_.stop(); }
 
 std::string OctomapRawPublisher::note() const {
   std::lock_guard lock(note_mutex_);
@@ -75,19 +71,12 @@ void OctomapRawPublisher::encode_if_changed() {
   note_ = raw.note;
 }
 
-void OctomapRawPublisher::run() {
-  const auto period = std::chrono::duration<double>(1.0 / cfg_.rate_hz);
-  std::unique_lock lock(mutex_);
-  while (!stop_) {
-    lock.unlock();
-    try {
-      encode_if_changed();
-      if (!encoded_.empty() && loop_.publish(cfg_.channel, encoded_.data(), encoded_.size()) == 0) ++published_;
-    } catch (const std::exception& e) {  // a failed encoding must not end the server
-      log_.error(text(cfg_.channel, " not published: ", e.what()));
-    }
-    lock.lock();
-    wake_.wait_for(lock, period, [&] { return stop_; });
+void OctomapRawPublisher::publish_newest() {
+  try {
+    encode_if_changed();
+    if (!encoded_.empty() && loop_.publish(cfg_.channel, encoded_.data(), encoded_.size()) == 0) ++published_;
+  } catch (const std::exception& e) {  // a failed encoding must not end the server
+    log_.error(text(cfg_.channel, " not published: ", e.what()));
   }
 }
 

@@ -7,15 +7,14 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <limits>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "core/log.h"
+#include "core/threads/periodic_thread.h"
 #include "daemon/map/map_state.h"
 #include "daemon/transport/lcm_loop.h"
 #include "protocol/channels.h"
@@ -53,22 +52,19 @@ class OctomapRawPublisher {
   int64_t published() const { return published_; }
 
  private:
-  void run();
+  void publish_newest();  // the periodic task
   void encode_if_changed();
 
   OctomapRawConfig cfg_;
   MapState& map_;
   LcmLoop& loop_;
   Log log_;
-  std::thread thread_;
-  std::mutex mutex_;  // stop_
-  std::condition_variable wake_;
-  bool stop_ = false;
   uint64_t encoded_version_ = UINT64_MAX;
   std::vector<uint8_t> encoded_;  // newest message; empty when the map is too large
   mutable std::mutex note_mutex_;
   std::string note_;
   std::atomic<int64_t> published_{0};
+  PeriodicThread periodic_;  // last: stopped before the members its task uses go
 };
 
 }  // namespace ort::daemon

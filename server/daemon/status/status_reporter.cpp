@@ -1,7 +1,5 @@
 #include "daemon/status/status_reporter.h"
 
-#include <chrono>
-
 namespace ort::daemon {
 
 using Status = octomap_rt::server_status_t;
@@ -14,9 +12,8 @@ void StatusReporter::set_state(int8_t state, std::string message) {
     std::lock_guard lock(mutex_);
     state_ = state;
     message_ = std::move(message);
-    changed_ = true;
   }
-  wake_.notify_all();
+  periodic_.wake();
 }
 
 void StatusReporter::stamp(StatusInputs& in) const {
@@ -27,33 +24,19 @@ void StatusReporter::stamp(StatusInputs& in) const {
 }
 
 void StatusReporter::start() {
-  if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
+  PeriodicOptions o;
+  o.run_on_stop = true;  // the status that says how the server stopped
+  periodic_.start(
+      cfg_.period_s, [this] { publish_or_log(); }, o);
 }
 
-void StatusReporter::stop() {
-  {
-    std::lock_guard lock(mutex_);
-    exit_ = true;
-  }
-  wake_.notify_all();
-  if (thread_.joinable()) thread_.join();
-}
+void StatusReporter::stop() { periodic_.stop(); }
 
-void StatusReporter::run() {
-  const auto period = std::chrono::duration<double>(cfg_.period_s);
-  std::unique_lock lock(mutex_);
-  for (;;) {
-    wake_.wait_for(lock, period, [&] { return changed_ || exit_; });
-    const bool exit = exit_;
-    changed_ = false;
-    lock.unlock();
-    try {
-      publish();
-    } catch (const std::exception& e) {
-      log_.error(text("status failed: ", e.what()));
-    }
-    lock.lock();
-    if (exit) return;
+void StatusReporter::publish_or_log() {
+  try {
+    publish();
+  } catch (const std::exception& e) {
+    log_.error(text("status failed: ", e.what()));
   }
 }
 

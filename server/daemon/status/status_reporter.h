@@ -10,14 +10,13 @@
 // stamp() fills a status' state, message and sequence number from any thread.
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <mutex>
 #include <string>
-#include <thread>
 
 #include "core/log.h"
+#include "core/threads/periodic_thread.h"
 #include "daemon/status/degraded_causes.h"
 #include "daemon/status/status_message.h"
 #include "daemon/transport/lcm_loop.h"
@@ -55,22 +54,20 @@ class StatusReporter {
   void stop();
 
  private:
-  void run();
   void publish();
+  void publish_or_log();  // the periodic task: a failed status is logged, the next one tried
 
   const StatusReporterConfig cfg_;
   LcmLoop& loop_;
   const StatusSources sources_;
   Log log_;
 
-  mutable std::mutex mutex_;  // state, message, seq, the thread's wake-up
-  std::condition_variable wake_;
+  mutable std::mutex mutex_;  // state, message, seq
   int8_t state_ = octomap_rt::server_status_t::STATE_STARTING;
   std::string message_;
-  bool changed_ = false, exit_ = false;
   int64_t seq_ = 0;
   DegradedTracker degraded_;  // the thread's only
-  std::thread thread_;
+  PeriodicThread periodic_;   // last: stopped before the members its task uses go
 };
 
 }  // namespace ort::daemon
