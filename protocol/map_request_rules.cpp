@@ -58,7 +58,7 @@ namespace {
 
 bool fresh_servable(const QueuedMapRequest& q, const SnapshotClock& c) {
   if (c.newest_is_current) return true;
-  if (c.newest_taken == std::chrono::steady_clock::time_point{}) return true;
+  if (c.newest_taken == SteadyClock::time_point{}) return true;
   if (c.newest_taken >= q.arrived) return true;
   return c.now >= c.newest_taken + c.fresh_interval;
 }
@@ -71,11 +71,10 @@ size_t next_servable(const std::deque<QueuedMapRequest>& queue, const SnapshotCl
   return SIZE_MAX;
 }
 
-std::chrono::steady_clock::time_point next_fresh_due(const std::deque<QueuedMapRequest>& queue,
-                                                     const SnapshotClock& clock) {
+SteadyClock::time_point next_fresh_due(const std::deque<QueuedMapRequest>& queue, const SnapshotClock& clock) {
   for (const QueuedMapRequest& q : queue)
     if (q.req.snapshot_id < 0) return clock.newest_taken + clock.fresh_interval;
-  return std::chrono::steady_clock::time_point::max();
+  return SteadyClock::time_point::max();
 }
 
 size_t queued_of(const std::deque<QueuedMapRequest>& queue, const std::string& client_id) {

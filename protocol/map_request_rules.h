@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/clock.h"
 #include "octomap_rt/map_request_t.hpp"
 
 namespace ort::protocol {
@@ -42,15 +43,15 @@ std::vector<int32_t> chunks_to_send(const std::vector<int32_t>& requested, int32
 // A request waiting in the map service's queue.
 struct QueuedMapRequest {
   octomap_rt::map_request_t req;
-  std::chrono::steady_clock::time_point arrived;
+  SteadyClock::time_point arrived;
 };
 
 // What the queue knows of the snapshots when it picks the next request to serve.
 struct SnapshotClock {
-  std::chrono::steady_clock::time_point now;
-  std::chrono::steady_clock::time_point newest_taken;  // the newest snapshot's copy; {} = none
-  bool newest_is_current = false;                      // the map did not change since
-  std::chrono::steady_clock::duration fresh_interval{};
+  SteadyClock::time_point now;
+  SteadyClock::time_point newest_taken;  // the newest snapshot's copy; {} = none
+  bool newest_is_current = false;        // the map did not change since
+  SteadyClock::duration fresh_interval{};
 };
 
 // The request to serve next, or SIZE_MAX: the oldest that can be served now. A fresh one
@@ -59,8 +60,7 @@ struct SnapshotClock {
 // until then it waits without holding up the others.
 size_t next_servable(const std::deque<QueuedMapRequest>& queue, const SnapshotClock& clock);
 // When the first waiting fresh request becomes servable (time_point::max() when none waits).
-std::chrono::steady_clock::time_point next_fresh_due(const std::deque<QueuedMapRequest>& queue,
-                                                     const SnapshotClock& clock);
+SteadyClock::time_point next_fresh_due(const std::deque<QueuedMapRequest>& queue, const SnapshotClock& clock);
 // How many requests of `client_id` are queued.
 size_t queued_of(const std::deque<QueuedMapRequest>& queue, const std::string& client_id);
 

@@ -4,7 +4,6 @@
 // points ("non-finite" in its status) and applies the rest. README.md, "Connect your robot".
 //     octomap-rt-publish-example SCAN.graph [LCM_URL] [ROBOT_ID]
 #include <cctype>
-#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <string>
@@ -12,6 +11,7 @@
 #include <octomap/ScanGraph.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "core/clock.h"
 #include "octomap_rt/scan_t.hpp"
 #include "protocol/channels.h"
 
@@ -22,8 +22,7 @@ int main(int argc, char** argv) {
   const octomap::ScanNode& node = **graph.begin();  // points in the sensor frame, pose map <- sensor
   const std::string robot = argc > 3 ? argv[3] : "cpprobot";
   octomap_rt::scan_t m;
-  m.utime = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-                .count();                                                   // acquisition time [us]
+  m.utime = ort::now_utime();                                               // acquisition time [us]
   m.seq = 0;                                                                // +1 per scan of this robot
   for (int i = 0; i < 3; ++i) m.sensor_position[i] = node.pose.trans()(i);  // map frame [m]
   const octomath::Quaternion& q = node.pose.rot();                          // unit, w x y z

@@ -10,6 +10,7 @@
 
 #include <octomap/AbstractOcTree.h>
 
+#include "core/clock.h"
 #include "map_client/snapshot_assembly.h"
 #include "octomap_rt/map_request_t.hpp"
 #include "protocol/ids.h"
@@ -21,15 +22,7 @@
 namespace ort::client {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using Chunk = octomap_rt::map_chunk_t;
-
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-int64_t utime_now() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 std::string default_client_id() {
   std::random_device rd;
@@ -121,7 +114,7 @@ void MapClient::handle_for(double seconds) {
 }
 
 void MapClient::spin(double timeout_s) {
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   do {
     handle_for(std::min(0.05, std::max(0.0, timeout_s - seconds_since(t0))));
   } while (seconds_since(t0) < timeout_s);
@@ -129,7 +122,7 @@ void MapClient::spin(double timeout_s) {
 
 std::optional<octomap_rt::map_info_t> MapClient::wait_info(double timeout_s) {
   info_.reset();
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   while (!info_ && seconds_since(t0) < timeout_s) handle_for(std::min(0.05, timeout_s - seconds_since(t0)));
   return info_;
 }
@@ -137,7 +130,7 @@ std::optional<octomap_rt::map_info_t> MapClient::wait_info(double timeout_s) {
 void MapClient::send_request(int64_t request_id, int64_t snapshot_id, int8_t format,
                              const std::vector<int32_t>& indices) {
   octomap_rt::map_request_t r{};
-  r.utime = utime_now();
+  r.utime = now_utime();
   r.request_id = request_id;
   r.snapshot_id = snapshot_id;
   r.format = format;
@@ -167,15 +160,15 @@ double busy_retry_s(const std::string& error) {
 
 FetchedSnapshot MapClient::fetch_snapshot(int8_t format, double timeout_s, const FetchProgress& progress,
                                           int64_t snapshot_id) {
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   FetchedSnapshot out;
   SnapshotAssembly as;
   chunks_.clear();
   const int64_t first_request = next_request_id_;
   send_request(next_request_id_++, snapshot_id, format, {});
   out.requests = 1;
-  auto last_arrival = Clock::now();
-  auto retry_at = Clock::time_point::max();  // refused as busy: ask again then (max: not refused)
+  auto last_arrival = SteadyClock::now();
+  auto retry_at = SteadyClock::time_point::max();  // refused as busy: ask again then (max: not refused)
   std::minstd_rand rng(static_cast<unsigned>(std::random_device{}()));
   while (!as.complete()) {
     if (seconds_since(t0) >= timeout_s) {
@@ -204,7 +197,7 @@ FetchedSnapshot MapClient::fetch_snapshot(int8_t format, double timeout_s, const
         if (c.error.rfind("busy", 0) == 0) {
           out.busy_replies++;
           retry_at =
-              Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+              SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(
                                  busy_retry_s(c.error) * std::uniform_real_distribution<double>(1.25, 1.5)(rng)));
           continue;
         }
@@ -216,29 +209,29 @@ FetchedSnapshot MapClient::fetch_snapshot(int8_t format, double timeout_s, const
       }
       const std::string why = as.add(c);
       if (!why.empty()) inbound_.refused["chunk: " + why]++;
-      last_arrival = Clock::now();
+      last_arrival = SteadyClock::now();
       if (progress) progress(as.received_bytes(), as.total_size());
     }
     chunks_.clear();
     // Before the first chunk the server may still be copying and compressing a big map: ask
     // again only after a longer silence, so as not to queue duplicate full sends.
     const double patience = as.started() ? opts_.rerequest_after_s : opts_.first_answer_after_s;
-    const bool refused = retry_at != Clock::time_point::max();
-    if (refused && Clock::now() >= retry_at) {
-      retry_at = Clock::time_point::max();
+    const bool refused = retry_at != SteadyClock::time_point::max();
+    if (refused && SteadyClock::now() >= retry_at) {
+      retry_at = SteadyClock::time_point::max();
       if (as.started())
         send_request(next_request_id_++, as.snapshot_id(), format, as.missing());
       else
         send_request(next_request_id_++, snapshot_id, format, {});
       out.requests++;
-      last_arrival = Clock::now();
+      last_arrival = SteadyClock::now();
     } else if (!refused && !as.complete() && seconds_since(last_arrival) >= patience) {
       if (as.started())
         send_request(next_request_id_++, as.snapshot_id(), format, as.missing());
       else
         send_request(next_request_id_++, snapshot_id, format, {});
       out.requests++;
-      last_arrival = Clock::now();
+      last_arrival = SteadyClock::now();
     }
   }
   std::string blob;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "core/clock.h"
 #include "protocol/delta_codec.h"
 
 namespace ort::client {
@@ -76,8 +77,8 @@ void MapMirror::sync() {
 }
 
 void MapMirror::spin(double seconds) {
-  const auto t0 = std::chrono::steady_clock::now();
-  auto left = [&] { return seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  const auto t0 = SteadyClock::now();
+  auto left = [&] { return seconds - seconds_since(t0); };
   while (left() > 0) {
     if (need_sync_ || !tree_) sync();
     client_.spin(std::min(0.05, std::max(0.0, left())));

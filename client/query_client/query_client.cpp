@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 
+#include "core/clock.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/distance_query_t.hpp"
 #include "octomap_rt/grid_query_t.hpp"
@@ -17,11 +18,6 @@
 
 namespace ort::client {
 namespace {
-
-int64_t now_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 std::string upper(std::string s) {
   for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
@@ -42,14 +38,14 @@ QueryClient::QueryClient(const std::string& url, std::string client_id, std::chr
   if (std::string why = protocol::check_channel_length(reply_channel_); !why.empty())
     throw std::invalid_argument("client id '" + client_id_ + "': " + why);
   // Request ids differ between runs of the same client id (stale replies are ignored).
-  next_request_ = now_us();
+  next_request_ = now_utime();
 }
 
 QueryClient::~QueryClient() = default;
 
 template <class Request>
 void QueryClient::address(Request& r, const WaitFor& w) {
-  r.utime = now_us();
+  r.utime = now_utime();
   r.request_id = next_request_++;
   r.min_snapshot_id = w.min_snapshot_id;
   r.wait_seq = w.robot_id.empty() ? -1 : w.seq;
@@ -78,10 +74,9 @@ std::vector<Reply> QueryClient::exchange(const std::string& channel, Request& re
   lcm::Subscription* sub = lcm_->subscribe(reply_channel_, &Sink::on, &sink);
   sub->setQueueCapacity(4096);
   lcm_->publish(channel, &request);
-  const auto deadline = std::chrono::steady_clock::now() + timeout_;
+  const auto deadline = SteadyClock::now() + timeout_;
   while (!done(replies)) {
-    const auto left =
-        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyClock::now());
     if (left.count() <= 0) {
       lcm_->unsubscribe(sub);
       throw QueryTimeout("no complete reply on " + reply_channel_ + " within " + std::to_string(timeout_.count()) +
@@ -215,7 +210,7 @@ octomap_rt::distance_path_reply_t QueryClient::distance_path(const std::vector<f
 
 octomap_rt::map_edit_ack_t QueryClient::edit(int8_t op, const Box& b, const std::string& token, int8_t flags) {
   octomap_rt::map_edit_t e{};
-  e.utime = now_us();
+  e.utime = now_utime();
   e.request_id = next_request_++;
   e.op = op;
   e.flags = flags;

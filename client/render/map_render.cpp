@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/clock.h"
 #include "render/height_colours.h"
 #include "render/map_legend.h"
 
@@ -15,10 +16,6 @@ constexpr Rgb kFreeFootprint{222, 229, 238};
 constexpr int kMargin = 16;
 // Brightness of a face by its normal axis (x, y, z): a fixed light from above and one side.
 constexpr double kFaceShade[3] = {0.82, 0.66, 1.0};
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // The face of `box` whose normal is +axis (high side) or -axis, projected, corners in order.
 std::array<ScreenPoint, 4> face(const ViewCamera& cam, const VoxelBox& box, int axis, bool high_side) {
@@ -87,11 +84,11 @@ PlaneExtent plane_extent(const ViewCamera& cam, const MapBoxes& boxes, float flo
 }  // namespace
 
 MapPicture render_map(const octomap::OcTree& tree, const RenderOptions& options) {
-  auto t0 = std::chrono::steady_clock::now();
+  auto t0 = SteadyClock::now();
   const MapBoxes boxes = collect_boxes(tree, options.heights, options.free == FreeSpace::faint);
   RenderStats stats{boxes.occupied.size(), boxes.free.size(), ms_since(t0), 0};
 
-  t0 = std::chrono::steady_clock::now();
+  t0 = SteadyClock::now();
   const Box3 extent = drawn_extent(boxes);
   ViewCamera cam = ViewCamera::looking(options.view, options.azimuth_deg, options.elevation_deg);
   cam.frame(plane_extent(cam, boxes, float(extent.lo[2])), options.width, kMargin);
