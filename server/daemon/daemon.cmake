@@ -11,7 +11,10 @@ octomap_rt_lcm_handler_sources(octomap_rt_daemon ${DAEMON_DIR}/transport/lcm_loo
 
 # The engine flags (-r, sensor model, back end, ...) come from engine/engine_flags, shared so
 # that `octomap-rt build` and the server take the same names and defaults.
-add_executable(octomap-rt-server ${DAEMON_DIR}/server_main.cpp ${DAEMON_DIR}/server_cli.cpp
-                                 ${DAEMON_DIR}/server_flag_groups.cpp)
-target_link_libraries(octomap-rt-server PRIVATE octomap_rt_daemon octomap_rt_allocator)
+# The server's command line, a library of its own so that its tests and the benches that start
+# a daemon with the server's flags compile it once.
+add_library(octomap_rt_server_cli STATIC ${DAEMON_DIR}/server_cli.cpp ${DAEMON_DIR}/server_flag_groups.cpp)
+target_link_libraries(octomap_rt_server_cli PUBLIC octomap_rt_daemon)
+add_executable(octomap-rt-server ${DAEMON_DIR}/server_main.cpp)
+target_link_libraries(octomap-rt-server PRIVATE octomap_rt_server_cli octomap_rt_allocator)
 target_compile_definitions(octomap-rt-server PRIVATE OCTOMAP_RT_VERSION="${PROJECT_VERSION}")

@@ -30,7 +30,7 @@ octomap_rt_add_test(gpu_prepare_test SOURCES ${GPU_TEST_DIR}/gpu_prepare_test.cp
 
 # The Vulkan distance transform (issue 27) against the CPU one, bit for bit.
 octomap_rt_add_test(gpu_distance_test SOURCES ${GPU_TEST_DIR}/gpu_distance_test.cpp
-                    ${CMAKE_CURRENT_SOURCE_DIR}/query/query_test_maps.cpp
+                    $<TARGET_OBJECTS:octomap_rt_query_test_maps>
                     LIBS octomap_rt_gpu octomap_rt_distance TIMEOUT 600)
 
 set_property(TEST gpu_prepare_test gpu_rt_parity_test gpu_distance_test APPEND PROPERTY LABELS data)

@@ -11,7 +11,7 @@ octomap_rt_add_test(octree_test
           ${CMAKE_CURRENT_LIST_DIR}/leaf_changes_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/full_blocks_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/worker_pool_test.cpp
-          ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp ${CMAKE_CURRENT_LIST_DIR}/real_scan_voxels.cpp
+          $<TARGET_OBJECTS:octomap_rt_octree_test_helpers>
   TIMEOUT 900)
 
 # Regions, the subtrees at one depth that decay, clearing and eviction work on (octree/region.h),
@@ -23,13 +23,14 @@ octomap_rt_add_test(region_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/region_test.cp
 # decay steps between them, whole sweeps and sweeps in slices.
 octomap_rt_add_test(forgetting_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/decay_test.cpp ${CMAKE_CURRENT_LIST_DIR}/distance_clearing_test.cpp
-          ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp ${CMAKE_CURRENT_LIST_DIR}/real_scan_voxels.cpp
+          $<TARGET_OBJECTS:octomap_rt_octree_test_helpers>
   TIMEOUT 300)
 
 # The memory bound's spill and restore on real scans: a map built with regions spilled and
 # brought back is, once everything is back, the map built without the bound; and the bound's
 # exact memory count equals OctoMap's walk after every kind of change (edits need the query layer).
-octomap_rt_add_test(eviction_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/eviction_test.cpp ${CMAKE_CURRENT_LIST_DIR}/tree_checks.cpp ${CMAKE_CURRENT_LIST_DIR}/real_scan_voxels.cpp
+octomap_rt_add_test(eviction_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/eviction_test.cpp
+                    $<TARGET_OBJECTS:octomap_rt_octree_test_helpers>
   LIBS octomap_rt_query
   TIMEOUT 300)
 

@@ -2,7 +2,7 @@
 # own FR-079 map (geb079.bt) and maps OctoMap builds from ../shared/data scans. Each test
 # also runs a deliberately wrong variant of its rule, which must disagree on the same inputs.
 octomap_rt_add_test(query_test
-  SOURCES ${CMAKE_CURRENT_LIST_DIR}/query_test_maps.cpp
+  SOURCES $<TARGET_OBJECTS:octomap_rt_query_test_maps>
           ${CMAKE_CURRENT_LIST_DIR}/brute_force.cpp
           ${CMAKE_CURRENT_LIST_DIR}/point_ray_query_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/box_query_test.cpp

@@ -1,5 +1,5 @@
 # In-process tests of octomap-rt-server's logic over memq:// (no network, no GPU: cpu back end).
-set(SERVER_TEST_FIXTURES ${CMAKE_CURRENT_LIST_DIR}/scan_fixtures.cpp)
+set(SERVER_TEST_FIXTURES $<TARGET_OBJECTS:octomap_rt_server_fixtures>)  # tests/CMakeLists.txt
 octomap_rt_add_test(server_validation_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/scan_validation_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/scan_decode_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 120)
@@ -73,8 +73,7 @@ octomap_rt_add_test(server_point_filters_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
 # The server's command line: --namespace, --config's unknown keys, --print-config (issue 24).
 octomap_rt_add_test(server_cli_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_cli_test.cpp
-                    ${CMAKE_SOURCE_DIR}/server/daemon/server_cli.cpp ${CMAKE_SOURCE_DIR}/server/daemon/server_flag_groups.cpp
-                    LIBS octomap_rt_daemon TIMEOUT 60)
+                    LIBS octomap_rt_server_cli TIMEOUT 60)
 # Issue 26: shards keep their regions' voxels; merged they are the one-daemon map (real data).
 octomap_rt_add_test(server_shard_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/shard_test.cpp ${SERVER_TEST_FIXTURES}
                     LIBS octomap_rt_daemon octomap_rt_map_client TIMEOUT 300)
