@@ -11,6 +11,7 @@
 #include "cli/query/query_common.h"
 #include "cli/shard_commands.h"
 #include "octomap_rt/box_query_t.hpp"
+#include "octomap_rt/box_reply_t.hpp"
 #include "protocol/lcm_url.h"
 #include "query_client/query_args.h"
 #include "query_client/query_client.h"
@@ -104,6 +105,16 @@ void register_rays(CLI::App& parent) {
   });
 }
 
+// A box reply as JSON or one line a box; exit status 2 when it was refused.
+void print_boxes(const octomap_rt::box_reply_t& r, bool json) {
+  if (json) write_boxes_json(std::cout, r);
+  if (refused(r)) std::exit(2);
+  if (!json)
+    for (int i = 0; i < r.num_boxes; ++i)
+      std::cout << "occupied " << r.occupied[i] << " free " << r.free[i] << " unknown " << r.unknown[i]
+                << (r.any_occupied[i] ? " (occupied)" : " (clear)") << "\n";
+}
+
 void register_box(CLI::App& parent) {
   auto* cmd = parent.add_subcommand("box", "finest-voxel counts of boxes (or a region's nodes with --region)");
   auto a = std::make_shared<CommonArgs>();
@@ -125,12 +136,7 @@ void register_box(CLI::App& parent) {
       bool partial = false;
       const int8_t mode = *any ? octomap_rt::box_query_t::MODE_ANY_OCCUPIED : octomap_rt::box_query_t::MODE_COUNTS;
       const auto r = routed(connect_shards(*a)->boxes(bs, mode), partial);
-      if (a->json) write_boxes_json(std::cout, r);
-      if (refused(r)) std::exit(2);
-      if (!a->json)
-        for (int i = 0; i < r.num_boxes; ++i)
-          std::cout << "occupied " << r.occupied[i] << " free " << r.free[i] << " unknown " << r.unknown[i]
-                    << (r.any_occupied[i] ? " (occupied)" : " (clear)") << "\n";
+      print_boxes(r, a->json);
       if (partial) std::exit(3);
       return;
     }
@@ -149,12 +155,7 @@ void register_box(CLI::App& parent) {
     }
     const int8_t mode = *any ? octomap_rt::box_query_t::MODE_ANY_OCCUPIED : octomap_rt::box_query_t::MODE_COUNTS;
     const auto r = client->boxes(bs, mode, wait_for(*a));
-    if (a->json) write_boxes_json(std::cout, r);
-    if (refused(r)) std::exit(2);
-    if (!a->json)
-      for (int i = 0; i < r.num_boxes; ++i)
-        std::cout << "occupied " << r.occupied[i] << " free " << r.free[i] << " unknown " << r.unknown[i]
-                  << (r.any_occupied[i] ? " (occupied)" : " (clear)") << "\n";
+    print_boxes(r, a->json);
   });
 }
 

@@ -198,7 +198,7 @@ FetchedSnapshot MapClient::fetch_snapshot(int8_t format, double timeout_s, const
           out.busy_replies++;
           retry_at =
               SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(
-                                 busy_retry_s(c.error) * std::uniform_real_distribution<double>(1.25, 1.5)(rng)));
+                                       busy_retry_s(c.error) * std::uniform_real_distribution<double>(1.25, 1.5)(rng)));
           continue;
         }
         throw FetchError(FetchError::kRefused, "the server refused the request: " + c.error);
@@ -217,21 +217,20 @@ FetchedSnapshot MapClient::fetch_snapshot(int8_t format, double timeout_s, const
     // again only after a longer silence, so as not to queue duplicate full sends.
     const double patience = as.started() ? opts_.rerequest_after_s : opts_.first_answer_after_s;
     const bool refused = retry_at != SteadyClock::time_point::max();
+    // Asked again: the chunks still missing of the snapshot begun, else the whole snapshot.
+    auto ask_again = [&] {
+      if (as.started())
+        send_request(next_request_id_++, as.snapshot_id(), format, as.missing());
+      else
+        send_request(next_request_id_++, snapshot_id, format, {});
+      out.requests++;
+      last_arrival = SteadyClock::now();
+    };
     if (refused && SteadyClock::now() >= retry_at) {
       retry_at = SteadyClock::time_point::max();
-      if (as.started())
-        send_request(next_request_id_++, as.snapshot_id(), format, as.missing());
-      else
-        send_request(next_request_id_++, snapshot_id, format, {});
-      out.requests++;
-      last_arrival = SteadyClock::now();
+      ask_again();
     } else if (!refused && !as.complete() && seconds_since(last_arrival) >= patience) {
-      if (as.started())
-        send_request(next_request_id_++, as.snapshot_id(), format, as.missing());
-      else
-        send_request(next_request_id_++, snapshot_id, format, {});
-      out.requests++;
-      last_arrival = SteadyClock::now();
+      ask_again();
     }
   }
   std::string blob;

@@ -13,8 +13,6 @@
 // two differ, ours must equal the brute-force search and theirs must be the larger.
 #include <gtest/gtest.h>
 
-#include <dynamicEDT3D/dynamicEDTOctomap.h>
-
 #include <cmath>
 #include <random>
 
@@ -22,6 +20,7 @@
 #include "distance/distance_queries.h"
 #include "distance/squared_edt.h"
 #include "query/query_test_maps.h"
+#include "scene/dynamic_edt_reference.h"
 
 namespace ort::test {
 namespace {
@@ -48,16 +47,11 @@ TEST(DistanceAgainstDynamicEDT, EqualSquaredDistancesInsideItsBox) {
         }
         const distance::BoxRead read = distance::read_box(tree, lo, hi, opt, {});
         const distance::BoxDistances ours = distance::answer_box(read, distance::cpu_edt(2), false);
-        // Their box: our padded grid, corners at voxel centres.
         const auto& g = read.grid.box;
-        const int n[3] = {g.dims.nx, g.dims.ny, g.dims.nz};
-        octomap::point3d bmin, bmax;
-        for (int a = 0; a < 3; ++a) {
-          bmin(a) = float(tree.keyToCoord(octomap::key_type(g.key_lo[a])));
-          bmax(a) = float(tree.keyToCoord(octomap::key_type(g.key_lo[a] + n[a] - 1)));
-        }
-        DynamicEDTOctomap edt(float(opt.max_distance), &tree, bmin, bmax, unknown == distance::UnknownAs::kOccupied);
-        edt.update();
+        const std::unique_ptr<DynamicEDTOctomap> edt_box =
+            scene::dynamic_edt_over(tree, g.key_lo, {g.dims.nx, g.dims.ny, g.dims.nz}, opt.max_distance,
+                                    unknown == distance::UnknownAs::kOccupied);
+        DynamicEDTOctomap& edt = *edt_box;
         const int theirs_clamp = edt.getSquaredMaxDistCells();
         const double our_clamp_sq = (opt.max_distance / res) * (opt.max_distance / res);
         size_t c = 0;
@@ -69,10 +63,7 @@ TEST(DistanceAgainstDynamicEDT, EqualSquaredDistancesInsideItsBox) {
         for (int k = 0; k < d.nz; ++k)
           for (int j = 0; j < d.ny; ++j)
             for (int i = 0; i < d.nx; ++i, ++c) {
-              const octomap::point3d p(float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[0] + i))),
-                                       float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[1] + j))),
-                                       float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[2] + k))));
-              const int theirs = edt.getSquaredDistanceInCells(p);
+              const int theirs = edt.getSquaredDistanceInCells(scene::voxel_centre(tree, ours.cells.key_lo, i, j, k));
               ++compared;
               bool agree = ours.squared[c] == distance::kNoObstacle ? theirs > our_clamp_sq || theirs == theirs_clamp
                                                                     : int64_t(ours.squared[c]) == theirs;

@@ -23,6 +23,7 @@
 #include "core/errors.h"
 #include "core/prepare_scan.h"
 #include "engine/map_engine.h"
+#include "support/every_backend.h"
 #include "support/tree_compare.h"
 
 namespace ort::test {
@@ -191,15 +192,7 @@ TEST_P(DegenerateRays, AMaxRangeBelowTheSmallestIsRefused) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryBackEnd, DegenerateRays,
-                         ::testing::Values(BackendKind::kCpu, BackendKind::kCpuGrid, BackendKind::kVulkan,
-                                           BackendKind::kRt),
-                         [](const auto& info) {
-                           std::string n = to_string(info.param);
-                           for (char& c : n)
-                             if (c == '-') c = '_';
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(EveryBackEnd, DegenerateRays, kEveryBackend, backend_param_name);
 
 TEST(DegenerateRays, FourPointsAtATimeSendNearOriginGroupsToThePointByPointRules) {
   const NearOriginScan s = near_origin_scan();

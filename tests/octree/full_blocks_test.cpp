@@ -98,21 +98,7 @@ class BlockBatches {
 };
 
 std::vector<BatchedUpdateOptions> variants() {
-  std::vector<BatchedUpdateOptions> out;
-  for (unsigned threads : {1u, 4u}) {
-    BatchedUpdateOptions deep;  // buckets as small as they go: blocks larger than a bucket's node
-    deep.threads = threads;
-    deep.min_parallel_voxels = 0;
-    deep.buckets.voxels_per_cell = 1;
-    deep.buckets.max_cells = 1 << 20;
-    deep.buckets.min_shift = 1;
-    out.push_back(deep);
-  }
-  BatchedUpdateOptions defaults;
-  defaults.threads = 7;
-  defaults.min_parallel_voxels = 0;
-  out.push_back(defaults);
-  return out;
+  return {test::deep_buckets(1), test::deep_buckets(4), test::default_buckets()};
 }
 
 void run(unsigned seed, int batches, void (*sensor)(OcTree&), BlockCounts& counts) {

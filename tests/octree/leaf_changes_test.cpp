@@ -29,21 +29,7 @@ using test::true_changes;
 using test::values_of;
 
 std::vector<BatchedUpdateOptions> variants() {
-  std::vector<BatchedUpdateOptions> out;
-  for (unsigned threads : {1u, 3u, 16u}) {
-    BatchedUpdateOptions deep;  // many small buckets, pruned nodes above them
-    deep.threads = threads;
-    deep.min_parallel_voxels = 0;
-    deep.buckets.voxels_per_cell = 1;
-    deep.buckets.max_cells = 1 << 20;
-    deep.buckets.min_shift = 1;
-    out.push_back(deep);
-  }
-  BatchedUpdateOptions defaults;
-  defaults.threads = 7;
-  defaults.min_parallel_voxels = 0;
-  out.push_back(defaults);
-  return out;
+  return {test::deep_buckets(1), test::deep_buckets(3), test::deep_buckets(16), test::default_buckets()};
 }
 
 struct Counts {

@@ -89,18 +89,9 @@ struct Variant {
 
 std::vector<Variant> variants() {
   std::vector<Variant> out;
-  for (unsigned threads : {1u, 2u, 7u, 16u}) {
-    BatchedUpdateOptions deep;  // buckets as deep as possible: many, pruned nodes above them
-    deep.threads = threads;
-    deep.min_parallel_voxels = 0;
-    deep.buckets.voxels_per_cell = 1;
-    deep.buckets.max_cells = 1 << 20;
-    deep.buckets.min_shift = 1;
-    out.push_back({std::to_string(threads) + " threads, deep buckets", deep});
-  }
-  BatchedUpdateOptions shallow;  // the production defaults but for tiny batches
-  shallow.threads = 7;
-  shallow.min_parallel_voxels = 0;
+  for (unsigned threads : {1u, 2u, 7u, 16u})
+    out.push_back({std::to_string(threads) + " threads, deep buckets", test::deep_buckets(threads)});
+  const BatchedUpdateOptions shallow = test::default_buckets();
   out.push_back({"7 threads, default buckets", shallow});
   BatchedUpdateOptions coarse = shallow;  // the root's 8 children as the buckets
   coarse.threads = 2;

@@ -7,7 +7,29 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
+#include "octree/batched/batched_update.h"
+
 namespace ort::test {
+
+// The batched stage on `threads` threads with buckets as deep as they go (many small buckets,
+// blocks larger than a bucket's node, pruned nodes above them), every batch in parallel.
+inline BatchedUpdateOptions deep_buckets(unsigned threads) {
+  BatchedUpdateOptions o;
+  o.threads = threads;
+  o.min_parallel_voxels = 0;
+  o.buckets.voxels_per_cell = 1;
+  o.buckets.max_cells = 1 << 20;
+  o.buckets.min_shift = 1;
+  return o;
+}
+
+// The production defaults on 7 threads, every batch in parallel (the tests' batches are tiny).
+inline BatchedUpdateOptions default_buckets() {
+  BatchedUpdateOptions o;
+  o.threads = 7;
+  o.min_parallel_voxels = 0;
+  return o;
+}
 
 // Node for node (shape, inner values, log-odds), every finest voxel, and the node counter:
 // size() equal and equal to the real number of nodes (the batched stage keeps OctoMap's

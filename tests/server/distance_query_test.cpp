@@ -158,10 +158,8 @@ void run_queries(daemon::MappingServer& server, lcm::LCM& lc, Replies& replies) 
 }
 
 TEST(DistanceQueries, PointsBoxAndPathFromTheStateJustWritten) {
-  lcm::LCM lc("memq://");
-  daemon::MappingServer server(test_config(0.1, true), lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture;
+  auto& [lc, log, server, replies] = fixture;
   run_queries(server, lc, replies);
 
   // Refusals, each with what refused it.

@@ -47,11 +47,8 @@ daemon::ServerConfig config_at(const std::string& map_path) {
 // Runs a server on `cfg` for `scans` wall scans (seq from `first`) and `edits` clear-boxes,
 // then stops it cleanly; returns its identity at the end.
 Identity run_server(const daemon::ServerConfig& cfg, int64_t first, int scans, int edits = 0, bool reset = false) {
-  lcm::LCM lc("memq://");
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture(cfg);
+  auto& [lc, log, server, replies] = fixture;
   for (int k = 0; k < scans; ++k) {
     const auto s = wall_scan(first + k);
     lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);

@@ -28,13 +28,8 @@ std::string replica_bytes(daemon::MappingServer& s) {
 
 TEST(MapReplica, EqualsTheMapOfRecordAfterScansEditsAndAReset) {
   const ScanSet set = make_synthetic_rooms();
-  lcm::LCM lc("memq://");
-  auto cfg = test_config(0.1, true);
-  cfg.queries.control_token = kToken;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture(with_edits(test_config(0.1, true)));
+  auto& [lc, log, server, replies] = fixture;
   auto edit = [&](int64_t id, int8_t op, double lo_x) {
     octomap_rt::map_edit_t e{};
     e.request_id = id, e.client_id = "op", e.reply_channel = kReply, e.op = op;
@@ -64,10 +59,8 @@ TEST(MapReplica, EqualsTheMapOfRecordAfterScansEditsAndAReset) {
 
 TEST(MapReplica, AReaderHoldingItDoesNotStopTheOctreeStage) {
   const ScanSet set = make_synthetic_rooms();
-  lcm::LCM lc("memq://");
-  std::ostringstream log;
-  daemon::MappingServer server(test_config(0.1, true), lc, log);
-  server.start();
+  MemqServer fixture(test_config(0.1, true));
+  auto& [lc, log, server] = fixture;
   // A reader holds the replica (a copy of a huge map) until every scan was applied to the map
   // of record: they are, without waiting for it.
   std::atomic<bool> release{false};
@@ -97,11 +90,8 @@ TEST(MapReplica, AReaderHoldingItDoesNotStopTheOctreeStage) {
 }
 
 TEST(MapReplica, QueriesAreAnsweredFromItWhileAScanHoldsTheMap) {
-  lcm::LCM lc("memq://");
-  std::ostringstream log;
-  daemon::MappingServer server(test_config(0.1, true), lc, log);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture;
+  auto& [lc, log, server, replies] = fixture;
   octomap_rt::scan_t last;
   for (int64_t k = 0; k < 4; ++k) {
     last = wall_scan(k);

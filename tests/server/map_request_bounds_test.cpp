@@ -58,15 +58,25 @@ octomap_rt::map_request_t request(const std::string& client, int64_t id, int64_t
   return r;
 }
 
-TEST(MapRequestBounds, AChunkNamedThousandsOfTimesIsSentOnce) {
-  lcm::LCM lc("memq://");
+// A server over memq:// started with `cfg`, every reply chunk collected.
+struct ServedMap {
+  lcm::LCM lc{"memq://"};
   std::ostringstream log;
-  daemon::MappingServer server(test_config(0.1, true), lc, log);
-  ChunkSink sink(server);
-  server.start();
-  const auto scan = small_scan("alpha", 0, 50);
-  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &scan);
-  ASSERT_TRUE(wait_until_done(server, 1));
+  daemon::MappingServer server;
+  ChunkSink sink;
+  explicit ServedMap(const daemon::ServerConfig& cfg) : server(cfg, lc, log), sink(server) { server.start(); }
+  // One small scan, applied: the map has a snapshot to serve.
+  bool map_one_scan() {
+    const auto scan = small_scan("alpha", 0, 50);
+    lc.publish("OCTOMAP_RT_SCAN_ALPHA", &scan);
+    return wait_until_done(server, 1);
+  }
+};
+
+TEST(MapRequestBounds, AChunkNamedThousandsOfTimesIsSentOnce) {
+  ServedMap map(test_config(0.1, true));
+  auto& [lc, log, server, sink] = map;
+  ASSERT_TRUE(map.map_one_scan());
   auto first = request("viewer", 1, -1);
   lc.publish("OCTOMAP_RT_MAP_REQUEST", &first);
   int64_t snapshot = 0;
@@ -87,14 +97,9 @@ TEST(MapRequestBounds, AChunkNamedThousandsOfTimesIsSentOnce) {
 }
 
 TEST(MapRequestBounds, ManyClientsAtOnceAreAllServed) {
-  lcm::LCM lc("memq://");
-  std::ostringstream log;
-  daemon::MappingServer server(test_config(0.1, true), lc, log);
-  ChunkSink sink(server);
-  server.start();
-  const auto scan = small_scan("alpha", 0, 50);
-  lc.publish("OCTOMAP_RT_SCAN_ALPHA", &scan);
-  ASSERT_TRUE(wait_until_done(server, 1));
+  ServedMap map(test_config(0.1, true));
+  auto& [lc, log, server, sink] = map;
+  ASSERT_TRUE(map.map_one_scan());
   constexpr int kClients = 120;  // the old queue held 32: the rest were refused as busy
   for (int i = 0; i < kClients; ++i) {
     auto r = request("robot-" + std::to_string(i), 100 + i, -1);
@@ -114,13 +119,10 @@ TEST(MapRequestBounds, ManyClientsAtOnceAreAllServed) {
 }
 
 TEST(MapRequestBounds, AFloodOfFreshRequestsCopiesTheMapOncePerInterval) {
-  lcm::LCM lc("memq://");
-  std::ostringstream log;
   auto cfg = test_config(0.1, true);
   cfg.serving.fresh_interval_s = 1.0;
-  daemon::MappingServer server(cfg, lc, log);
-  ChunkSink sink(server);
-  server.start();
+  ServedMap map(cfg);
+  auto& [lc, log, server, sink] = map;
   // The map changes all the time (a scan every 20 ms) while 40 clients ask for fresh
   // snapshots every 25 ms, for 2.5 s.
   const auto t0 = SteadyClock::now();

@@ -25,15 +25,13 @@ void send_and_wait(lcm::LCM& lc, daemon::MappingServer& server, const octomap_rt
 }
 
 TEST(MapUpkeep, DecayStepsBetweenScansGiveTheRulesMap) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.upkeep.decay_half_life_s = 10;
   cfg.upkeep.decay_step_s = 5;
   cfg.upkeep.manual = true;
   cfg.upkeep.slice_nodes = 500;  // many slices a step
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   const ScanSet scene = make_synthetic_rooms();
   MapEngine engine(cfg.engine);
   auto reference = engine.make_tree();
@@ -62,14 +60,12 @@ TEST(MapUpkeep, DecayStepsBetweenScansGiveTheRulesMap) {
 }
 
 TEST(MapUpkeep, ClearingKeepsWhatIsNearTheRobotsSeenLately) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.upkeep.clear_radius_m = 2.5;
   cfg.upkeep.clear_recent_s = 600;
   cfg.upkeep.manual = true;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   const ScanSet scene = make_synthetic_rooms();
   MapEngine engine(cfg.engine);
   auto reference = engine.make_tree();
@@ -95,13 +91,11 @@ TEST(MapUpkeep, ClearingKeepsWhatIsNearTheRobotsSeenLately) {
 }
 
 TEST(MapUpkeep, UnseenMapDecaysToNothingOnTheDaemonsClock) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.upkeep.decay_half_life_s = 0.1;  // 3.5 -> below 0.1 in ~0.52 s
   cfg.upkeep.decay_step_s = 0.02;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   const ScanSet scene = make_synthetic_rooms();
   for (size_t k = 0; k < 3; ++k) {
     const auto msg = scan_message(scene.scans[k], "alpha", int64_t(k));

@@ -342,10 +342,8 @@ TEST(MemoryBound, DecayOverEvictedRegionsIsTheRulesMap) {
   cfg.upkeep.decay_step_s = 5;
   cfg.upkeep.manual = true;
   cfg.upkeep.slice_nodes = 20000;
-  lcm::LCM lc("memq://");
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   octomap::OcTree reference(cfg.engine.resolution);
   const DecayRule step{decay_factor(5, 10), cfg.upkeep.decay_delete_below};
   int64_t sent = 0;

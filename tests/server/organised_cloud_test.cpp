@@ -17,6 +17,7 @@
 #include "core/errors.h"
 #include "engine/map_engine.h"
 #include "server/scan_fixtures.h"
+#include "support/every_backend.h"
 #include "support/test_data.h"
 #include "support/tree_compare.h"
 
@@ -127,15 +128,7 @@ TEST_P(OrganisedCloud, NaNNoReturnsAreCountedEveryFinitePointAppliedAndTheMapIsO
   server->stop();
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryBackEnd, OrganisedCloud,
-                         ::testing::Values(BackendKind::kCpu, BackendKind::kCpuGrid, BackendKind::kVulkan,
-                                           BackendKind::kRt),
-                         [](const auto& info) {
-                           std::string n = to_string(info.param);
-                           for (char& c : n)
-                             if (c == '-') c = '_';
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(EveryBackEnd, OrganisedCloud, kEveryBackend, backend_param_name);
 
 }  // namespace
 }  // namespace ort::test

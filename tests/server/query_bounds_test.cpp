@@ -54,10 +54,8 @@ void map_walls(daemon::MappingServer& server, lcm::LCM& lc, int scans) {
 }
 
 TEST(QueryBounds, RaysThroughUnknownSpaceAreCutAndTheReplySaysWhere) {
-  lcm::LCM lc("memq://");
-  daemon::MappingServer server(test_config(0.1, true), lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture;
+  auto& [lc, log, server, replies] = fixture;
   map_walls(server, lc, 2);
   const auto q = far_rays(1, 2000);
   const auto t0 = SteadyClock::now();
@@ -90,12 +88,10 @@ TEST(QueryBounds, RaysThroughUnknownSpaceAreCutAndTheReplySaysWhere) {
 }
 
 TEST(QueryBounds, ARayLongerThanTheWorkBoundIsRefusedWithTheReason) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.queries.bounds.max_work = 1000;
-  daemon::MappingServer server(cfg, lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture(cfg);
+  auto& [lc, log, server, replies] = fixture;
   const auto q = far_rays(1, 3);
   lc.publish(wire::kQueryRaysChannel, &q);
   const auto r = replies.wait_for<octomap_rt::ray_reply_t>(1);
@@ -176,14 +172,12 @@ TEST(QueryBounds, WholeMapBoxesAreCutAtTheWorkBoundAndAnsweredOnesAreExact) {
 }
 
 TEST(QueryBounds, StoppingCutsTheQueryUnderTheLockWithinTheDrainBound) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.queries.bounds.max_work = uint64_t{1} << 40;  // only the stop can end it early
   cfg.queries.bounds.lock_ms = 10000;
   cfg.drain_timeout_s = 1;
-  daemon::MappingServer server(cfg, lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture(cfg);
+  auto& [lc, log, server, replies] = fixture;
   map_walls(server, lc, 2);
   const auto q = far_rays(1, 2000);
   lc.publish(wire::kQueryRaysChannel, &q);

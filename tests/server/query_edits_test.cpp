@@ -25,12 +25,8 @@ namespace ort::test {
 namespace {
 
 TEST(QueryService, EditsNeedTheTokenAndApplyInOrderWithTheScans) {
-  lcm::LCM lc("memq://");
-  auto cfg = test_config(0.1, true);
-  cfg.queries.control_token = kToken;
-  daemon::MappingServer server(cfg, lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture(with_edits(test_config(0.1, true)));
+  auto& [lc, log, server, replies] = fixture;
   const auto s = wall_scan(0);
   lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);
   octomap_rt::map_edit_t e{};
@@ -70,12 +66,8 @@ TEST(QueryService, EditsNeedTheTokenAndApplyInOrderWithTheScans) {
 // a forged, a tampered, a replayed and a stale edit are refused with their reasons and
 // counted, and the token is in the bytes of none of them.
 TEST(QueryService, EditsAreAuthenticatedByTheirMacWithinTheWindowAndOnce) {
-  lcm::LCM lc("memq://");
-  auto cfg = test_config(0.1, true);
-  cfg.queries.control_token = kToken;
-  daemon::MappingServer server(cfg, lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture(with_edits(test_config(0.1, true)));
+  auto& [lc, log, server, replies] = fixture;
   octomap_rt::map_edit_t good{};
   good.request_id = 1, good.client_id = "op", good.reply_channel = kReply;
   good.op = octomap_rt::map_edit_t::OP_RESET;
@@ -163,13 +155,8 @@ TEST(EditGate, TheNonceCacheIsBoundedAndForgetsWithTheWindow) {
 // nodes under the exclusive lock. The same box on known space only is applied (the map's
 // nodes), and every edit leaves an audit line in the server's log.
 TEST(QueryService, ACostlyEditIsRefusedBeforeItStartsAndEveryEditIsAudited) {
-  lcm::LCM lc("memq://");
-  auto cfg = test_config(0.1, true);
-  cfg.queries.control_token = kToken;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture(with_edits(test_config(0.1, true)));
+  auto& [lc, log, server, replies] = fixture;
   const auto s = wall_scan(0);
   lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);
   ASSERT_TRUE(wait_until_done(server, 1));
@@ -213,13 +200,10 @@ TEST(QueryService, ACostlyEditIsRefusedBeforeItStartsAndEveryEditIsAudited) {
 // scans are dropped and counted to their producer, the edit is applied and acked, and no
 // producer counts it.
 TEST(QueryService, EditsAreNeverShedAsStale) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
-  cfg.queries.control_token = kToken;
   cfg.latency_bound_s = 1e-9;  // every queued scan is stale when stage 1 takes it
-  daemon::MappingServer server(cfg, lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture(with_edits(cfg));
+  auto& [lc, log, server, replies] = fixture;
   for (int64_t k = 0; k < 3; ++k) {
     const auto s = wall_scan(k);
     lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);
@@ -246,13 +230,10 @@ TEST(QueryService, EditsAreNeverShedAsStale) {
 // producer's scans): for the edit client, received = applied + refused. The test holds the
 // map (stage 2 waits) so that edits are still queued when the server stops.
 TEST(QueryService, EditsLeftAtShutdownAreRefusedNotDropped) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
-  cfg.queries.control_token = kToken;
   cfg.drain_timeout_s = 0;
-  daemon::MappingServer server(cfg, lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture(with_edits(cfg));
+  auto& [lc, log, server, replies] = fixture;
   MapHold hold(server);
   octomap_rt::map_edit_t e{};
   e.client_id = "op", e.reply_channel = kReply;

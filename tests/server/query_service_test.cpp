@@ -31,10 +31,8 @@ namespace ort::test {
 namespace {
 
 TEST(QueryService, ReadYourWritesSeesTheScanJustSent) {
-  lcm::LCM lc("memq://");
-  daemon::MappingServer server(test_config(0.1, true), lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture;
+  auto& [lc, log, server, replies] = fixture;
   for (int64_t k = 0; k < 6; ++k) {
     const octomap_rt::scan_t scan = wall_scan(k);
     lc.publish("OCTOMAP_RT_SCAN_ALPHA", &scan);
@@ -63,10 +61,8 @@ TEST(QueryService, ReadYourWritesSeesTheScanJustSent) {
 }
 
 TEST(QueryService, AnEmptyWaitRobotIdMeansNoWaitWhateverWaitSeqHolds) {
-  lcm::LCM lc("memq://");
-  daemon::MappingServer server(test_config(0.1, true), lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture;
+  auto& [lc, log, server, replies] = fixture;
   // A default-initialised query has wait_seq 0 and no robot: answered at once, no scan needed.
   auto plain = point_query(1, {3.05f, 0.f, 0.05f});
   plain.wait_seq = 0, plain.wait_robot_id = "", plain.wait_timeout_ms = 0;
@@ -90,10 +86,8 @@ TEST(QueryService, AnEmptyWaitRobotIdMeansNoWaitWhateverWaitSeqHolds) {
 }
 
 TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
-  lcm::LCM lc("memq://");
-  daemon::MappingServer server(test_config(0.1, true), lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture;
+  auto& [lc, log, server, replies] = fixture;
   for (int64_t k = 0; k < 3; ++k) {
     const auto s = wall_scan(k);
     lc.publish("OCTOMAP_RT_SCAN_ALPHA", &s);
@@ -178,12 +172,10 @@ TEST(QueryService, AnswersEqualTheQueryCoreOnTheServersMap) {
 }
 
 TEST(QueryService, BadQueriesAreRefusedOrDroppedAndCounted) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.queries.per_client_queue = 2;
-  daemon::MappingServer server(cfg, lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture(cfg);
+  auto& [lc, log, server, replies] = fixture;
   auto nan = point_query(1, {0, NAN, 0});
   lc.publish(ort::protocol::kQueryChannel, &nan);
   EXPECT_EQ(replies.wait_for<Reply>(1).status, Reply::REPLY_BAD_REQUEST);

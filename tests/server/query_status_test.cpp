@@ -30,12 +30,10 @@ Status round_trip(const Status& s) {
 }
 
 TEST(QueryStatus, CountsEachClientsQueriesAndWhyTheyWereRefused) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.queries.per_client_queue = 2;
-  daemon::MappingServer server(cfg, lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture(cfg);
+  auto& [lc, log, server, replies] = fixture;
   for (int i = 0; i < 3; ++i) {
     auto ok = point_query(1 + i, {0, 0, 0});
     lc.publish(ort::protocol::kQueryChannel, &ok);

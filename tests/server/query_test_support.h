@@ -5,6 +5,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -75,6 +76,25 @@ inline void sign(octomap_rt::map_edit_t& e, const std::string& token = kToken) {
   e.utime = now_utime();
   e.nonce = protocol::random_edit_nonce();
   protocol::sign_edit(e, token, ort::protocol::kMapEditChannel);
+}
+
+// A server over memq:// started with `cfg`; the replies to the test's queries and edits
+// collected, the server's log kept.
+struct QueryServer {
+  lcm::LCM lc{"memq://"};
+  std::ostringstream log;
+  daemon::MappingServer server;
+  Replies replies;
+  explicit QueryServer(const daemon::ServerConfig& cfg = test_config(0.1, true))
+      : server(cfg, lc, log), replies(server) {
+    server.start();
+  }
+};
+
+// `c` with map edits on, signed with kToken.
+inline daemon::ServerConfig with_edits(daemon::ServerConfig c) {
+  c.queries.control_token = kToken;
+  return c;
 }
 
 // Scan k of robot "alpha": a wall of points at x = 3 + k (map frame), sensor at the origin.

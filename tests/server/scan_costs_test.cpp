@@ -36,10 +36,8 @@ int64_t nodes(daemon::MappingServer& s) {
 }
 
 TEST(ScanCosts, AScanFarFromWhereItsRobotHasBeenIsRefused) {
-  lcm::LCM lc("memq://");
-  std::ostringstream log;
-  daemon::MappingServer server(test_config(0.1, true), lc, log);
-  server.start();
+  MemqServer fixture(test_config(0.1, true));
+  auto& [lc, log, server] = fixture;
   const auto near = reaching_scan(0, {1, 2, 0.5f}, 5, 100);
   lc.publish("OCTOMAP_RT_SCAN_ALPHA", &near);
   ASSERT_TRUE(wait_until_done(server, 1));
@@ -171,10 +169,8 @@ TEST(ScanCosts, AScanOverTheVoxelBoundIsRefusedWhole) {
 }
 
 TEST(ScanCosts, AScanFromTheFarFutureDoesNotPinTheMapsUtime) {
-  lcm::LCM lc("memq://");
-  daemon::MappingServer server(test_config(0.1, true), lc, std::cerr);
-  Replies replies(server);
-  server.start();
+  QueryServer fixture;
+  auto& [lc, log, server, replies] = fixture;
   auto future = wall_scan(0);
   future.utime = now_utime() + int64_t(10) * 365 * 24 * 3600 * 1'000'000;  // ten years ahead
   lc.publish("OCTOMAP_RT_SCAN_ALPHA", &future);

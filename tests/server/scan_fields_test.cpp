@@ -14,6 +14,7 @@
 #include "core/errors.h"
 #include "engine/map_engine.h"
 #include "server/scan_fixtures.h"
+#include "support/every_backend.h"
 #include "support/tree_compare.h"
 
 namespace ort::test {
@@ -176,15 +177,7 @@ TEST_P(ScanFields, EveryDegenerateFieldIsRefusedWithItsReasonOrWalkedSafely) {
   server->stop();
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryBackEnd, ScanFields,
-                         ::testing::Values(BackendKind::kCpu, BackendKind::kCpuGrid, BackendKind::kVulkan,
-                                           BackendKind::kRt),
-                         [](const auto& info) {
-                           std::string n = to_string(info.param);
-                           for (char& c : n)
-                             if (c == '-') c = '_';
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(EveryBackEnd, ScanFields, kEveryBackend, backend_param_name);
 
 }  // namespace
 }  // namespace ort::test

@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -55,6 +56,14 @@ std::string temp_dir(const std::string& tag);
 // Holds the server's map lock (a reader in with_map) on a thread of its own from construction
 // until release() or destruction: stage 2 cannot apply, so scans and edits stay queued.
 // Construct it after server.start(); it returns once the lock is held.
+// A server over its own memq:// instance, started with `cfg`, its log kept.
+struct MemqServer {
+  lcm::LCM lc{"memq://"};
+  std::ostringstream log;
+  daemon::MappingServer server;
+  explicit MemqServer(const daemon::ServerConfig& cfg) : server(cfg, lc, log) { server.start(); }
+};
+
 class MapHold {
  public:
   explicit MapHold(daemon::MappingServer& server);

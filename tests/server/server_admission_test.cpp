@@ -17,13 +17,11 @@ using daemon::Reject;
 
 // The warm-up scan is never larger than the largest scan the daemon accepts.
 TEST(ServerMemq, WarmUpIsNoLargerThanMaxPoints) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.warm_up_points = 640 * 480;
   cfg.max_points = 1000;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   server.stop();
   EXPECT_NE(log.str().find("warmed up on a scan of 1000 points"), std::string::npos) << log.str();
 }
@@ -32,13 +30,11 @@ TEST(ServerMemq, WarmUpIsNoLargerThanMaxPoints) {
 // applied keeps the arrival order, and the counts still balance.
 TEST(ServerMemq, FullQueueDropsNewestAndCountsIt) {
   const auto scans = robot_scans(1, 6, 1);
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.05, true);
   cfg.max_points = 30'000;
   cfg.queue_budget_bytes = 12 * 30'000 + 8192;  // about one full scan per producer
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   const auto& list = scans.at("robot0");
   const int rounds = 5;
   for (int round = 0; round < rounds; ++round)
@@ -66,12 +62,10 @@ TEST(ServerMemq, FullQueueDropsNewestAndCountsIt) {
 // More scan channels than --max-producers: the extra ones share one "*" entry whose scans
 // are all rejected (bounded memory whatever the channel names), and are still counted.
 TEST(ServerMemq, ProducersBeyondTheLimitAreRejectedAndCounted) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.max_producers = 2;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   for (const char* robot : {"a1", "a2", "a3", "a4"}) {
     const auto msg = small_scan(robot, 0, 10);
     lc.publish(channel_of(robot), &msg);

@@ -33,15 +33,13 @@ octomap_rt::scan_t far_scan(const std::string& robot, int64_t seq, double distan
 }
 
 TEST(ServerHardening, FarFlungScansDoNotWedgeTheServer) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.engine.backend.kind = BackendKind::kCpuGrid;
   cfg.engine.backend.threads = 2;
   cfg.scan_costs.max_origin_jump_m = 0;    // the corner scan's origin jumps: this test is about its rays,
   cfg.scan_costs.max_mean_ray_voxels = 0;  // which are kilometres long (the engine's bounds, not the daemon's)
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   const std::string ch = "OCTOMAP_RT_SCAN_FAR";
   lc.publish(ch, &static_cast<const octomap_rt::scan_t&>(far_scan("far", 0, 3000.0, 50)));
   // Corner to corner of the key range: longer than OctoMap's ray walk can hold.
@@ -61,12 +59,10 @@ TEST(ServerHardening, FarFlungScansDoNotWedgeTheServer) {
 }
 
 TEST(ServerHardening, StaleScansAreShedWithAReasonUnderOverload) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.latency_bound_s = 0.001;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   // Hold the map lock: stage 2 cannot apply, stage 1 stops after one shot, the queue fills
   // and its scans grow old.
   MapHold hold(server);
@@ -91,13 +87,11 @@ TEST(ServerHardening, StaleScansAreShedWithAReasonUnderOverload) {
 }
 
 TEST(ServerHardening, OnlyAllowedRobotsAreServed) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.allowed_robots = {"husky1"};
   cfg.max_producers = 1;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   for (int i = 0; i < 5; ++i) {
     const std::string id = "intruder" + std::to_string(i);
     std::string ch = "OCTOMAP_RT_SCAN_" + id;

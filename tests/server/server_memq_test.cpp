@@ -199,15 +199,13 @@ void run_real_scans(BackendKind backend, size_t warm_up_points = 0) {
   if (path.empty()) return;
   const ScanSet set = load_scan_graph(path);
   ASSERT_EQ(set.scans.size(), 3u);
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.2, true);
   cfg.engine.backend.kind = backend;
   cfg.engine.backend.compact_into_host_memory = true;  // as the daemon's command line sets it
   cfg.engine.shoots_beside_apply = true;
   cfg.warm_up_points = warm_up_points;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   if (warm_up_points) {
     EXPECT_NE(log.str().find("warmed up on a scan of " + std::to_string(warm_up_points) + " points"), std::string::npos)
         << log.str();

@@ -49,13 +49,11 @@ bool degraded_with(daemon::MappingServer& server, const std::string& cause) {
 
 TEST(ServerShutdown, DrainIsBoundedAndTheAppliedMapIsSaved) {
   const auto dir = temp_dir("drain-deadline");
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.map_path = dir + "/map.ot";
   cfg.drain_timeout_s = 0.05;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   publish(lc, "first", 0);
   ASSERT_TRUE(wait_until_done(server, 1));
   const int n = 10;

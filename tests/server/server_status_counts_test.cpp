@@ -32,12 +32,10 @@ TEST(ServerStatusCounts, BigMapIsExactOnceDrained) {
   const std::string path = data_file("3dtk_dat/3dtk_3scans.graph");
   if (path.empty()) return;
   const ScanSet set = load_scan_graph(path);
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.status.period_s = 0.02;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   for (size_t k = 0; k < set.scans.size(); ++k) {
     const auto msg = scan_message(set.scans[k], "husky1", static_cast<int64_t>(k));
     lc.publish(std::string(ort::protocol::kScanChannelPrefix) + "HUSKY1", &msg);
@@ -143,10 +141,8 @@ TEST(ServerStatusCounts, SlowestScansAreAppliedScansWithTheirParts) {
   const std::string path = data_file("3dtk_dat/3dtk_3scans.graph");
   if (path.empty()) return;
   const ScanSet set = load_scan_graph(path);
-  lcm::LCM lc("memq://");
-  std::ostringstream log;
-  daemon::MappingServer server(test_config(0.1, true), lc, log);
-  server.start();
+  MemqServer fixture(test_config(0.1, true));
+  auto& [lc, log, server] = fixture;
   int64_t sent = 0;
   for (int round = 0; round < 2; ++round)
     for (size_t k = 0; k < set.scans.size(); ++k, ++sent) {
@@ -197,12 +193,10 @@ TEST(ServerStatusCounts, SlowestScansAreAppliedScansWithTheirParts) {
 // A handler that throws on the LCM thread is caught by the loop, logged once per message through
 // the server's log, counted, and the count reaches every later status and the summary.
 TEST(ServerStatusCounts, HandlerErrorsReachTheStatus) {
-  lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.status.period_s = 0.02;
-  std::ostringstream log;
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   EXPECT_EQ(server.status().lcm_handler_errors, 0);
   server.lcm_loop().subscribe("ORT_TEST_BROKEN_HANDLER", [](const lcm::ReceiveBuffer&, const std::string&) {
     throw std::runtime_error("a service's handler failed");

@@ -26,9 +26,11 @@
 #include <CLI/CLI.hpp>
 
 #include "bigmap_readers.h"
+#include "cli/replay/scan_message.h"
 #include "core/clock.h"
 #include "daemon/mapping_server.h"
 #include "engine/engine_flags.h"
+#include "protocol/channels.h"
 #include "scene/scan_set.h"
 #include "scene/scene_presets.h"
 
@@ -36,23 +38,11 @@ namespace {
 
 using namespace ort;
 
+// A producer's message of `scan` (the points in the sensor frame, as octomap-rt replay sends them).
 octomap_rt::scan_t to_message(const PosedScan& scan, const std::string& robot, int64_t seq) {
-  octomap_rt::scan_t m;
-  m.utime = seq + 1;
-  m.seq = seq;
-  for (int i = 0; i < 3; ++i) m.sensor_position[i] = scan.pose.trans()(i);
-  m.sensor_orientation[0] = scan.pose.rot().u();
-  m.sensor_orientation[1] = scan.pose.rot().x();
-  m.sensor_orientation[2] = scan.pose.rot().y();
-  m.sensor_orientation[3] = scan.pose.rot().z();
-  m.max_range = -1;
-  m.points_frame = octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME;
-  for (const auto& p : scan.points)
-    for (int a = 0; a < 3; ++a) m.xyz.push_back(p(a));
-  m.num_xyz = static_cast<int32_t>(m.xyz.size());
-  m.robot_id = robot;
-  m.map_frame = "map";
-  return m;
+  cli::ScanMessageFields f;
+  f.robot_id = robot, f.seq = seq, f.utime = seq + 1;
+  return cli::make_scan_message(scan, f);
 }
 
 int64_t finished(daemon::MappingServer& s) {
@@ -128,7 +118,7 @@ int grow(const Args& a) {
   int64_t seq = 0, nodes = 0;
   while (nodes < a.target_nodes && seq < 100'000) {
     const auto m = to_message(set.scans[static_cast<size_t>(seq) % set.scans.size()], "grow", seq);
-    lc.publish("OCTOMAP_RT_SCAN_GROW", &m);
+    lc.publish(std::string(protocol::kScanChannelPrefix) + "GROW", &m);
     ++seq;
     while (finished(server) < seq) std::this_thread::sleep_for(std::chrono::milliseconds(5));
     nodes = server.status().num_nodes;
@@ -182,7 +172,7 @@ int run(const Args& a) {
   for (int p = 0; p < a.producers; ++p)
     producers.emplace_back([&, p] {
       const std::string robot = "bench" + std::to_string(p);
-      const std::string channel = "OCTOMAP_RT_SCAN_BENCH" + std::to_string(p);
+      const std::string channel = std::string(protocol::kScanChannelPrefix) + "BENCH" + std::to_string(p);
       const auto period = std::chrono::duration<double>(1.0 / a.rate);
       auto next = t0 + std::chrono::duration_cast<SteadyClock::duration>(period * p / a.producers);
       for (int64_t seq = 0; SteadyClock::now() - t0 < std::chrono::duration<double>(a.duration); ++seq) {

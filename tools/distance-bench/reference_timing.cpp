@@ -13,7 +13,7 @@
 #include "gpu/distance_transform.h"
 
 #ifdef OCTOMAP_RT_HAVE_DYNAMICEDT
-#include <dynamicEDT3D/dynamicEDTOctomap.h>
+#include "scene/dynamic_edt_reference.h"
 #endif
 
 namespace ort::bench {
@@ -33,20 +33,12 @@ double median_ms(int reps, F&& f) {
 }
 
 #ifdef OCTOMAP_RT_HAVE_DYNAMICEDT
-// DynamicEDTOctomap over our padded grid (corners at its outer voxel centres), as the test does.
+// DynamicEDTOctomap over our padded grid, as the test does.
 std::unique_ptr<DynamicEDTOctomap> dynamic_edt(octomap::OcTree& tree, const distance::BoxRead& read,
                                                const distance::DistanceOptions& opt) {
   const auto& g = read.grid.box;
-  const int n[3] = {g.dims.nx, g.dims.ny, g.dims.nz};
-  octomap::point3d bmin, bmax;
-  for (int a = 0; a < 3; ++a) {
-    bmin(a) = float(tree.keyToCoord(octomap::key_type(g.key_lo[a])));
-    bmax(a) = float(tree.keyToCoord(octomap::key_type(g.key_lo[a] + n[a] - 1)));
-  }
-  auto edt = std::make_unique<DynamicEDTOctomap>(float(opt.max_distance), &tree, bmin, bmax,
-                                                 opt.unknown == distance::UnknownAs::kOccupied);
-  edt->update();
-  return edt;
+  return scene::dynamic_edt_over(tree, g.key_lo, {g.dims.nx, g.dims.ny, g.dims.nz}, opt.max_distance,
+                                 opt.unknown == distance::UnknownAs::kOccupied);
 }
 
 // The squared distance (cells) from padded cell (i, j, k) to the nearest obstacle of the grid
@@ -74,10 +66,7 @@ void count_differences(const octomap::OcTree& tree, DynamicEDTOctomap& edt, cons
   for (int k = 0; k < d.nz; ++k)
     for (int j = 0; j < d.ny; ++j)
       for (int i = 0; i < d.nx; ++i, ++c) {
-        const octomap::point3d p(float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[0] + i))),
-                                 float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[1] + j))),
-                                 float(tree.keyToCoord(octomap::key_type(ours.cells.key_lo[2] + k))));
-        const int64_t theirs = edt.getSquaredDistanceInCells(p);
+        const int64_t theirs = edt.getSquaredDistanceInCells(scene::voxel_centre(tree, ours.cells.key_lo, i, j, k));
         const uint32_t mine = ours.squared[c];
         if (mine == distance::kNoObstacle || double(mine) > clamp_sq || theirs == int64_t(mine)) continue;
         ++t.dynamic_edt_differ;

@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/replay/scan_message.h"
 #include "core/clock.h"
 #include "daemon/mapping_server.h"
 #include "engine/engine_flags.h"
@@ -31,23 +32,11 @@ struct RunResult {
   octomap_rt::server_status_t status;
 };
 
+// A producer's message of `scan` (the points in the sensor frame, as octomap-rt replay sends them).
 octomap_rt::scan_t to_message(const PosedScan& scan, const std::string& robot, int64_t seq) {
-  octomap_rt::scan_t m;
-  m.utime = seq;
-  m.seq = seq;
-  for (int i = 0; i < 3; ++i) m.sensor_position[i] = scan.pose.trans()(i);
-  m.sensor_orientation[0] = scan.pose.rot().u();
-  m.sensor_orientation[1] = scan.pose.rot().x();
-  m.sensor_orientation[2] = scan.pose.rot().y();
-  m.sensor_orientation[3] = scan.pose.rot().z();
-  m.max_range = -1;
-  m.points_frame = octomap_rt::scan_t::POINTS_IN_SENSOR_FRAME;
-  for (size_t i = 0; i < scan.points.size(); ++i)
-    for (int a = 0; a < 3; ++a) m.xyz.push_back(scan.points[i](a));
-  m.num_xyz = static_cast<int32_t>(m.xyz.size());
-  m.robot_id = robot;
-  m.map_frame = "map";
-  return m;
+  cli::ScanMessageFields f;
+  f.robot_id = robot, f.seq = seq, f.utime = seq;
+  return cli::make_scan_message(scan, f);
 }
 
 RunResult run(const daemon::ServerConfig& base, bool pipelined, const ScanSet& set, int producers, int repeat) {

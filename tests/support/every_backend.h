@@ -1,0 +1,25 @@
+// The back ends a parameterized test runs on (each skips itself where it has no device), and
+// their names as gtest takes them: INSTANTIATE_TEST_SUITE_P(EveryBackEnd, Suite,
+// kEveryBackend, backend_param_name).
+#pragma once
+
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/backend_kind.h"
+
+namespace ort::test {
+
+inline const auto kEveryBackend =
+    ::testing::Values(BackendKind::kCpu, BackendKind::kCpuGrid, BackendKind::kVulkan, BackendKind::kRt);
+
+// "cpu-grid" -> "cpu_grid": gtest names are identifiers.
+inline std::string backend_param_name(const ::testing::TestParamInfo<BackendKind>& info) {
+  std::string n = to_string(info.param);
+  for (char& c : n)
+    if (c == '-') c = '_';
+  return n;
+}
+
+}  // namespace ort::test
