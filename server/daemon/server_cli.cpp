@@ -18,6 +18,7 @@
 #include "protocol/channels.h"
 #include "protocol/ids.h"
 #include "protocol/lcm_url.h"
+#include "protocol/limits.h"
 
 namespace ort::daemon {
 
@@ -318,7 +319,9 @@ ServerConfig to_server_config(const ServerFlags& f) {
     throw CLI::ValidationError("--producer-idle-release", "must be a finite number of seconds");
   for (const std::string& id : c.allowed_robots)
     if (!protocol::valid_robot_id(id))
-      throw CLI::ValidationError("--allow-robot", "'" + id + "' is not a robot id (1-32 of [A-Za-z0-9_-])");
+      throw CLI::ValidationError(
+          "--allow-robot",
+          "'" + id + "' is not a robot id (1-" + std::to_string(protocol::kMaxRobotIdLength) + " of [A-Za-z0-9_-])");
   try {
     std::regex check(c.scan_channels);
   } catch (const std::regex_error& e) {

@@ -14,14 +14,18 @@ import signal
 import time
 
 from octomap_rt import (box_query_t, map_request_t, ray_query_t, scan_t)
+from octomap_rt.channels import Channels
+from octomap_rt.protocol_table import MAX_QUERY_RAYS
 from octomap_rt.transport import open_transport
+
+CHANNELS = Channels()  # the protocol's names (protocol/channels.h) in $OCTOMAP_RT_NAMESPACE, as the server takes them
 
 
 def ray_query(i):
     q = ray_query_t()
     q.request_id, q.client_id, q.reply_channel = i, "hostile-rays", "HOSTILE_REPLY"
     q.wait_seq, q.ignore_unknown, q.max_range = -1, 1, 10000.0
-    n = 2000  # the most a ray query may have
+    n = MAX_QUERY_RAYS  # the most a ray query may have
     q.origin_xyz = [0.05, 0.05, 0.25] * n
     q.direction_xyz = [c for k in range(n) for c in (1.0, 0.001 * k, 0.3)]
     q.num_xyz = 3 * n
@@ -41,7 +45,7 @@ def fresh_request(i, client):
     r = map_request_t()
     r.utime, r.request_id, r.snapshot_id, r.format = int(time.time() * 1e6), i, -1, 1
     r.client_id = client
-    r.reply_channel = "OCTOMAP_RT_MAP_REPLY_" + client.upper().replace("-", "_")
+    r.reply_channel = CHANNELS.reply_channel(CHANNELS.map_reply_prefix, client)
     r.chunk_indices, r.num_chunk_indices = [], 0
     return r
 
@@ -80,19 +84,19 @@ def main():
         i += 1
         rays.request_id = boxes.request_id = i
         if "rays" in kinds:
-            t.publish("OCTOMAP_RT_QUERY_RAYS", rays.encode())
+            t.publish(CHANNELS.query_rays, rays.encode())
             sent["ray_queries"] += 1
         if "boxes" in kinds:
-            t.publish("OCTOMAP_RT_QUERY_BOXES", boxes.encode())
+            t.publish(CHANNELS.query_boxes, boxes.encode())
             sent["box_queries"] += 1
         if i % 2 == 0 and "fresh" in kinds:
             for c in range(40):
-                t.publish("OCTOMAP_RT_MAP_REQUEST", fresh_request(i * 100 + c, "hostile-%d" % c).encode())
+                t.publish(CHANNELS.map_request, fresh_request(i * 100 + c, "hostile-%d" % c).encode())
                 sent["fresh_requests"] += 1
         if i % 4 == 0 and "far" in kinds:
             for r in range(4):
                 robot = "evil%d" % r
-                t.publish("OCTOMAP_RT_SCAN_" + robot.upper(), far_scan(seq, robot).encode())
+                t.publish(CHANNELS.scan_prefix + robot.upper(), far_scan(seq, robot).encode())
                 sent["far_scans"] += 1
             seq += 1
         t.handle(0.0)

@@ -2,6 +2,9 @@
 
 #include <cctype>
 
+#include "protocol/ids.h"
+#include "protocol/limits.h"
+
 namespace ort::cli {
 
 octomap_rt::scan_t make_scan_message(const PosedScan& scan, const ScanMessageFields& f) {
@@ -40,12 +43,10 @@ std::string scan_channel(const std::string& prefix, const std::string& robot_id)
 }
 
 std::string check_robot_id(const std::string& robot_id) {
-  if (robot_id.empty() || robot_id.size() > 32) return "robot id must have 1 to 32 characters";
-  for (char ch : robot_id) {
-    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-'))
-      return "robot id may only hold letters, digits, '_' and '-': " + robot_id;
-  }
-  return "";
+  if (protocol::valid_robot_id(robot_id)) return "";  // the server's rule (protocol/ids.h)
+  if (robot_id.empty() || robot_id.size() > protocol::kMaxRobotIdLength)
+    return "robot id must have 1 to " + std::to_string(protocol::kMaxRobotIdLength) + " characters";
+  return "robot id may only hold letters, digits, '_' and '-': " + robot_id;
 }
 
 }  // namespace ort::cli

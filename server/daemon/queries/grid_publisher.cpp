@@ -57,7 +57,7 @@ void GridPublisher::compute_if_changed() {
 EncodedReplies GridPublisher::clipped_grid(octomap_rt::grid_query_t q, const MapStamp& stamp, const std::string& why) {
   const double res = map_.tree->getResolution();
   const double cell = q.cell_size > 0 ? q.cell_size : res;
-  const int64_t max_cells = std::min<int64_t>(4'000'000, static_cast<int64_t>(bounds_.max_reply_bytes));
+  const int64_t max_cells = std::min<int64_t>(kMaxGridCells, static_cast<int64_t>(bounds_.max_reply_bytes));
   const int64_t side = std::max<int64_t>(1, static_cast<int64_t>(std::sqrt(static_cast<double>(max_cells))) - 2);
   const double half = 0.5 * static_cast<double>(side) * cell;
   const octomap::point3d& o = map_.last_scan_origin;

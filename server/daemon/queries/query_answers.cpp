@@ -27,7 +27,6 @@ using Box = octomap_rt::box_query_t;
 constexpr int kRegionChunk = protocol::kRegionChunkVoxels, kGridChunkCells = protocol::kGridChunkCells;
 // A region voxel on the wire: state, depth and its center's three floats.
 constexpr size_t kRegionVoxelBytes = 1 + 1 + 12;
-constexpr int64_t kMaxGridCells = 4'000'000;
 
 EncodedReplies replies_on(const std::string& channel) {
   EncodedReplies out;

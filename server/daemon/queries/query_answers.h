@@ -17,6 +17,10 @@
 
 namespace ort::daemon {
 
+// The most cells a grid answer may have (within --query-max-reply-bytes too): the grid query's
+// and the grid published at a rate.
+inline constexpr int64_t kMaxGridCells = 4'000'000;
+
 // Common to every query message.
 struct QueryHeader {
   int64_t request_id = 0, min_snapshot_id = 0, wait_seq = -1;

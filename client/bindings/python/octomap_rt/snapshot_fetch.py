@@ -139,7 +139,7 @@ def fetch_snapshot(transport, fmt: str = "bt", timeout_s: float = 30.0, snapshot
                     if missing is None:
                         request(snapshot_id, [])
                     else:
-                        request(assembly.first.snapshot_id, missing[:8192])
+                        request(assembly.first.snapshot_id, missing[:MAX_REQUESTED_CHUNKS])
                 continue
             # Before the first chunk the server may be copying a big map or waiting for its
             # next fresh snapshot: ask again only after a longer silence.
