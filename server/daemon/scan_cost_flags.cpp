@@ -63,7 +63,7 @@ void add_scan_cost_flags(CLI::App& app, ScanCostBounds& c) {
                  "arrival order")
       ->capture_default_str();
   app.add_option("--share-history-scans", c.share_history_scans,
-                 "scans a robot must have had applied (over --share-history) before it has a share of its own")
+                 "valid scans a robot must have sent (over --share-history) before it has a share of its own")
       ->capture_default_str()
       ->check(CLI::Range(int64_t{0}, int64_t{1'000'000'000}));
   app.add_option("--share-history", c.share_history_s, "see --share-history-scans [s]")

@@ -27,6 +27,26 @@ TEST(ProducerRegistry, SeqGapsAreCounted) {
   EXPECT_EQ(r.snapshot()[p].seq_restarts, 0);
 }
 
+TEST(ProducerRegistry, HistoryIsValidScansSentOverTimeNotScansApplied) {
+  // A share of the stages of its own (intake/scan_queue.h) comes with history; a flood that
+  // keeps the shared class's scans from being applied must not keep a new robot from it.
+  ProducerPolicy policy;
+  policy.history_scans = 3;
+  policy.history = std::chrono::duration<double>(0.05);
+  ProducerRegistry r("OCTOMAP_RT_SCAN_", policy);
+  const size_t p = r.producer_for("OCTOMAP_RT_SCAN_A");
+  const auto t0 = SteadyClock::now();
+  for (int64_t seq : {0, 1}) admit(r, p, seq);
+  EXPECT_FALSE(r.has_history(p, t0 + std::chrono::seconds(1)));  // two scans: too few
+  admit(r, p, 2);
+  EXPECT_FALSE(r.has_history(p, SteadyClock::now()));           // three, but not over 50 ms yet
+  EXPECT_TRUE(r.has_history(p, t0 + std::chrono::seconds(1)));  // none applied: still history
+  r.count_rejected_arrival(p, Reject::kTruncated);
+  const size_t q = r.producer_for("OCTOMAP_RT_SCAN_B");
+  for (int k = 0; k < 3; ++k) r.count_rejected_arrival(q, Reject::kTruncated);
+  EXPECT_FALSE(r.has_history(q, t0 + std::chrono::seconds(1)));  // invalid messages are no history
+}
+
 TEST(ProducerRegistry, ACopyOfTheLastScanIsRejectedNotAppliedTwice) {
   // The same message delivered or replayed twice (same seq, same utime) used to be queued
   // again, applied a second time and counted as a restart.

@@ -4,8 +4,11 @@ send what the review found expensive (issue 21):
   - ray queries of 2000 rays through unknown space with max_range 10 km (ignore_unknown);
   - box queries of 1000 whole-map boxes;
   - floods of fresh-snapshot requests from 40 client ids;
-  - far scans: 100 points 1 km from a sensor that jumps 3 km each scan, on 4 robot channels.
---kinds picks some of them (rays, boxes, fresh, far; default all). Prints what it sent, one
+  - far scans: 100 points 1 km from a sensor that jumps 3 km each scan, on 4 robot channels;
+  - far400 scans: 100 points 400 m out (just under the server's mean-ray bound at 0.1 m), 4 a
+    second from a sensor that stays put, each from a robot id it has not used for a while
+    (50 ids in turn: the server's --max-producers is 64).
+--kinds picks some of them (rays, boxes, fresh, far, far400; default all but far400). Prints what it sent, one
 `key value` a line, when the time is up or on SIGTERM."""
 import argparse
 import math
@@ -50,10 +53,10 @@ def fresh_request(i, client):
     return r
 
 
-def far_scan(seq, robot):
+def far_scan(seq, robot, distance=1000.0, jump=3000.0):
     s = scan_t()
     s.utime, s.seq, s.robot_id = int(time.time() * 1e6), seq, robot
-    s.sensor_position = [3000.0 * (seq % 7), 2.0, 0.5]
+    s.sensor_position = [jump * (seq % 7), 2.0, 0.5]
     s.sensor_orientation = [1.0, 0.0, 0.0, 0.0]
     s.points_frame, s.max_range = scan_t.POINTS_IN_SENSOR_FRAME, -1.0
     s.map_frame = "map"
@@ -62,7 +65,7 @@ def far_scan(seq, robot):
     for _ in range(100):
         d = [rng.gauss(0, 1) for _ in range(3)]
         n = math.sqrt(sum(c * c for c in d)) or 1.0
-        xyz += [1000.0 * c / n for c in d]
+        xyz += [distance * c / n for c in d]
     s.xyz, s.num_xyz = xyz, len(xyz)
     return s
 
@@ -77,7 +80,7 @@ def main():
     stop = []
     signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
     t = open_transport(a.lcm_url)
-    sent = {"ray_queries": 0, "box_queries": 0, "fresh_requests": 0, "far_scans": 0}
+    sent = {"ray_queries": 0, "box_queries": 0, "fresh_requests": 0, "far_scans": 0, "far400_scans": 0}
     rays, boxes = ray_query(0), box_query(0)
     end, i, seq = time.monotonic() + a.duration, 0, 0
     while time.monotonic() < end and not stop:
@@ -99,6 +102,11 @@ def main():
                 t.publish(CHANNELS.scan_prefix + robot.upper(), far_scan(seq, robot).encode())
                 sent["far_scans"] += 1
             seq += 1
+        if i % 5 == 0 and "far400" in kinds:
+            k = sent["far400_scans"]
+            robot = "fresh%d" % (k % 50)
+            t.publish("OCTOMAP_RT_SCAN_" + robot.upper(), far_scan(k, robot, 400.0, 0.0).encode())
+            sent["far400_scans"] += 1
         t.handle(0.0)
         time.sleep(0.05)
     for k, v in sent.items():

@@ -39,7 +39,7 @@ size_t ProducerRegistry::special_entry(size_t& index, const char* channel, const
     s.robot_id = robot_id;
     producers_.push_back(s);
     last_arrival_.emplace_back();
-    first_applied_.emplace_back();
+    first_valid_.emplace_back();
   }
   return index;
 }
@@ -84,7 +84,7 @@ void ProducerRegistry::release(size_t slot) {
   r.released++;
   by_channel_.erase(p.channel);
   p = ProducerStats{};
-  first_applied_[slot] = {};  // the new channel earns its own history
+  first_valid_[slot] = {};  // the new channel earns its own history
 }
 
 size_t ProducerRegistry::producer_for(const std::string& channel, SteadyClock::time_point now) {
@@ -100,7 +100,7 @@ size_t ProducerRegistry::producer_for(const std::string& channel, SteadyClock::t
     slot = producers_.size();
     producers_.emplace_back();
     last_arrival_.emplace_back();
-    first_applied_.emplace_back();
+    first_valid_.emplace_back();
     slots_used_++;
   } else if ((slot = idle_slot(now)) != SIZE_MAX) {
     release(slot);
@@ -133,8 +133,9 @@ std::string ProducerRegistry::expected_robot_id(size_t producer) const {
 
 bool ProducerRegistry::has_history(size_t producer, SteadyClock::time_point now) const {
   std::lock_guard lock(mutex_);
-  const SteadyClock::time_point first = first_applied_[producer];
-  return producers_[producer].applied >= policy_.history_scans && first != SteadyClock::time_point{} &&
+  const ProducerStats& p = producers_[producer];
+  const SteadyClock::time_point first = first_valid_[producer];
+  return p.received - p.rejected >= policy_.history_scans && first != SteadyClock::time_point{} &&
          now - first >= policy_.history;
 }
 
@@ -172,6 +173,7 @@ bool ProducerRegistry::admit(size_t producer, int64_t seq, int64_t utime, const 
   }
   note_seq(p, seq);
   p.last_utime = utime;
+  if (first_valid_[producer] == SteadyClock::time_point{}) first_valid_[producer] = SteadyClock::now();
   if (!enqueue()) {
     p.dropped++;
     p.drop_reasons[static_cast<size_t>(Reject::kQueueFull)]++;
@@ -186,7 +188,7 @@ void ProducerRegistry::count_applied(size_t producer, int64_t points, double end
   std::lock_guard lock(mutex_);
   ProducerStats& p = producers_[producer];
   p.in_flight--;
-  if (p.applied++ == 0) first_applied_[producer] = SteadyClock::now();
+  p.applied++;
   p.points_applied += points;
   for (size_t k = 0; k < kPointDropReasonCount; ++k) p.point_drops[k] += dropped[k];
   p.points_read_as_zero += read_as_zero;

@@ -56,7 +56,8 @@ struct ProducerPolicy {
   // A seq step larger than this is a restart (counted), not that many lost scans.
   int64_t max_seq_gap = 100'000;
   // A producer has history (a share of the stages of its own, intake/scan_queue.h) once it
-  // has had this many scans applied over at least this long.
+  // has sent this many valid scans over at least this long. Valid arrivals, not applied
+  // scans: a flood in the shared class must not keep a new robot from ever earning its own.
   int64_t history_scans = 20;
   std::chrono::duration<double> history{30.0};
 };
@@ -75,7 +76,8 @@ class ProducerRegistry {
   bool is_overflow(size_t producer) const;
   Reject refusal(size_t producer) const;
   std::string expected_robot_id(size_t producer) const;
-  // The producer has had history_scans scans applied, the first history ago or earlier.
+  // The producer has sent history_scans valid scans (received, not rejected), the first
+  // history ago or earlier.
   bool has_history(size_t producer, SteadyClock::time_point now = SteadyClock::now()) const;
 
   void count_rejected_arrival(size_t producer, Reject why);
@@ -110,8 +112,8 @@ class ProducerRegistry {
   size_t overflow_index_ = SIZE_MAX, refused_index_ = SIZE_MAX, released_index_ = SIZE_MAX;
   size_t slots_used_ = 0;
   std::vector<ProducerStats> producers_;
-  std::vector<SteadyClock::time_point> last_arrival_;   // parallel to producers_
-  std::vector<SteadyClock::time_point> first_applied_;  // parallel to producers_; unset: none yet
+  std::vector<SteadyClock::time_point> last_arrival_;  // parallel to producers_
+  std::vector<SteadyClock::time_point> first_valid_;   // parallel to producers_; unset: none yet
   std::map<std::string, size_t> by_channel_;
 };
 

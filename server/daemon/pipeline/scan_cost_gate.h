@@ -45,7 +45,7 @@ struct ScanCostBounds {
   // daemon's clock (a scan stamped years ahead would pin it there).
   double max_future_s = 60;
   // The stages' time shared among producers (intake/scan_queue.h): a producer has a share of
-  // its own once it has had share_history_scans scans applied over share_history_s seconds;
+  // its own once it has sent share_history_scans valid scans over share_history_s seconds;
   // before, it shares one with every other producer without history. false: one FIFO.
   bool producer_share = true;
   int64_t share_history_scans = 20;
