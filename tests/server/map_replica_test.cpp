@@ -2,12 +2,14 @@
 // clear-boxes and a reset it equals the map of record byte for byte (.ot), and a reader that
 // holds it for a long time does not stop the octree stage: scans go on being applied, and the
 // replica catches up once the reader lets go (the scans that waited applied as one list);
-// while stage 2 holds the map of record, queries are answered from the replica.
+// while stage 2 holds the map of record, queries are answered from the replica; while stage 2
+// waits for the replica's room it does not hold the map of record.
 #include <sstream>
 #include <thread>
 
 #include <gtest/gtest.h>
 
+#include "daemon/map/map_mutex.h"
 #include "daemon/persistence/map_store.h"
 #include "octomap_rt/map_edit_ack_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
@@ -87,6 +89,77 @@ TEST(MapReplica, AReaderHoldingItDoesNotStopTheOctreeStage) {
   EXPECT_GT(after->largest_batch, 1u);
   EXPECT_LT(after->updates, set.scans.size());
   server.stop();
+}
+
+TEST(MapReplica, StageTwoWaitsForItsRoomWithoutHoldingTheMapOfRecord) {
+  const ScanSet set = make_synthetic_rooms();
+  ASSERT_GE(set.scans.size(), 4u);
+  lcm::LCM lc("memq://");
+  std::ostringstream log;
+  auto cfg = test_config(0.1, true);
+  cfg.replica_pending_bytes = 1;  // a scan queued behind another has no room: stage 2 waits for it
+  daemon::MappingServer server(cfg, lc, log);
+  server.start();
+  std::atomic<bool> release{false};
+  std::thread reader([&] { server.hold_replica_until(release); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  for (size_t k = 0; k < set.scans.size(); ++k) {
+    const auto msg = scan_message(set.scans[k], "rover", static_cast<int64_t>(k));
+    lc.publish("OCTOMAP_RT_SCAN_ROVER", &msg);
+  }
+  // The map of record stops at the scans the replica's queue has room for; stage 2 waits.
+  int64_t version = -1;
+  for (int i = 0; i < 100; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const int64_t now = server.status().map_version;
+    if (now == version && now > 0) break;
+    version = now;
+  }
+  ASSERT_LT(version, static_cast<int64_t>(set.scans.size())) << "stage 2 did not wait for the held replica";
+  // Meanwhile the map of record can be read (stage 2 waits for room before it takes the lock).
+  std::atomic<bool> read{false};
+  std::thread other([&] {
+    server.with_map([](const octomap::OcTree& t) { return t.size(); });
+    read = true;
+  });
+  for (int i = 0; i < 200 && !read; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  const bool read_while_waiting = read;
+  release = true;
+  reader.join();
+  other.join();
+  EXPECT_TRUE(read_while_waiting) << "stage 2 held the map of record while it waited for the replica";
+  ASSERT_TRUE(wait_until_done(server, static_cast<int64_t>(set.scans.size())));
+  EXPECT_EQ(replica_bytes(server), map_bytes(server));
+  const auto stats = server.replica_stats();
+  ASSERT_TRUE(stats.has_value());
+  EXPECT_GT(stats->writer_waited_ms, 0);
+  EXPECT_GT(stats->lock_wait_ms_max, 100) << "its thread waited for the reader";
+  server.stop();
+}
+
+TEST(MapReplica, ItsLockLetsAWaitingWriterInBeforeNewReaders) {
+  // The replica's lock (daemon/map/map_mutex.h): readers that keep overlapping never keep its
+  // writer out, because a reader coming after a waiting writer waits too. The map of record's
+  // lock keeps std::shared_mutex's reader preference.
+  for (bool writers_first : {false, true}) {
+    daemon::MapMutex m;
+    if (writers_first) m.prefer_writers();
+    m.lock_shared();
+    std::atomic<bool> wrote{false};
+    std::thread writer([&] {
+      m.lock();
+      wrote = true;
+      m.unlock();
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the writer waits now
+    const bool second_reader = m.try_lock_shared();
+    if (second_reader) m.unlock_shared();
+    EXPECT_EQ(second_reader, !writers_first) << (writers_first ? "writers first" : "readers first");
+    EXPECT_FALSE(wrote);
+    m.unlock_shared();
+    writer.join();
+    EXPECT_TRUE(wrote);
+  }
 }
 
 TEST(MapReplica, QueriesAreAnsweredFromItWhileAScanHoldsTheMap) {

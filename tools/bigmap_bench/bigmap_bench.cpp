@@ -76,6 +76,7 @@ struct Args {
   double rate = 1.0, duration = 60;
   std::string readers = "on", replica = "on";
   uint64_t replica_batch_voxels = daemon::MapReplica::kDefaultBatchVoxels;
+  uint64_t replica_pending_bytes = daemon::ServerConfig{}.replica_pending_bytes;
   int replica_nice = 10;
   unsigned replica_threads = 0;
   double snapshot_period = 1, save_interval = 10, raw_rate = 1, query_rate = 100;
@@ -91,6 +92,7 @@ daemon::ServerConfig server_config(const Args& a) {
   cfg.latency_bound_s = 60;
   cfg.read_replica = a.replica == "on";
   cfg.replica_batch_voxels = a.replica_batch_voxels;
+  cfg.replica_pending_bytes = a.replica_pending_bytes;
   cfg.replica_nice = a.replica_nice;
   cfg.replica_threads = a.replica_threads;
   // The producers go round the preset's scans (origins far apart, many new nodes a second at
@@ -230,10 +232,12 @@ int run(const Args& a) {
   if (replica)
     std::printf(
         "  read replica: %.1f s of updates on its thread (%llu updates, %llu scans in batches, at most %llu in one), "
-        "at most %.1f MB pending, stage 2 waited %.1f ms for room\n",
+        "at most %.1f MB pending, stage 2 waited %.1f ms for room; its thread waited %.1f s for readers (at most "
+        "%.1f ms)\n",
         replica->apply_ms_total / 1e3, (unsigned long long)replica->updates,
         (unsigned long long)replica->scans_in_batches, (unsigned long long)replica->largest_batch,
-        double(replica->max_pending_bytes_seen) / 1e6, replica->writer_waited_ms);
+        double(replica->max_pending_bytes_seen) / 1e6, replica->writer_waited_ms, replica->lock_wait_ms_total / 1e3,
+        replica->lock_wait_ms_max);
   std::printf("  memory: RSS %.0f MiB before the map, %.0f MiB loaded, %.0f MiB at the end, peak %.0f MiB\n",
               rss_before, rss_loaded, rss_end, hwm);
   // readers, replica, nodes, scans, s, stall max, stall p99, e2e p50, e2e p99, query p50, query p99, snapshots,
@@ -279,6 +283,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   r->add_option("--replica-batch-voxels", a.replica_batch_voxels,
                 "scans waiting for the read replica are applied together up to this many voxels (0: one by one)")
+      ->capture_default_str();
+  r->add_option("--replica-pending-bytes", a.replica_pending_bytes,
+                "how far (bytes of changes) the read replica may lag before stage 2 waits for it")
       ->capture_default_str();
   r->add_option("--replica-threads", a.replica_threads, "the read replica's octree threads (0: every hardware thread)")
       ->capture_default_str();

@@ -15,6 +15,7 @@ namespace ort::daemon {
 MapReplica::MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
                        uint64_t max_batch_voxels, int nice)
     : stage_(octree), max_pending_bytes_(max_pending_bytes), max_batch_voxels_(max_batch_voxels) {
+  state_.mutex.prefer_writers();  // readers overlap one another: the writer must get in between
   state_.tree = std::make_unique<octomap::OcTree>(*map.tree);
   state_.version = map.version;
   state_.epoch = map.epoch;
@@ -45,7 +46,7 @@ void MapReplica::stop() {
 
 void MapReplica::scan_applied(VoxelList& voxels, const MapState& map, const std::string& robot_lower) {
   Item it;
-  it.bytes = voxels.size() * sizeof(VoxelUpdate) + sizeof(Item);
+  it.bytes = scan_bytes(voxels.size());
   it.voxels.swap(voxels);
   it.version = map.version;
   it.epoch = map.epoch;
@@ -67,15 +68,22 @@ void MapReplica::step_applied(MapStep step, const MapState& map) {
   push(std::move(it));
 }
 
+void MapReplica::wait_room_locked(std::unique_lock<std::mutex>& lock, uint64_t bytes) {
+  // Room for it, unless the queue is empty (one item always fits: the bound never stops the map).
+  if (queue_.empty() || stats_.pending_bytes + bytes <= max_pending_bytes_) return;
+  const auto t0 = SteadyClock::now();
+  room_.wait(lock, [&] { return stop_ || queue_.empty() || stats_.pending_bytes + bytes <= max_pending_bytes_; });
+  stats_.writer_waited_ms += ms_since(t0);
+}
+
+void MapReplica::wait_for_room(size_t voxels) {
+  std::unique_lock lock(mutex_);
+  wait_room_locked(lock, scan_bytes(voxels));
+}
+
 void MapReplica::push(Item item) {
   std::unique_lock lock(mutex_);
-  // Room for it, unless the queue is empty (one item always fits: the bound never stops the map).
-  if (!queue_.empty() && stats_.pending_bytes + item.bytes > max_pending_bytes_) {
-    const auto t0 = SteadyClock::now();
-    room_.wait(lock,
-               [&] { return stop_ || queue_.empty() || stats_.pending_bytes + item.bytes <= max_pending_bytes_; });
-    stats_.writer_waited_ms += ms_since(t0);
-  }
+  wait_room_locked(lock, item.bytes);
   stats_.pending_items++;
   stats_.pending_bytes += item.bytes;
   stats_.max_pending_bytes_seen = std::max(stats_.max_pending_bytes_seen, stats_.pending_bytes);
@@ -96,14 +104,16 @@ void MapReplica::take_batch(std::deque<Item>& batch) {
   }
 }
 
-void MapReplica::apply_batch(std::deque<Item>& batch) {
+double MapReplica::apply_batch(std::deque<Item>& batch) {
   std::span<const VoxelUpdate> voxels = batch.front().voxels;
   if (batch.size() > 1) {
     joined_.clear();
     for (const Item& it : batch) joined_.insert(joined_.end(), it.voxels.begin(), it.voxels.end());
     voxels = joined_;
   }
+  const auto t0 = SteadyClock::now();
   std::unique_lock lock(state_.mutex);
+  const double waited = ms_since(t0);
   const MapHoldNote note(state_.holders, "replica update");
   // The leaf count as the map of record keeps it (daemon/map/map_identity.h): the octree
   // stage says how the batch changed it; a step does not (0 if it left the tree empty).
@@ -124,6 +134,7 @@ void MapReplica::apply_batch(std::deque<Item>& batch) {
   state_.epoch = last.epoch;
   state_.scans = last.scans;
   state_.last_scan_utime = last.last_scan_utime;
+  return waited;
 }
 
 void MapReplica::run() {
@@ -136,14 +147,17 @@ void MapReplica::run() {
       take_batch(batch);
     }
     const auto t0 = SteadyClock::now();
-    apply_batch(batch);
+    const double waited = apply_batch(batch);
+    const double applied_ms = ms_since(t0);
     uint64_t bytes = 0;
     for (const Item& it : batch) bytes += it.bytes;
     const uint64_t items = batch.size();
     batch.clear();  // the voxel lists are freed outside both locks
     {
       std::lock_guard lock(mutex_);
-      stats_.apply_ms_total += ms_since(t0);
+      stats_.apply_ms_total += applied_ms - std::min(applied_ms, waited);
+      stats_.lock_wait_ms_total += waited;
+      stats_.lock_wait_ms_max = std::max(stats_.lock_wait_ms_max, waited);
       stats_.updates++;
       if (items > 1) stats_.scans_in_batches += items;
       stats_.largest_batch = std::max(stats_.largest_batch, items);
@@ -176,7 +190,7 @@ MapState& readable_map(MapState& map) {
   return map.replica->state();
 }
 
-MapState& lock_for_short_read(MapState& map, uint64_t min_version, std::shared_lock<std::shared_mutex>& lock) {
+MapState& lock_for_short_read(MapState& map, uint64_t min_version, std::shared_lock<MapMutex>& lock) {
   if (!map.replica) {
     lock = std::shared_lock(map.mutex);
     return map;

@@ -52,7 +52,9 @@ struct ReplicaStats {
   uint64_t pending_items = 0, pending_bytes = 0;
   uint64_t max_pending_bytes_seen = 0;
   double writer_waited_ms = 0;    // stage 2's total wait for room (the bound above)
-  double apply_ms_total = 0;      // the replica thread's own update time
+  double apply_ms_total = 0;      // the replica thread's own update time (its lock held)
+  double lock_wait_ms_total = 0;  // the replica thread's wait for its lock (readers inside)
+  double lock_wait_ms_max = 0;
   uint64_t updates = 0;           // tree updates it made: one per batch of scans or per step
   uint64_t scans_in_batches = 0;  // scans applied together with others
   uint64_t largest_batch = 0;     // most scans in one update
@@ -78,6 +80,11 @@ class MapReplica {
   void scan_applied(VoxelList& voxels, const MapState& map, const std::string& robot_lower);
   // Under the map lock, after the map of record applied `step`: the replica applies it too.
   void step_applied(MapStep step, const MapState& map);
+  // Stage 2, before it takes the map lock for a scan of `voxels` voxels: waits until the queue
+  // has room for it (counted in writer_waited_ms), so that while the replica is behind, stage 2
+  // waits without holding the map of record and queries go on reading it. scan_applied keeps
+  // its own wait for the rare case that another change took the room meanwhile.
+  void wait_for_room(size_t voxels);
 
   // The state readers read: lock its mutex (shared) to read tree, version, epoch, ...
   MapState& state() { return state_; }
@@ -103,12 +110,16 @@ class MapReplica {
     MapState::NewestScan newest;
     uint64_t bytes = 0;
   };
+  static uint64_t scan_bytes(size_t voxels) { return voxels * sizeof(VoxelUpdate) + sizeof(Item); }
+  // Under mutex_ (`lock`): waits while `bytes` more would pass the bound (never for an empty queue).
+  void wait_room_locked(std::unique_lock<std::mutex>& lock, uint64_t bytes);
   void push(Item item);
   void run();
   // Under mutex_: the front item, and the scans right behind a scan up to max_batch_voxels_.
   void take_batch(std::deque<Item>& batch);
   // Applies a batch to the tree and takes its last item's state (under state_.mutex).
-  void apply_batch(std::deque<Item>& batch);
+  // Returns how long it waited for that lock (ms).
+  double apply_batch(std::deque<Item>& batch);
 
   MapState state_;
   OctreeStage stage_;
@@ -134,6 +145,6 @@ MapState& readable_map(MapState& map);
 // `min_version` or newer (a reader that passes the newest id it answered from never answers
 // from an older state after a newer one); else it waits for the map of record. Both are
 // states between two whole scans, each named by its own `version`. Returns the state locked.
-MapState& lock_for_short_read(MapState& map, uint64_t min_version, std::shared_lock<std::shared_mutex>& lock);
+MapState& lock_for_short_read(MapState& map, uint64_t min_version, std::shared_lock<MapMutex>& lock);
 
 }  // namespace ort::daemon

@@ -19,6 +19,7 @@
 #include "core/voxel_update.h"
 #include "daemon/map/applied_order.h"
 #include "daemon/map/map_lock_holders.h"
+#include "daemon/map/map_mutex.h"
 #include "octree/leaf_changes.h"
 
 namespace ort::daemon {
@@ -49,7 +50,7 @@ inline std::string robot_key(std::string id) {
 
 struct MapState {
   // Writers (stage 2, edits) lock it exclusively; queries read under a shared lock.
-  std::shared_mutex mutex;
+  MapMutex mutex;
   // Who held `mutex` and for how long (daemon/map/map_lock_holders.h): each holder names itself.
   MapLockHolders holders;
   std::unique_ptr<octomap::OcTree> tree;

@@ -223,6 +223,9 @@ void ScanPipeline::apply(ShotJob& job) {
   Stage2Parts parts;
   int64_t new_nodes = 0;
   try {
+    // Room in the read replica's queue first, without the map lock: while the replica is
+    // behind, queries go on reading the map of record instead of waiting with stage 2.
+    if (map_.replica) map_.replica->wait_for_room(job.shot.voxels.size());
     std::lock_guard lock(map_.mutex);
     const auto locked = SteadyClock::now();
     // The holder it waited for let go of the lock last (daemon/map/map_lock_holders.h).

@@ -327,7 +327,7 @@ void QueryService::run() {
       const auto now = SteadyClock::now();
       const bool overdue =
           std::any_of(parked.begin(), parked.end(), [&](const PendingQuery& p) { return p.deadline <= now; });
-      std::shared_lock<std::shared_mutex> lock;
+      std::shared_lock<MapMutex> lock;
       if (overdue) {
         lock = std::shared_lock(map_.mutex);
         turn_map_ = &map_;

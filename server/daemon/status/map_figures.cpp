@@ -11,7 +11,7 @@ namespace ort::daemon {
 namespace {
 
 // A shared lock of `m`, tried for ~100 ms (not owned after that).
-std::shared_lock<std::shared_mutex> try_shared(std::shared_mutex& m) {
+std::shared_lock<MapMutex> try_shared(MapMutex& m) {
   std::shared_lock lock(m, std::defer_lock);
   for (int i = 0; i < 100 && !lock.try_lock(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   return lock;
