@@ -10,7 +10,7 @@
 
 namespace ort::protocol {
 
-inline constexpr int32_t kProtocolVersion = 2;
+inline constexpr int32_t kProtocolVersion = 3;
 
 // For a map_info_t or server_status_t message whose 8-byte fingerprint is not
 // `expected_hash`: what its sender speaks, in words ("the server speaks protocol version 3,
