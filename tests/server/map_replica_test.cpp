@@ -27,6 +27,13 @@ std::string map_bytes(daemon::MappingServer& s) {
 std::string replica_bytes(daemon::MappingServer& s) {
   return s.with_readable_map([](const octomap::OcTree& t) { return daemon::serialize_map(t); });
 }
+// Every scan of `set` from robot "rover", seq 0, 1, ...
+void publish_as_rover(lcm::LCM& lc, const ScanSet& set) {
+  for (size_t k = 0; k < set.scans.size(); ++k) {
+    const auto msg = scan_message(set.scans[k], "rover", static_cast<int64_t>(k));
+    lc.publish("OCTOMAP_RT_SCAN_ROVER", &msg);
+  }
+}
 
 TEST(MapReplica, EqualsTheMapOfRecordAfterScansEditsAndAReset) {
   const ScanSet set = make_synthetic_rooms();
@@ -41,10 +48,7 @@ TEST(MapReplica, EqualsTheMapOfRecordAfterScansEditsAndAReset) {
     lc.publish(ort::protocol::kMapEditChannel, &e);
     EXPECT_EQ(replies.wait_for<octomap_rt::map_edit_ack_t>(id).status, Reply::REPLY_OK);
   };
-  for (size_t k = 0; k < set.scans.size(); ++k) {
-    const auto msg = scan_message(set.scans[k], "rover", static_cast<int64_t>(k));
-    lc.publish("OCTOMAP_RT_SCAN_ROVER", &msg);
-  }
+  publish_as_rover(lc, set);
   ASSERT_TRUE(wait_until_done(server, static_cast<int64_t>(set.scans.size())));
   edit(1, octomap_rt::map_edit_t::OP_CLEAR_TO_FREE, 1.05);
   edit(2, octomap_rt::map_edit_t::OP_CLEAR_TO_UNKNOWN, 4.4);
@@ -68,10 +72,7 @@ TEST(MapReplica, AReaderHoldingItDoesNotStopTheOctreeStage) {
   std::atomic<bool> release{false};
   std::thread reader([&] { server.hold_replica_until(release); });
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  for (size_t k = 0; k < set.scans.size(); ++k) {
-    const auto msg = scan_message(set.scans[k], "rover", static_cast<int64_t>(k));
-    lc.publish("OCTOMAP_RT_SCAN_ROVER", &msg);
-  }
+  publish_as_rover(lc, set);
   const bool applied = wait_until_done(server, static_cast<int64_t>(set.scans.size()));
   const auto during = server.replica_stats();
   const auto status = server.status();
@@ -94,19 +95,14 @@ TEST(MapReplica, AReaderHoldingItDoesNotStopTheOctreeStage) {
 TEST(MapReplica, StageTwoWaitsForItsRoomWithoutHoldingTheMapOfRecord) {
   const ScanSet set = make_synthetic_rooms();
   ASSERT_GE(set.scans.size(), 4u);
-  lcm::LCM lc("memq://");
-  std::ostringstream log;
   auto cfg = test_config(0.1, true);
   cfg.replica_pending_bytes = 1;  // a scan queued behind another has no room: stage 2 waits for it
-  daemon::MappingServer server(cfg, lc, log);
-  server.start();
+  MemqServer fixture(cfg);
+  auto& [lc, log, server] = fixture;
   std::atomic<bool> release{false};
   std::thread reader([&] { server.hold_replica_until(release); });
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  for (size_t k = 0; k < set.scans.size(); ++k) {
-    const auto msg = scan_message(set.scans[k], "rover", static_cast<int64_t>(k));
-    lc.publish("OCTOMAP_RT_SCAN_ROVER", &msg);
-  }
+  publish_as_rover(lc, set);
   // The map of record stops at the scans the replica's queue has room for; stage 2 waits.
   int64_t version = -1;
   for (int i = 0; i < 100; ++i) {
