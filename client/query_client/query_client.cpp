@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <thread>
 
 #include "core/clock.h"
 #include "octomap_rt/box_query_t.hpp"
@@ -75,14 +76,28 @@ std::vector<Reply> QueryClient::exchange(const std::string& channel, Request& re
   sub->setQueueCapacity(4096);
   lcm_->publish(channel, &request);
   const auto deadline = SteadyClock::now() + timeout_;
-  while (!done(replies)) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyClock::now());
-    if (left.count() <= 0) {
-      lcm_->unsubscribe(sub);
-      throw QueryTimeout("no complete reply on " + reply_channel_ + " within " + std::to_string(timeout_.count()) +
-                         " ms (is octomap-rt-server running on this LCM URL?)");
+  // BUSY says "this may fit another turn" (a full per-client queue, or a region or grid cut by
+  // the time bound under the map lock while mapping held the cores): ask again, backing off,
+  // until the timeout; a fresh request id so a late reply to the first ask is not mixed in.
+  auto backoff = std::chrono::milliseconds(20);
+  for (;;) {
+    while (!done(replies)) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyClock::now());
+      if (left.count() <= 0) {
+        lcm_->unsubscribe(sub);
+        throw QueryTimeout("no complete reply on " + reply_channel_ + " within " + std::to_string(timeout_.count()) +
+                           " ms (is octomap-rt-server running on this LCM URL?)");
+      }
+      lcm_->handleTimeout(static_cast<int>(std::min<int64_t>(left.count(), 100)));
     }
-    lcm_->handleTimeout(static_cast<int>(std::min<int64_t>(left.count(), 100)));
+    if (replies.front().status != octomap_rt::occupancy_reply_t::REPLY_BUSY || SteadyClock::now() + backoff >= deadline)
+      break;
+    busy_retries_++;
+    std::this_thread::sleep_for(backoff);
+    backoff = std::min(backoff * 2, std::chrono::milliseconds(500));
+    replies.clear();
+    request.request_id = sink.id = next_request_++;
+    lcm_->publish(channel, &request);
   }
   lcm_->unsubscribe(sub);
   return replies;

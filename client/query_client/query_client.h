@@ -82,9 +82,13 @@ class QueryClient {
 
   const std::string& reply_channel() const { return reply_channel_; }
 
+  // Requests asked again after a BUSY reply (every reply type's status 3), since construction.
+  int64_t busy_retries() const { return busy_retries_; }
+
  private:
   // Publishes `request` (already addressed) on `channel` and collects raw replies with this
-  // request id until `done(replies)` says so; throws QueryTimeout.
+  // request id until `done(replies)` says so; a BUSY reply is asked again (backing off)
+  // until the timeout, and the last BUSY is returned when time runs out; throws QueryTimeout.
   template <class Reply, class Request, class Done>
   std::vector<Reply> exchange(const std::string& channel, Request& request, Done&& done);
   template <class Request>
@@ -98,6 +102,7 @@ class QueryClient {
   std::string client_id_, reply_channel_;
   std::chrono::milliseconds timeout_;
   int64_t next_request_ = 1;
+  int64_t busy_retries_ = 0;
 };
 
 }  // namespace ort::client

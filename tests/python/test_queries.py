@@ -66,3 +66,55 @@ class QueriesTest(ServerTestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class _BusyThenAnswer:
+    """A transport standing in for a server that refuses the first `busy` grid queries as BUSY
+    (a full queue, or the time bound under the map lock) and answers the next one."""
+
+    def __init__(self, busy):
+        self.busy, self.asked, self.pending, self.handlers = busy, [], [], {}
+
+    def subscribe(self, channel, handler):
+        self.handlers[channel] = handler
+        return channel
+
+    def unsubscribe(self, sub):
+        self.handlers.pop(sub, None)
+
+    def publish(self, channel, data):
+        q = octomap_rt.grid_query_t.decode(data)
+        self.asked.append(q.request_id)
+        r = octomap_rt.grid_t()
+        r.request_id, r.num_chunks = q.request_id, 1
+        if len(self.asked) <= self.busy:
+            r.status, r.num_chunks = octomap_rt.occupancy_reply_t.REPLY_BUSY, 0
+            r.error = "refused: the time bound under the map lock"
+        else:
+            r.width, r.height, r.num_rows, r.cell_size = 1, 1, 1, 0.1
+            r.cells, r.num_cells = [octomap_rt.OCCUPIED], 1
+        self.pending.append((q.reply_channel, r.encode()))
+
+    def handle(self, timeout_s=None):
+        for channel, data in self.pending:
+            if channel in self.handlers:
+                self.handlers[channel](channel, data)
+        n, self.pending = len(self.pending), []
+        return n
+
+
+class BusyRepliesTest(unittest.TestCase):
+    def test_a_busy_reply_is_asked_again_until_it_is_answered(self):
+        from octomap_rt.queries import QueryChannel, grid
+        t = _BusyThenAnswer(busy=3)
+        q = QueryChannel(t, "busy-test", timeout_s=5.0)
+        cells, _, size = grid(q, 0.0, 1.0)
+        self.assertEqual(int(cells[0, 0]), octomap_rt.OCCUPIED)
+        self.assertEqual((q.busy_retries, len(t.asked), len(set(t.asked))), (3, 4, 4))
+
+    def test_busy_past_the_timeout_is_an_error_that_says_why(self):
+        from octomap_rt.queries import QueryChannel, QueryError, grid
+        q = QueryChannel(_BusyThenAnswer(busy=10 ** 6), "busy-test", timeout_s=0.3)
+        with self.assertRaisesRegex(QueryError, "status 3.*time bound under the map lock"):
+            grid(q, 0.0, 1.0)
+        self.assertGreater(q.busy_retries, 0)

@@ -38,6 +38,8 @@ class Wait:
     def waits(self) -> bool:
         return self.min_snapshot_id > 0 or bool(self.robot_id)
 
+_REPLY_BUSY = occupancy_reply_t.REPLY_BUSY  # every reply type's status 3
+
 
 class QueryChannel:
     """Sends a query and collects the reply messages with its request_id. `wait`, when set,
@@ -54,6 +56,7 @@ class QueryChannel:
         self.retry_after_s = retry_after_s
         self._next_id = int(time.time() * 1000) * 1000
         self.wait: Optional[Wait] = None
+        self.busy_retries = 0  # requests asked again after a BUSY reply
 
     def _stamp(self, msg, min_snapshot_id: int) -> None:
         msg.utime = int(time.time() * 1e6)
@@ -88,6 +91,7 @@ class QueryChannel:
         w = self.wait if self.wait is not None and self.wait.waits() else None
         # A query that waits on the server is answered when its condition holds: not resent before.
         retry_after_s = self.retry_after_s + (min(30.0, w.timeout_s) if w is not None else 0.0)
+        backoff_s = 0.02
         try:
             start = time.monotonic()
             while time.monotonic() - start < max(self.timeout_s, retry_after_s):
@@ -98,7 +102,13 @@ class QueryChannel:
                 while time.monotonic() - sent < retry_after_s and not (replies and complete(replies)):
                     self.transport.handle(0.05)
                 if replies and complete(replies):
-                    break
+                    # BUSY: "this may fit another turn" (a full queue, or a region or grid cut by
+                    # the time bound under the map lock): ask again, backing off, until the timeout.
+                    if replies[0].status != _REPLY_BUSY or time.monotonic() + backoff_s - start >= self.timeout_s:
+                        break
+                    self.busy_retries += 1
+                    time.sleep(backoff_s)
+                    backoff_s = min(0.5, backoff_s * 2)
                 replies.clear()
         finally:
             self.transport.unsubscribe(sub)
