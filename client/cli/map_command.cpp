@@ -119,7 +119,12 @@ void register_map_command(CLI::App& app) {
   add_common(watch, *args);
   watch->add_option("--seconds", args->seconds, "stop after this long; 0: at Ctrl-C")->capture_default_str();
   watch->add_option("--save", args->save, "write the mirror to this .ot file at the end");
-  watch->callback([args] { run_map_watch(*args); });
+  watch->add_flag("--shards", args->shards,
+                  "the namespace is a shard set: follow every shard's deltas in one mirror (each shard's version and "
+                  "epoch printed, a missing or late shard named; exit status 3 if one is at the end)");
+  watch->callback([args] {
+    if (const int rc = run_map_watch(*args); rc != 0) throw CLI::RuntimeError(rc);
+  });
   auto files = std::make_shared<std::vector<std::string>>();
   CLI::App* diff = map->add_subcommand(
       "diff", "compare two maps (.ot/.bt) voxel by voxel: class, and log-odds; exit 1 if classes differ");

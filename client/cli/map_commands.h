@@ -12,11 +12,12 @@ struct MapArgs {
   bool json = false, quiet = false;
   double seconds = 0;    // watch: 0 = until Ctrl-C
   std::string save;      // watch: .ot written at the end
-  bool shards = false;   // get: the namespace is a shard set: merge every shard's map
+  bool shards = false;   // get, watch: the namespace is a shard set: merge every shard's map
   bool partial = false;  // get --shards: write the merged map even when a shard is missing
 };
 
-void run_map_watch(const MapArgs& a);
+// 0, or 3 when a watch of a shard set ends with a shard missing or late.
+int run_map_watch(const MapArgs& a);
 // 0 when both maps classify every finest voxel alike, else 1.
 int run_map_diff(const std::string& a, const std::string& b);
 

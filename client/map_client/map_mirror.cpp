@@ -29,6 +29,7 @@ void MapMirror::on_delta(const Delta& d) {
 // so they arrive in that order: an info naming a delta_seq never received means that delta
 // was lost. Without this a lost last delta (the end of a stream) would go unseen for good.
 void MapMirror::on_info(const octomap_rt::map_info_t& info) {
+  if (opts_.on_info) opts_.on_info(info);
   const bool baseline = !info_seen_;  // synced before any info: its deltas' seqs were unknown
   info_seen_ = true;
   latest_info_seq_ = info.delta_seq;

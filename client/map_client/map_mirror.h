@@ -40,6 +40,9 @@ struct MirrorOptions {
   int8_t snapshot_format = octomap_rt::map_chunk_t::FORMAT_OCTOMAP_FULL;
   double fetch_timeout_s = 30;
   std::function<void(const AppliedDelta&)> on_delta;
+  // Called with every map_info_t heard (1 Hz), before the mirror checks it: a shard set's mirror
+  // (shard_client/shard_mirror.h) checks the set each shard announces and when it last spoke.
+  std::function<void(const octomap_rt::map_info_t&)> on_info;
 };
 
 struct MirrorStats {
@@ -56,6 +59,7 @@ class MapMirror {
   // Handles deltas for `seconds`; resyncs (when enabled) on a gap.
   void spin(double seconds);
 
+  bool synced() const { return tree_ != nullptr; }  // a snapshot was fetched
   const octomap::OcTree& tree() const { return *tree_; }
   int64_t version() const { return version_; }  // map state id the mirror is at
   int64_t epoch() const { return epoch_; }      // and its epoch

@@ -32,6 +32,8 @@ if(PYTHON3 AND LCM_LOGGER)
   octomap_rt_add_python_test(python_map_mirror_test test_map_mirror 300)
   # Issue 26: the Python shard client against three shards and one whole daemon.
   octomap_rt_add_python_test(python_shards_test test_shards 300)
+  # Every shard's deltas in one mirror (real 3DTK scans), one shard's new epoch, a late shard.
+  octomap_rt_add_python_test(python_shard_mirror_test test_shard_mirror 300)
 else()
   message(WARNING "octomap-rt: python3 or lcm-logger missing: the Python client tests are not registered")
 endif()

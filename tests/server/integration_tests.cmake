@@ -33,3 +33,6 @@ octomap_rt_add_integration_test(map_identity_integration_test 300)
 # Issue 26: three shards in one namespace; the CLI merges their maps, queries routed by region.
 octomap_rt_add_integration_test(shards_integration_test 300)
 target_link_libraries(shards_integration_test PRIVATE octomap_rt_shard_client)
+# Every shard's deltas in one mirror: it equals the merged snapshot; one shard's new epoch; late, missing.
+octomap_rt_add_integration_test(shard_mirror_integration_test 300)
+target_link_libraries(shard_mirror_integration_test PRIVATE octomap_rt_shard_client)

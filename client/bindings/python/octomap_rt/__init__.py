@@ -12,3 +12,4 @@ from .queries import FREE, OCCUPIED, UNKNOWN, QueryError  # noqa: F401
 from .distance import distance_box, distance_path, distance_points  # noqa: F401
 from .edits import MapEditor, edit_mac, sign_edit  # noqa: F401
 from .map_mirror import DeltaError, MapMirror, MirrorStats, canonical_leaves  # noqa: F401
+from .shard_mirror import MergedMirror, ShardMirror  # noqa: F401

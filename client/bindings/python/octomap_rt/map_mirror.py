@@ -164,6 +164,16 @@ class MapMirror:
         self._subs = [t.subscribe(client.channels.map_delta, self._on_delta_bytes),
                       t.subscribe(client.channels.map_info, self._on_info_bytes)]
 
+    @property
+    def synced(self) -> bool:
+        """A snapshot was fetched (leaves, version and epoch are the server's map at some point)."""
+        return self._synced
+
+    @property
+    def needs_sync(self) -> bool:
+        """No snapshot yet, or a gap or a new epoch was seen since: the next spin() fetches one."""
+        return self._need_sync or not self._synced
+
     def close(self) -> None:
         for s in self._subs:
             self.client.transport.unsubscribe(s)
