@@ -93,7 +93,8 @@ void MapEngine::shoot(const octomap::point3d& origin, std::span<const octomap::p
   check_max_range(max_range);
   out.reset();
   const auto t0 = SteadyClock::now();
-  const RayBatch batch = prepare_scan(origin, points, max_range, opts_.resolution, out.prepare, opts_.octree.threads);
+  RayBatch batch = prepare_scan(origin, points, max_range, opts_.resolution, out.prepare, opts_.octree.threads);
+  if (out.prepare.origin_ok && clip_) clip_rays(batch, out);
   out.shoot.times.prepare_ms = ms_since(t0);
   if (!out.prepare.origin_ok) return;
   // Bounded work whatever the geometry: OctoMap's own limit per ray, then the scan's cost
@@ -145,6 +146,30 @@ void MapEngine::shoot_posed_xyz(const octomap::pose6d& pose, const octomap::poin
   out.prepare.read_as_zero += tiny_as_sent_only(sensor_xyz, world);
   out.shoot.times.prepare_ms += transform_ms;
   out.prepare.device_declined = declined;  // said, so callers can count scans the device passed on
+}
+
+// The walk of a ray (OctoMap's DDA) stays inside the key box of its origin and end widened by
+// the overstep margin that core/ray_tiles.h plans its tiles with.
+void MapEngine::clip_rays(RayBatch& batch, ShotScan& out) const {
+  constexpr int kMargin = 2, kKeyMax = 65535;
+  KeyBox keys;
+  keys.include(batch.origin_key);
+  size_t kept = 0;
+  for (const RayEnd& e : batch.ends) {
+    octomap::OcTreeKey k;
+    coord_to_key_checked(octomap::point3d(e.x, e.y, e.z), batch.resolution, k);  // ends are in range
+    KeyBox walk;
+    for (int i = 0; i < 3; ++i) {
+      walk.lo[i] = std::max(0, std::min<int>(batch.origin_key[i], k[i]) - kMargin);
+      walk.hi[i] = std::min(kKeyMax, std::max<int>(batch.origin_key[i], k[i]) + kMargin);
+    }
+    if (!clip_(walk)) continue;
+    batch.ends[kept++] = e;
+    keys.include(k);
+  }
+  out.clipped_rays = batch.ends.size() - kept;
+  batch.ends.resize(kept);
+  batch.keys = keys;
 }
 
 // A sum, not an increment of one of two counters chosen per voxel (that chains every voxel

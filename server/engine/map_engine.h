@@ -7,6 +7,7 @@
 // scans; neither may be called from two threads at once.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -71,8 +72,9 @@ struct ShotScan {
   ShootStats shoot;
   VoxelList voxels;
   uint64_t free_voxels = 0, occupied_voxels = 0;
-  uint64_t walk_keys = 0;  // the scan's cost: key steps over all its windows
-  uint64_t tiles = 0;      // path-following tiles (0: the scan's box was shot whole)
+  uint64_t walk_keys = 0;     // the scan's cost: key steps over all its windows
+  uint64_t tiles = 0;         // path-following tiles (0: the scan's box was shot whole)
+  uint64_t clipped_rays = 0;  // rays left out by the engine's ray clip (a shard's: set_ray_clip)
   ShotRefusal refusal = ShotRefusal::kNone;
   std::string refusal_detail;  // says why, with the numbers
 
@@ -131,6 +133,16 @@ class MapEngine {
     apply(out, tree);
   }
 
+  // A shard's ray clip (docs/PROTOCOL.md, "Shards"): `may_hold(box)` says whether the inclusive
+  // key box may hold a voxel the caller keeps; it must never say false for a box that does. A
+  // ray whose walk stays in a box `may_hold` refuses (its origin's and end's keys, widened by
+  // the DDA's overstep margin) is left out before the walk; the rays kept are walked whole, as
+  // OctoMap walks them, so every voxel kept gets OctoMap's update (a voxel's update depends only
+  // on the rays through it). On the CPU preparation path only: a back end that prepares scans
+  // on its device walks every ray. An empty function (the default) keeps every ray.
+  using RayClip = std::function<bool(const KeyBox&)>;
+  void set_ray_clip(RayClip may_hold) { clip_ = std::move(may_hold); }
+
   const EngineOptions& options() const { return opts_; }
   // The batched octree stage's threads (0 in opts_.octree: all hardware threads).
   unsigned octree_threads() const;
@@ -144,10 +156,13 @@ class MapEngine {
 
  private:
   void count_states(ShotScan& out) const;
+  // Leaves out the rays clip_ refuses; the batch's key box then bounds the rays kept.
+  void clip_rays(RayBatch& batch, ShotScan& out) const;
   // Shoots a scan too large for one window tile by tile, each tile's voxels cut to it.
   void shoot_tiled(const RayBatch& batch, ShotScan& out);
 
   EngineOptions opts_;
+  RayClip clip_;
   std::unique_ptr<RayBackend> backend_;
   mutable OctreeStage octree_stage_;          // keeps the batched stage's threads between scans; only apply() uses it
   std::vector<octomap::point3d> map_points_;  // shoot_posed_xyz's map-frame points, kept between scans

@@ -2,6 +2,7 @@
 // scans, for 2, 3 and 4 shards: every shard's map is OctoMap's map restricted to its regions,
 // and the shards' maps merged are the one-daemon map node for node (its .bt byte for byte),
 // both from the engine's lists and through whole daemons over memq://.
+#include <limits>
 #include <sstream>
 #include <thread>
 
@@ -229,6 +230,53 @@ TEST(Shards, RealScansShardByShardEqualOctomapAndMergeToTheWholeMap) {
       expect_merge_is_whole(shards, depth, *whole, std::to_string(n) + " shards, depth " + std::to_string(depth));
     }
   }
+}
+
+// The engine's ray clip, as the daemon sets it (a shard leaves out the rays whose walk meets none
+// of its regions): each shard's map is still OctoMap's map restricted to its regions, the box
+// shard away from the sensors left rays out, and the hashed set some. 4 hashed shards (regions at
+// depth 10: 12.8 m) and 2 boxes cut at x = 5 m (the sensors stand near x = 0; y is up in 3DTK).
+TEST(Shards, ClippedRaysLeaveEveryShardOctomapsMap) {
+  const std::string path = data_file("3dtk_dat/3dtk_3scans.graph");
+  if (path.empty()) return;
+  const ScanSet set = load_scan_graph(path);
+  const auto cfg = test_config(0.2, false);
+  const auto reference = octomap_reference(set, cfg.engine.resolution, cfg.engine.max_range);
+  std::vector<ShardSet> sets;
+  for (uint32_t i = 0; i < 4; ++i) sets.push_back(hash_set(i, 4, 10));
+  const double inf = std::numeric_limits<double>::infinity();
+  const double lo[3] = {-inf, -inf, -inf}, hi[3] = {inf, inf, inf}, cut_max[3] = {5.0, inf, inf},
+               cut_min[3] = {5.0, -inf, -inf};
+  uint64_t hashed_clipped = 0, hashed_rays = 0;
+  for (uint32_t i = 0; i < 2; ++i) {
+    ShardSet s;
+    s.index = i, s.count = 2, s.rule = ShardRule::kBoxes, s.region_depth = 11;
+    s.boxes = {protocol::region_box_of(lo, cut_max, 0.2, 11), protocol::region_box_of(cut_min, hi, 0.2, 11)};
+    sets.push_back(s);
+  }
+  for (const ShardSet& s : sets) {
+    const daemon::ShardFilter filter(s);
+    MapEngine engine(cfg.engine);
+    engine.set_ray_clip([&](const KeyBox& box) { return filter.may_hold(box); });
+    auto tree = engine.make_tree();
+    uint64_t clipped = 0, rays = 0;
+    for (const PosedScan& scan : set.scans) {
+      const octomap::Pointcloud pts = world_points(scan);
+      std::vector<octomap::point3d> points(pts.begin(), pts.end());
+      ShotScan shot;
+      engine.shoot(sensor_origin(scan), points, cfg.engine.max_range, shot);
+      clipped += shot.clipped_rays, rays += points.size();
+      filter.keep_owned(shot);
+      engine.apply(shot, *tree);
+    }
+    const std::string what = protocol::describe(s);
+    expect_same_map(*tree, *restricted(*reference, s), what);
+    if (s.rule == ShardRule::kBoxes)  // the box holding the sensors keeps every ray, the other not
+      EXPECT_EQ(clipped > rays / 20, s.index == 1) << what << ": " << clipped << " of " << rays << " rays left out";
+    else
+      hashed_clipped += clipped, hashed_rays += rays;
+  }
+  EXPECT_GT(hashed_clipped, hashed_rays / 50) << hashed_clipped << " of " << hashed_rays << " rays left out";
 }
 
 std::string scan_channel(const std::string& robot) {

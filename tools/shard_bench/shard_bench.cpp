@@ -1,4 +1,5 @@
 // octomap-rt-shard-bench GRAPH -r RES [--shards 1,2,3,4] [--depth 10] [--backend cpu-grid]
+//                        [--rule hash|boxes] [--clip]
 //
 // One process, one thread a stage: every scan is encoded as a robot sends it (scan_t), decoded
 // as the daemon's LCM thread decodes it, shot once (every shard walks every ray: the walk is
@@ -9,10 +10,15 @@
 // machine; with a core per daemon, a set's rate is bounded by decode + walk + cut + its
 // busiest shard's update (docs/BENCHMARKS.md, "Shards"). With --only-shard i the process keeps
 // shard i of each set only: N such processes pinned to N cores side by side are the set with a
-// core per daemon (docs/bench/gpu/issue26-pinned.sh sums them up).
+// core per daemon (docs/bench/gpu/issue26-pinned.sh sums them up). With --clip each shard
+// shoots the scan itself with the daemon's ray clip (MapEngine::set_ray_clip: the rays that
+// meet none of its regions left out): the walk is then per shard (its busiest and mean shard
+// printed, with the rays it left out). --rule boxes: N slabs of equal width along x over the
+// scans' points (the first and last open), instead of the hash rule.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -48,6 +54,8 @@ int main(int argc, char** argv) {
   double res = 0.1, max_range = -1;
   unsigned depth = 10;
   int repeat = 1, only = -1;
+  bool clip = false;
+  std::string rule = "hash";
   app.add_option("input", input, "ScanGraph file (.graph)")->required();
   app.add_option("-r,--resolution", res, "[m]")->capture_default_str();
   app.add_option("--max-range", max_range, "[m]; < 0: none")->capture_default_str();
@@ -56,6 +64,10 @@ int main(int argc, char** argv) {
   app.add_option("--backend", backend, "ray back end (cpu, cpu-grid, vulkan)")->capture_default_str();
   app.add_option("--repeat", repeat, "go over the scans this many times")->capture_default_str();
   app.add_option("--only-shard", only, "keep only shard i of each set (-1: every shard)")->capture_default_str();
+  app.add_flag("--clip", clip, "each shard shoots with the daemon's ray clip (walk times per shard)");
+  app.add_option("--rule", rule, "hash, or boxes (slabs along x)")
+      ->check(CLI::IsMember({"hash", "boxes"}))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   const ort::ScanSet set = ort::load_scan_graph(input);
@@ -77,18 +89,32 @@ int main(int argc, char** argv) {
   struct PerSize {
     std::vector<std::unique_ptr<octomap::OcTree>> trees;
     std::vector<ort::daemon::ShardFilter> filters;
-    std::vector<double> cut_ms, apply_ms;
-    std::vector<uint64_t> voxels;
+    std::vector<double> cut_ms, apply_ms, walk_ms;
+    std::vector<uint64_t> voxels, clipped;
   };
+  double x_lo = 1e300, x_hi = -1e300;  // the slabs' span (--rule boxes)
+  for (const ort::PosedScan& scan : set.scans)
+    for (const octomap::point3d& p : ort::world_points(scan))
+      x_lo = std::min(x_lo, double(p.x())), x_hi = std::max(x_hi, double(p.x()));
   std::vector<PerSize> runs(sizes.size());
   for (size_t s = 0; s < sizes.size(); ++s)
     for (int i = 0; i < sizes[s]; ++i) {
       ort::protocol::ShardSet sh;
       if (sizes[s] > 1) sh.index = i, sh.count = sizes[s], sh.rule = ort::protocol::ShardRule::kHash;
       sh.region_depth = depth;
+      if (sizes[s] > 1 && rule == "boxes") {
+        sh.rule = ort::protocol::ShardRule::kBoxes;
+        const double inf = std::numeric_limits<double>::infinity(), w = (x_hi - x_lo) / sizes[s];
+        for (int j = 0; j < sizes[s]; ++j) {
+          const double lo[3] = {j == 0 ? -inf : x_lo + j * w, -inf, -inf};
+          const double hi[3] = {j + 1 == sizes[s] ? inf : x_lo + (j + 1) * w, inf, inf};
+          sh.boxes.push_back(ort::protocol::region_box_of(lo, hi, res, depth));
+        }
+      }
       runs[s].trees.push_back(engine.make_tree());
       runs[s].filters.emplace_back(sh);
-      runs[s].cut_ms.push_back(0), runs[s].apply_ms.push_back(0), runs[s].voxels.push_back(0);
+      runs[s].cut_ms.push_back(0), runs[s].apply_ms.push_back(0), runs[s].walk_ms.push_back(0);
+      runs[s].voxels.push_back(0), runs[s].clipped.push_back(0);
     }
   double decode_ms = 0, walk_ms = 0;
   uint64_t bytes = 0, scans = 0;
@@ -107,12 +133,25 @@ int main(int argc, char** argv) {
       decode_ms += ms_since(t);
       const octomap::pose6d pose = ort::daemon::scan_pose(got);
       const std::span<const float> xyz(got.xyz.data(), got.xyz.size());
-      t = SteadyClock::now();
-      engine.shoot_posed_xyz(pose, pose.trans(), xyz, max_range, shot);
-      walk_ms += ms_since(t);
+      if (!clip) {  // one walk serves every shard: they all walk every ray alike
+        t = SteadyClock::now();
+        engine.shoot_posed_xyz(pose, pose.trans(), xyz, max_range, shot);
+        walk_ms += ms_since(t);
+      }
       for (PerSize& run : runs)
         for (size_t i = 0; i < run.trees.size(); ++i) {
           if (only >= 0 && i != size_t(only)) continue;
+          if (clip) {
+            const ort::daemon::ShardFilter& f = run.filters[i];
+            if (f.active())
+              engine.set_ray_clip([&f](const ort::KeyBox& b) { return f.may_hold(b); });
+            else
+              engine.set_ray_clip({});
+            t = SteadyClock::now();
+            engine.shoot_posed_xyz(pose, pose.trans(), xyz, max_range, shot);
+            run.walk_ms[i] += ms_since(t);
+            run.clipped[i] += shot.clipped_rays;
+          }
           ort::ShotScan mine = shot;
           t = SteadyClock::now();
           run.filters[i].keep_owned(mine);
@@ -126,9 +165,17 @@ int main(int argc, char** argv) {
   const double n = static_cast<double>(scans);
   std::printf("%s: %llu scans, %.1f MB a scan on the bus, resolution %g m, regions at depth %u, back end %s\n",
               input.c_str(), (unsigned long long)scans, bytes / n / 1e6, res, depth, backend.c_str());
-  std::printf("every shard: decode %.2f ms, walk %.2f ms a scan\n", decode_ms / n, walk_ms / n);
-  std::printf("%6s %12s %14s %14s %12s %14s %10s\n", "shards", "cut ms", "update ms max", "update ms mean",
-              "voxels max", "bound scans/s", "merged");
+  uint64_t rays = 0;
+  for (const ort::PosedScan& scan : set.scans) rays += scan.points.size();
+  rays *= static_cast<uint64_t>(repeat);
+  if (clip)
+    std::printf("every shard: decode %.2f ms a scan; each shard walks its own rays (--clip, rule %s)\n", decode_ms / n,
+                rule.c_str());
+  else
+    std::printf("every shard: decode %.2f ms, walk %.2f ms a scan (rule %s)\n", decode_ms / n, walk_ms / n,
+                rule.c_str());
+  std::printf("%6s %12s %14s %14s %12s %12s %12s %12s %14s %10s\n", "shards", "cut ms", "update ms max",
+              "update ms mean", "voxels max", "walk ms max", "walk ms mean", "rays kept", "bound scans/s", "merged");
   const octomap::OcTree* whole = nullptr;
   for (size_t s = 0; s < sizes.size(); ++s)
     if (sizes[s] == 1) whole = runs[s].trees[0].get();
@@ -140,6 +187,18 @@ int main(int argc, char** argv) {
     for (double a : r.apply_ms) upd_sum += a;
     if (only >= 0) upd_sum = upd_max * n;  // the one shard kept: the mean is its own
     const uint64_t vox = *std::max_element(r.voxels.begin(), r.voxels.end());
+    // Without --clip every shard's walk is the one shared walk.
+    const size_t kept_shards = only >= 0 ? 1 : r.trees.size();
+    double walk_max = walk_ms / n, walk_sum = 0;
+    uint64_t clipped_sum = 0;
+    if (clip) {
+      walk_max = *std::max_element(r.walk_ms.begin(), r.walk_ms.end()) / n;
+      for (double w : r.walk_ms) walk_sum += w;
+      for (uint64_t c : r.clipped) clipped_sum += c;
+    } else {
+      walk_sum = walk_ms * static_cast<double>(kept_shards);
+    }
+    const double kept = 1.0 - double(clipped_sum) / double(rays * kept_shards);
     std::string merged = "-";
     if (whole && sizes[s] > 1 && only < 0) {
       std::vector<const octomap::OcTree*> views;
@@ -147,9 +206,9 @@ int main(int argc, char** argv) {
       const auto m = ort::client::merge_shard_trees(views, depth);
       merged = (m->size() == whole->size() && *m == *whole) ? "identical" : "DIFFERS";
     }
-    std::printf("%6d %12.2f %14.2f %14.2f %12.0f %14.1f %10s\n", sizes[s], cut, upd_max,
-                upd_sum / n / (only >= 0 ? 1 : r.trees.size()), vox / n,
-                1000.0 / (decode_ms / n + walk_ms / n + cut + upd_max), merged.c_str());
+    std::printf("%6d %12.2f %14.2f %14.2f %12.0f %12.2f %12.2f %11.1f%% %14.1f %10s\n", sizes[s], cut, upd_max,
+                upd_sum / n / double(kept_shards), vox / n, walk_max, walk_sum / n / double(kept_shards), 100 * kept,
+                1000.0 / (decode_ms / n + walk_max + cut + upd_max), merged.c_str());
   }
   return 0;
 }

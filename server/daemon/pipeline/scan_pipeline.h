@@ -53,7 +53,11 @@ class ScanPipeline {
   // What one producer's scans may cost (pipeline/scan_cost_gate.h); call before start().
   void set_cost_bounds(const ScanCostBounds& b) { gate_ = ScanCostGate(b); }
   // A shard's regions (pipeline/shard_filter.h): stage 1 keeps only their voxels; call before start().
-  void set_shard(const ShardFilter& f) { shard_ = f; }
+  // The engine then leaves out the rays that meet none of its regions (MapEngine::set_ray_clip).
+  void set_shard(const ShardFilter& f) {
+    shard_ = f;
+    if (shard_.active()) engine_.set_ray_clip([this](const KeyBox& box) { return shard_.may_hold(box); });
+  }
   void start();
   // Call after queue.close(): returns once every queued scan was applied or rejected.
   void join();

@@ -16,6 +16,28 @@ bool ShardFilter::owns(const octomap::OcTreeKey& key) const {
   return protocol::shard_of(set_, r) == set_.index;
 }
 
+bool ShardFilter::may_hold(const KeyBox& box) const {
+  if (!active()) return true;
+  if (box.empty()) return false;
+  const uint32_t s = 16 - set_.region_depth;
+  uint32_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) lo[a] = uint32_t(box.lo[a]) >> s, hi[a] = uint32_t(box.hi[a]) >> s;
+  if (set_.rule == protocol::ShardRule::kBoxes) {  // regions [min, max) of its box
+    const protocol::RegionBox& b = set_.boxes[set_.index];
+    for (int a = 0; a < 3; ++a)
+      if (hi[a] < b.min[a] || lo[a] >= b.max[a]) return false;
+    return true;
+  }
+  uint64_t regions = 1;
+  for (int a = 0; a < 3; ++a) regions *= hi[a] - lo[a] + 1;
+  if (regions > kMostRegionsLooked) return true;
+  for (uint32_t x = lo[0]; x <= hi[0]; ++x)
+    for (uint32_t y = lo[1]; y <= hi[1]; ++y)
+      for (uint32_t z = lo[2]; z <= hi[2]; ++z)
+        if (protocol::shard_of(set_, protocol::RegionCoords{x, y, z}) == set_.index) return true;
+  return false;
+}
+
 uint64_t ShardFilter::keep_owned(VoxelList& voxels) const {
   if (!active()) return 0;
   const size_t before = voxels.size();

@@ -2,6 +2,8 @@
 // octree/region.h's regions). Rays are walked whole, exactly as OctoMap walks them, before the
 // cut, so every voxel a shard keeps has the update the one-daemon map gives it: a shard's map
 // is OctoMap's map of the same scans restricted to its regions (docs/PROTOCOL.md, "Shards").
+// may_hold() is the engine's ray clip (MapEngine::set_ray_clip): a ray whose walk meets none of
+// the shard's regions is not walked at all.
 #pragma once
 
 #include <cstdint>
@@ -20,6 +22,10 @@ class ShardFilter {
   explicit ShardFilter(const protocol::ShardSet& set);
   bool active() const { return set_.sharded(); }
   bool owns(const octomap::OcTreeKey& key) const;
+  // Whether the inclusive key box meets a region of this shard (never false when it does; true
+  // without looking for a hashed box of more than kMostRegionsLooked regions).
+  bool may_hold(const KeyBox& box) const;
+  static constexpr uint64_t kMostRegionsLooked = 64;
   // Removes the voxels of other shards' regions, keeping the list's order; returns how many
   // it removed.
   uint64_t keep_owned(VoxelList& voxels) const;
