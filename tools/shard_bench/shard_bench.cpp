@@ -119,6 +119,11 @@ int main(int argc, char** argv) {
   double decode_ms = 0, walk_ms = 0;
   uint64_t bytes = 0, scans = 0;
   ort::ShotScan shot;
+  {  // warm-up, untimed: the walk's grid takes its page faults on the first scan of a size
+    const octomap_rt::scan_t msg = ort::cli::make_scan_message(set.scans[0], ort::cli::ScanMessageFields{});
+    const octomap::pose6d pose = ort::daemon::scan_pose(msg);
+    engine.shoot_posed_xyz(pose, pose.trans(), std::span<const float>(msg.xyz.data(), msg.xyz.size()), max_range, shot);
+  }
   for (int rep = 0; rep < repeat; ++rep)
     for (size_t k = 0; k < set.scans.size(); ++k, ++scans) {
       ort::cli::ScanMessageFields f;
