@@ -12,6 +12,9 @@ import statistics
 import sys
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from bound_costs import bound_costs, costs_text  # noqa: E402 (docs/bench/dev/bound_costs.py)
+
 out = Path(sys.argv[1])
 print("run      e2e p99 ms (median, max)  octree p99 ms (median, max)  tree MiB max  RSS MiB max  bound MiB"
       "  evictions  restores")
@@ -42,18 +45,7 @@ if per_mode["off"] and per_mode["on"]:
     print(f"on / off (medians over {len(per_mode['on'])} and {len(per_mode['off'])} runs): e2e p99 "
           f"{on_e2e:.1f} / {off_e2e:.1f} = {on_e2e / off_e2e:.2f}x, octree p99 {on_oct:.1f} / {off_oct:.1f} = "
           f"{on_oct / off_oct:.2f}x")
-cost = re.compile(r"memory bound costs: (\d+) passes evicted (\d+) regions in ([0-9.]+) ms \(most ([0-9.]+) ms a "
-                  r"pass; walks ([0-9.]+), list ([0-9.]+), encode ([0-9.]+), store write ([0-9.]+), strip "
-                  r"([0-9.]+)\); (\d+) restores in ([0-9.]+) ms \(most ([0-9.]+) ms a scan; store read ([0-9.]+), "
-                  r"rebuild ([0-9.]+)\)(?:; exact counts recounted (\d+) regions, reused (\d+))?")
-names = ["passes", "evicted", "evict ms", "most a pass", "walks", "list", "encode", "store write", "strip",
-         "restores", "restore ms", "most a scan", "store read", "rebuild", "regions recounted", "reused"]
 for path in sorted(out.glob("server-on*.log")):
-    total = [0.0] * len(names)
-    for line in path.open(errors="replace"):
-        m = cost.search(line)
-        if m:
-            for i, v in enumerate(m.groups()):
-                total[i] = max(total[i], float(v or 0)) if names[i].startswith("most") else total[i] + float(v or 0)
+    total = bound_costs(path.open(errors="replace"))
     if any(total):
-        print(f"{path.name}: " + ", ".join(f"{n} {v:.0f}" for n, v in zip(names, total)))
+        print(f"{path.name}: " + costs_text(total))

@@ -9,10 +9,12 @@ Prints the server's RSS and map memory per quarter of the run (flat: the last qu
 time went (the server's "memory bound costs" lines added up).
 """
 import csv
-import re
 import statistics
 import sys
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from bound_costs import bound_costs, costs_text  # noqa: E402 (docs/bench/dev/bound_costs.py)
 
 run = Path(sys.argv[1])
 bound = float(sys.argv[2]) if len(sys.argv) > 2 else None
@@ -45,18 +47,7 @@ for i in range(10):
     print(f"{a / 60:5.1f}-{b / 60:4.1f} min: e2e p99 median {statistics.median(e2e):.0f} ms" +
           (f", octree p99 median {statistics.median(octree):.0f} ms" if octree else ""))
 print("last status:", rows[-1])
-cost = re.compile(r"memory bound costs: (\d+) passes evicted (\d+) regions in ([0-9.]+) ms \(most ([0-9.]+) ms a "
-                  r"pass; walks ([0-9.]+), list ([0-9.]+), encode ([0-9.]+), store write ([0-9.]+), strip "
-                  r"([0-9.]+)\); (\d+) restores in ([0-9.]+) ms \(most ([0-9.]+) ms a scan; store read ([0-9.]+), "
-                  r"rebuild ([0-9.]+)\)(?:; exact counts recounted (\d+) regions, reused (\d+))?")
-names = ["passes", "evicted", "evict ms", "most a pass", "exact counts", "list", "encode", "store write", "strip",
-         "restores", "restore ms", "most a scan", "store read", "rebuild", "regions recounted", "reused"]
-total = [0.0] * len(names)
 log = run / "server.log"
-for line in log.open(errors="replace") if log.exists() else []:
-    m = cost.search(line)
-    if m:
-        for i, v in enumerate(m.groups()):
-            total[i] = max(total[i], float(v or 0)) if names[i].startswith("most") else total[i] + float(v or 0)
+total = bound_costs(log.open(errors="replace")) if log.exists() else []
 if any(total):
-    print("the bound's costs (ms, summed): " + ", ".join(f"{n} {v:.0f}" for n, v in zip(names, total)))
+    print("the bound's costs (ms, summed): " + costs_text(total))
