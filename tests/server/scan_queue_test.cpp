@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <future>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -46,6 +47,44 @@ TEST(ScanQueue, TheClassThatUsedLessOfTheStagesGoesFirst) {
   ASSERT_TRUE(next);
   EXPECT_EQ(next->producer, 2u);
   EXPECT_TRUE(next->passed_over);
+}
+
+// A robot's first scans wait in the shared class; once it has history, they and its new ones
+// are served in its own class, in its order, however long a flood keeps the shared class's
+// backlog (they used to stay there until no scan of the robot waited in it: never, under a flood).
+TEST(ScanQueue, ARobotThatEarnsItsHistoryTakesItsWaitingScansOutOfTheSharedClass) {
+  ScanQueue q(1 << 20, 8 << 20);
+  ASSERT_TRUE(q.try_push(scan_of(1, false)));
+  ASSERT_TRUE(q.try_push(scan_of(2, false)));
+  ASSERT_TRUE(q.try_push(scan_of(0, false, 300)));  // the robot, before its history
+  ASSERT_TRUE(q.try_push(scan_of(3, false)));
+  auto far = q.pop();
+  ASSERT_EQ(far->producer, 1u);
+  q.charge(far->share_class, 1000);
+  q.leave(*far);
+  ASSERT_TRUE(q.try_push(scan_of(0, true, 300)));  // now with history
+  EXPECT_EQ(q.producer_bytes(0), 600u);
+  std::vector<size_t> producers;
+  uint64_t last_robot_arrival = 0;
+  while (q.depth() > 0) {
+    auto s = q.pop();
+    ASSERT_TRUE(s);
+    producers.push_back(s->producer);
+    if (s->producer == 0) {
+      EXPECT_EQ(s->share_class, 0u);
+      EXPECT_GT(s->arrival, last_robot_arrival);  // its order kept
+      last_robot_arrival = s->arrival;
+    }
+    q.charge(s->share_class, 10);
+    q.leave(*s);
+  }
+  EXPECT_EQ(producers, (std::vector<size_t>{0, 0, 2, 3}));
+  EXPECT_EQ(q.producer_bytes(0), 0u);
+  // The shared class's byte budget is free of the robot's scans again: fresh ids fill it alone.
+  ScanQueue small(700, 1 << 20);
+  ASSERT_TRUE(small.try_push(scan_of(0, false, 300)));
+  ASSERT_TRUE(small.try_push(scan_of(0, true, 300)));
+  EXPECT_TRUE(small.try_push(scan_of(1, false, 600)));
 }
 
 TEST(ScanQueue, ProducersWithoutHistoryShareOneByteBudget) {

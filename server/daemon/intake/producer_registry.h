@@ -58,8 +58,8 @@ struct ProducerPolicy {
   // A producer has history (a share of the stages of its own, intake/scan_queue.h) once it
   // has sent this many valid scans over at least this long. Valid arrivals, not applied
   // scans: a flood in the shared class must not keep a new robot from ever earning its own.
-  int64_t history_scans = 20;
-  std::chrono::duration<double> history{30.0};
+  int64_t history_scans = 10;
+  std::chrono::duration<double> history{5.0};
 };
 
 class ProducerRegistry {

@@ -16,10 +16,29 @@ ScanQueue::ScanQueue(uint64_t per_producer_budget, uint64_t total_budget, bool f
     : per_producer_budget_(per_producer_budget), total_budget_(total_budget), fair_(fair) {}
 
 size_t ScanQueue::class_for(const QueuedScan& s) const {
-  if (!fair_ || !s.established) return kNewProducersClass;
-  // A producer that just earned its history keeps its waiting scans' class until they have
-  // left, so that its scans still leave in its order.
-  return new_class_depth_[s.producer] > 0 ? kNewProducersClass : s.producer;
+  return fair_ && s.established ? s.producer : kNewProducersClass;
+}
+
+void ScanQueue::move_to_own_class(size_t producer) {
+  // Its scans still waiting in the shared class come along, in their order, so that its
+  // scans leave in its order. Waiting for them to leave the shared class first kept a robot
+  // there for as long as a flood of fresh ids kept that class's backlog (it never emptied).
+  ShareClass& shared = classes_[kNewProducersClass];
+  ShareClass& own = classes_[producer];
+  if (own.scans.empty()) own.used_ms = std::max(own.used_ms, virtual_ms_);
+  for (auto it = shared.scans.begin(); it != shared.scans.end();) {
+    if (it->producer != producer) {
+      ++it;
+      continue;
+    }
+    shared.bytes -= it->bytes;
+    own.bytes += it->bytes;
+    it->share_class = producer;
+    it->deferrals_at_push = own.deferrals;
+    own.scans.push_back(std::move(*it));
+    it = shared.scans.erase(it);
+  }
+  new_class_depth_[producer] = 0;
 }
 
 bool ScanQueue::try_push(QueuedScan&& s) {
@@ -34,6 +53,7 @@ bool ScanQueue::try_push(QueuedScan&& s) {
     if (bytes_by_producer_[s.producer] + s.bytes > per_producer_budget_) return false;
     if (total_bytes_ + s.bytes > total_budget_) return false;
     const size_t cls = class_for(s);
+    if (cls != kNewProducersClass && new_class_depth_[s.producer] > 0) move_to_own_class(s.producer);
     ShareClass& c = classes_[cls];
     // Fresh ids are free to make: together they hold what one producer may.
     if (fair_ && cls == kNewProducersClass && c.bytes + s.bytes > per_producer_budget_) return false;

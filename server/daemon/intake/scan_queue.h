@@ -16,8 +16,8 @@
 // what a robot's scan may wait for is one scan of each class ahead of it, not one in each
 // stage. fair = false: one FIFO.
 //
-// Order: each producer's scans leave in its arrival order (a producer's scans all stay in
-// the class they started in while any of them waits); across producers, by share. A map edit
+// Order: each producer's scans leave in its arrival order (a producer that earns its history
+// takes its scans waiting in the shared class into its own, in order); across producers, by share. A map edit
 // leaves only after every scan that arrived before it, and before any that arrived after.
 //
 // Policy when a producer's budget is full: the NEWEST scan is refused (the caller counts it
@@ -108,6 +108,8 @@ class ScanQueue {
     SteadyClock::time_point served;
   };
   size_t class_for(const QueuedScan& s) const;  // under mutex_
+  // A producer that earned its history: its scans waiting in the shared class join its own.
+  void move_to_own_class(size_t producer);  // under mutex_
   // The class to serve next (least used; ties: oldest head), or nullptr when no scan may be.
   ShareClass* next_class(SteadyClock::time_point now);  // under mutex_
   bool streams(const ShareClass& c, SteadyClock::time_point now) const;

@@ -46,10 +46,12 @@ struct ScanCostBounds {
   double max_future_s = 60;
   // The stages' time shared among producers (intake/scan_queue.h): a producer has a share of
   // its own once it has sent share_history_scans valid scans over share_history_s seconds;
-  // before, it shares one with every other producer without history. false: one FIFO.
+  // before, it shares one with every other producer without history. false: one FIFO. A
+  // robot streaming at 2 Hz or more has its own share after 5 s; an attacker's ids earn one
+  // however long this is (the allow-list bounds those), so it is kept short.
   bool producer_share = true;
-  int64_t share_history_scans = 20;
-  double share_history_s = 30;
+  int64_t share_history_scans = 10;
+  double share_history_s = 5;
 };
 
 class ScanCostGate {
