@@ -11,6 +11,7 @@ add_custom_target(viewer_check_types DEPENDS ${VIEWER_CHECK_DIR}/libbot_copy/raw
 
 octomap_rt_add_test(server_octomap_raw_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/octomap_raw_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/bt_conformance_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/octomap_raw_publisher_test.cpp
                     LIBS octomap_rt_daemon TIMEOUT 120)
 add_dependencies(server_octomap_raw_test viewer_check_types)
 target_include_directories(server_octomap_raw_test PRIVATE ${VIEWER_CHECK_DIR})

@@ -53,13 +53,16 @@ void OctomapRawPublisher::encode_if_changed() {
     if (r.version == encoded_version_) return;
     encoded_version_ = r.version;
     raw = make_raw_map(*r.tree, r.last_scan_utime, options);
+    ++encodings_;
   } else {
     // The band filter changes the tree it encodes: a copy (of the replica when there is one).
     auto copy = copy_map_if_changed(map_.replica ? readable_map(map_) : map_, encoded_version_);
     if (!copy) return;
+    ++map_copies_;
     encoded_version_ = copy->version;
     if (band) drop_occupied_outside_band(*copy->tree, cfg_.occupancy_min_z, cfg_.occupancy_max_z);
     raw = make_raw_map(*copy->tree, copy->last_scan_utime, options);
+    ++encodings_;
   }
   encoded_.clear();
   if (raw.message) {

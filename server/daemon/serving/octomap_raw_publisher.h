@@ -50,6 +50,10 @@ class OctomapRawPublisher {
   // For the status: "" while the whole map goes out; else what was cut or why nothing is sent.
   std::string note() const;
   int64_t published() const { return published_; }
+  // Whole-map copies made (only when the map changed, and only to drop cells outside the
+  // occupancy band when there is a read replica) and encodings made (one per map version).
+  int64_t map_copies() const { return map_copies_; }
+  int64_t encodings() const { return encodings_; }
 
  private:
   void publish_newest();  // the periodic task
@@ -64,6 +68,8 @@ class OctomapRawPublisher {
   mutable std::mutex note_mutex_;
   std::string note_;
   std::atomic<int64_t> published_{0};
+  std::atomic<int64_t> map_copies_{0};
+  std::atomic<int64_t> encodings_{0};
   PeriodicThread periodic_;  // last: stopped before the members its task uses go
 };
 
