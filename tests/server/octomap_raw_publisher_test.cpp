@@ -1,7 +1,7 @@
 // The viewer publisher (serving/octomap_raw_publisher.h) over many periods: it copies the map
 // only when the map changed, encodes each map version once, and with a read replica encodes
-// from the replica without copying the map. What a viewer receives is OctoMap's own .bt of the
-// map (after every change, without a replica).
+// from the replica without copying the map (a copy only to drop cells outside the occupancy
+// band). What a viewer receives is OctoMap's own .bt of the map, after every change.
 #include "daemon/serving/octomap_raw_publisher.h"
 
 #include <gtest/gtest.h>
@@ -79,7 +79,8 @@ struct PublisherRun {
   }
   void scan(const octomap::Pointcloud& cloud) {
     std::unique_lock lock(map_.mutex);
-    apply_map_step(map_, [&](octomap::OcTree& tree) { tree.insertPointCloud(cloud, octomap::point3d(0, 0, 0)); });
+    // By value: the replica replays the step later, on its own thread.
+    apply_map_step(map_, [cloud](octomap::OcTree& tree) { tree.insertPointCloud(cloud, octomap::point3d(0, 0, 0)); });
   }
 
   MapState& map_;
@@ -114,9 +115,25 @@ TEST(OctomapRawPublisher, EncodesFromTheReadReplicaWithoutACopy) {
   reference.insertPointCloud(room_scan(3), octomap::point3d(0, 0, 0));
   MapReplica replica(map, OctreeUpdateOptions{}, 64u << 20);
   map.replica = &replica;
-  PublisherRun run(map);
-  ASSERT_TRUE(run.viewer.wait_for(20, bt_of(reference)));  // 20 periods of one map
-  EXPECT_EQ(run.publisher->map_copies(), 0);
+  {
+    PublisherRun run(map);
+    ASSERT_TRUE(run.viewer.wait_for(20, bt_of(reference)));  // 20 periods of one map
+    EXPECT_EQ(run.publisher->encodings(), 1);
+    run.scan(room_scan(4));
+    reference.insertPointCloud(room_scan(4), octomap::point3d(0, 0, 0));
+    ASSERT_TRUE(run.viewer.wait_for(20, bt_of(reference)));
+    EXPECT_EQ(run.publisher->map_copies(), 0);
+    EXPECT_EQ(run.publisher->encodings(), 2);
+  }
+  // The occupancy band changes the tree it encodes: one copy of the replica per map version.
+  OctomapRawConfig band;
+  band.occupancy_min_z = -0.5;
+  PublisherRun run(map, band);
+  {
+    std::unique_lock wait(run.viewer.mutex);
+    ASSERT_TRUE(run.viewer.got.wait_for(wait, std::chrono::seconds(20), [&] { return run.viewer.messages >= 20; }));
+  }
+  EXPECT_EQ(run.publisher->map_copies(), 1);
   EXPECT_EQ(run.publisher->encodings(), 1);
   run.publisher->stop();
   map.replica = nullptr;
