@@ -33,6 +33,34 @@ def voxel_keys(points, resolution=0.1):
     return {tuple(k) for k in np.floor(coords * (1.0 / resolution)).astype(int)}
 
 
+class ServerGroup:
+    """The servers one test class starts itself (each with its own flags) on one test URL,
+    with one folder and one log: stop() ends those still running (SIGTERM) and removes the
+    folder when every one exited 0 (OCTOMAP_RT_KEEP_TEST_DIRS keeps it)."""
+
+    def __init__(self, prefix, port_factor, port_offset):
+        self.dir = tempfile.mkdtemp(prefix=prefix)
+        self.url = test_url(20000 + (os.getpid() * port_factor + port_offset) % 20000)
+        self.log = open(os.path.join(self.dir, "servers.log"), "w")
+        self.servers = []
+
+    def start(self, args, env=None):
+        server = subprocess.Popen(args, stdout=self.log, stderr=subprocess.STDOUT, env=env)
+        self.servers.append(server)
+        return server
+
+    def stop(self):
+        codes = []
+        for server in self.servers:
+            if server.poll() is None:
+                server.send_signal(signal.SIGTERM)
+            codes.append(server.wait(timeout=60))
+        self.log.close()
+        if all(c == 0 for c in codes) and not os.environ.get("OCTOMAP_RT_KEEP_TEST_DIRS"):
+            shutil.rmtree(self.dir, ignore_errors=True)
+        return codes
+
+
 class ServerTestCase(unittest.TestCase):
     server_args = []  # more flags for the server (a test class's own)
 

@@ -6,30 +6,27 @@ the server at start."""
 
 import json
 import os
-import shutil
-import signal
 import subprocess
-import tempfile
 import time
 import unittest
 
 import numpy as np
 
 import octomap_rt
-from server_fixture import CLI, SERVER, test_url
+from server_fixture import CLI, SERVER, ServerGroup
 
 JAVA_CP = os.environ.get("OCTOMAP_RT_JAVA_CP", "")  # lcm.jar, our types jar, the examples' jar
 
 
-def start_server(url, ns, server_id, log, use_env=False):
+def start_server(group, ns, server_id, use_env=False):
     env = dict(os.environ)
-    args = [SERVER, "-r", "0.1", "--lcm-url", url, "--backend", "cpu", "--server-id", server_id,
+    args = [SERVER, "-r", "0.1", "--lcm-url", group.url, "--backend", "cpu", "--server-id", server_id,
             "--octomap-raw-rate", "4", "--warm-up-points", "0"]
     if use_env:
         env["OCTOMAP_RT_NAMESPACE"] = ns
     else:
         args += ["--namespace", ns]
-    return subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, env=env)
+    return group.start(args, env=env)
 
 
 def messages_on(transport, channel_regex, seconds):
@@ -45,11 +42,10 @@ def messages_on(transport, channel_regex, seconds):
 class TwoNamespacesOnOneUrl(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.dir = tempfile.mkdtemp(prefix="ort-py-ns-")
-        cls.url = test_url(20000 + (os.getpid() * 11 + 5) % 20000)
-        cls.log = open(os.path.join(cls.dir, "servers.log"), "w")
-        cls.servers = [start_server(cls.url, "lab_a", "server-a", cls.log),
-                       start_server(cls.url, "lab_b", "server-b", cls.log, use_env=True)]
+        cls.group = ServerGroup("ort-py-ns-", 11, 5)
+        cls.url = cls.group.url
+        start_server(cls.group, "lab_a", "server-a")
+        start_server(cls.group, "lab_b", "server-b", use_env=True)
         cls.a = octomap_rt.MapClient(cls.url, namespace="lab_a")
         cls.b = octomap_rt.MapClient(cls.url, namespace="lab_b")
         for client in (cls.a, cls.b):
@@ -59,13 +55,7 @@ class TwoNamespacesOnOneUrl(unittest.TestCase):
     def tearDownClass(cls):
         for client in (cls.a, cls.b):
             client.close()
-        codes = []
-        for server in cls.servers:
-            server.send_signal(signal.SIGTERM)
-            codes.append(server.wait(timeout=60))
-        cls.log.close()
-        if codes == [0, 0] and not os.environ.get("OCTOMAP_RT_KEEP_TEST_DIRS"):
-            shutil.rmtree(cls.dir, ignore_errors=True)
+        cls.group.stop()
 
     def test_each_client_hears_only_its_own_server(self):
         for _ in range(3):

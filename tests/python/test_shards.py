@@ -4,11 +4,7 @@ scans; octomap_rt.shards.ShardClient finds the shards by their statuses, and its
 rays (stopping at unknown space and passing it), box counts, grid and merged snapshot equal the
 whole daemon's answers. With a shard stopped the answers say it is missing (partial)."""
 
-import os
-import shutil
 import signal
-import subprocess
-import tempfile
 import time
 import unittest
 
@@ -16,7 +12,7 @@ import numpy as np
 
 import octomap_rt
 from octomap_rt.shards import ShardClient
-from server_fixture import SERVER, test_url
+from server_fixture import SERVER, ServerGroup
 
 SHARDS = 3
 ROBOT = "pyshard"
@@ -38,16 +34,14 @@ def leaf_voxels(leaves, sizes, resolution):
 class ShardSetTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.dir = tempfile.mkdtemp(prefix="ort-py-shards-")
-        cls.url = test_url(20000 + (os.getpid() * 13 + 7) % 20000)
-        cls.log = open(os.path.join(cls.dir, "servers.log"), "w")
+        cls.group = ServerGroup("ort-py-shards-", 13, 7)
+        cls.url, cls.servers = cls.group.url, cls.group.servers
         common = [SERVER, "-r", "0.1", "--lcm-url", cls.url, "--backend", "cpu", "--warm-up-points", "0",
                   "--query-lock-ms", "2000"]
-        cls.servers = [subprocess.Popen(common + ["--namespace", "campus", "--shard", f"{i}/{SHARDS}",
-                                                  "--shard-region-depth", "14", "--server-id", f"shard-{i}"],
-                                        stdout=cls.log, stderr=subprocess.STDOUT) for i in range(SHARDS)]
-        cls.servers.append(subprocess.Popen(common + ["--namespace", "one", "--server-id", "whole"],
-                                            stdout=cls.log, stderr=subprocess.STDOUT))
+        for i in range(SHARDS):
+            cls.group.start(common + ["--namespace", "campus", "--shard", f"{i}/{SHARDS}", "--shard-region-depth", "14",
+                                      "--server-id", f"shard-{i}"])
+        cls.group.start(common + ["--namespace", "one", "--server-id", "whole"])
         cls.whole = octomap_rt.MapClient(cls.url, namespace="one")
         cls.feed = octomap_rt.MapClient(cls.url, namespace="campus")
         cls.whole.status(timeout_s=60)
@@ -74,14 +68,7 @@ class ShardSetTest(unittest.TestCase):
     @classmethod
     def tearDownClass(cls):
         cls.whole.close(), cls.feed.close(), cls.shards.close()
-        codes = []
-        for s in cls.servers:
-            if s.poll() is None:
-                s.send_signal(signal.SIGTERM)
-            codes.append(s.wait(timeout=60))
-        cls.log.close()
-        if all(c == 0 for c in codes) and not os.environ.get("OCTOMAP_RT_KEEP_TEST_DIRS"):
-            shutil.rmtree(cls.dir, ignore_errors=True)
+        cls.group.stop()
 
     def test_1_routed_answers_equal_the_whole_daemon(self):
         self.assertEqual(self.shards.set.count, SHARDS)
