@@ -5,17 +5,15 @@ shard's own snapshot and the whole daemon's map, each shard followed by deltas (
 reset of one shard (a new epoch) resyncs that shard alone; a stopped shard is said late."""
 
 import os
-import shutil
 import signal
 import subprocess
-import tempfile
 import time
 import unittest
 
 import octomap_rt
 from octomap_rt import ShardMirror, canonical_leaves, read_bt_leaves
 from octomap_rt.shards import ShardClient
-from server_fixture import CLI, SERVER, test_url
+from server_fixture import CLI, SERVER, ServerGroup
 
 DATA = os.environ.get("OCTOMAP_RT_DATA", "")
 GRAPH = os.path.join(DATA, "3dtk_dat", "3dtk_3scans.graph")
@@ -33,16 +31,14 @@ def snapshot_leaves(client):
 class ShardMirrorTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.dir = tempfile.mkdtemp(prefix="ort-py-shard-mirror-")
-        cls.url = test_url(20000 + (os.getpid() * 17 + 11) % 20000)
-        cls.log = open(os.path.join(cls.dir, "servers.log"), "w")
+        cls.group = ServerGroup("ort-py-shard-mirror-", 17, 11)
+        cls.url, cls.servers = cls.group.url, cls.group.servers
         common = [SERVER, "-r", "0.2", "--lcm-url", cls.url, "--backend", "cpu", "--warm-up-points", "0",
                   "--control-token", TOKEN]
-        cls.servers = [subprocess.Popen(common + ["--namespace", "campus", "--shard", f"{i}/{SHARDS}",
-                                                  "--shard-region-depth", "12", "--server-id", f"shard-{i}"],
-                                        stdout=cls.log, stderr=subprocess.STDOUT) for i in range(SHARDS)]
-        cls.servers.append(subprocess.Popen(common + ["--namespace", "one", "--server-id", "whole"],
-                                            stdout=cls.log, stderr=subprocess.STDOUT))
+        for i in range(SHARDS):
+            cls.group.start(common + ["--namespace", "campus", "--shard", f"{i}/{SHARDS}", "--shard-region-depth", "12",
+                                      "--server-id", f"shard-{i}"])
+        cls.group.start(common + ["--namespace", "one", "--server-id", "whole"])
         cls.whole = octomap_rt.MapClient(cls.url, namespace="one")
         cls.whole.status(timeout_s=60)
         cls.shards = ShardClient(transport=octomap_rt.open_transport(cls.url), namespace="campus", timeout_s=60)
@@ -50,14 +46,7 @@ class ShardMirrorTest(unittest.TestCase):
     @classmethod
     def tearDownClass(cls):
         cls.whole.close(), cls.shards.close()
-        codes = []
-        for s in cls.servers:
-            if s.poll() is None:
-                s.send_signal(signal.SIGTERM)
-            codes.append(s.wait(timeout=60))
-        cls.log.close()
-        if all(c == 0 for c in codes) and not os.environ.get("OCTOMAP_RT_KEEP_TEST_DIRS"):
-            shutil.rmtree(cls.dir, ignore_errors=True)
+        cls.group.stop()
 
     def replay(self, ns, mirror, *more):
         """Publishes the scans to namespace `ns` (every 4th point) while `mirror` follows."""
