@@ -108,6 +108,10 @@ void add_server_flags(CLI::App& app, ServerFlags& f) {
                  "most bytes of replies one region or grid query may make the server send")
       ->capture_default_str()
       ->check(CLI::Range(size_t{1024}, size_t{1} << 30));
+  app.add_option("--query-chunk-interval-ms", s.queries.reply_chunk_interval_ms,
+                 "pause between two messages of one query's reply (pacing for clients' receive buffers; 0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
   add_distance_flags(app, s.queries.distance);
   app.add_option("--latency-bound", s.latency_bound_s,
                  "overload bound [s]: a scan queued longer is dropped ('over latency bound') and the status is "

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 #include <string>
 
 namespace ort::distance {
@@ -56,6 +57,11 @@ std::string check_options(const DistanceOptions& opt, double resolution, const D
 
 PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, const DistanceOptions& opt,
                        const DistanceLimits& lim) {
+  return read_points(tree, xyz, opt, lim, {});
+}
+
+PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, const DistanceOptions& opt,
+                       const DistanceLimits& lim, const std::function<std::optional<CellBox>(const CellBox&)>& cover) {
   PointsRead r;
   r.opt = opt;
   r.resolution = tree.getResolution();
@@ -74,6 +80,11 @@ PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, 
   }
   r.cells.resize(n);
   const CellBox all = cell_box_around(lo, hi, m, pad);
+  if (const std::optional<CellBox> c = cover ? cover(all) : std::nullopt; c && c->dims.cells() <= lim.max_grid_cells) {
+    r.grids.push_back(read_occupancy(tree, *c, opt.unknown, opt.ownership));
+    for (size_t p = 0; p < n; ++p) r.cells[p] = {0, cell_index(keys[p], *c)};
+    return r;
+  }
   if (all.dims.cells() <= std::min(lim.single_grid_cells, lim.max_grid_cells)) {
     r.grids.push_back(read_occupancy(tree, all, opt.unknown, opt.ownership));
     for (size_t p = 0; p < n; ++p) r.cells[p] = {0, cell_index(keys[p], all)};
@@ -106,9 +117,16 @@ PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, 
 std::vector<PointDistance> answer_points(const PointsRead& r, const SquaredEdt& edt) {
   std::vector<DistanceField> fields;
   for (const OccupancyGrid& g : r.grids) fields.push_back(compute_field(g, edt, r.resolution, r.opt));
+  std::vector<const DistanceField*> each;
+  for (const DistanceField& f : fields) each.push_back(&f);
+  return answer_points(r, each);
+}
+
+std::vector<PointDistance> answer_points(const PointsRead& r, std::span<const DistanceField* const> fields) {
+  if (fields.size() != r.grids.size()) throw std::logic_error("answer_points: one field per grid");
   std::vector<PointDistance> out(r.cells.size());
   for (size_t p = 0; p < r.cells.size(); ++p) {
-    const DistanceField& f = fields[r.cells[p].grid];
+    const DistanceField& f = *fields[size_t(r.cells[p].grid)];
     const auto& [i, j, k] = r.cells[p].index;
     out[p].distance = f.distance(i, j, k);
     out[p].gradient = f.gradient(i, j, k);
@@ -144,7 +162,13 @@ BoxRead read_box(const octomap::OcTree& tree, const double lo[3], const double h
 }
 
 BoxDistances answer_box(const BoxRead& r, const SquaredEdt& edt, bool with_gradient) {
-  const DistanceField f = compute_field(r.grid, edt, r.resolution, r.opt);
+  return answer_box(r, compute_field(r.grid, edt, r.resolution, r.opt), with_gradient);
+}
+
+BoxDistances answer_box(const BoxRead& r, const DistanceField& f, bool with_gradient) {
+  if (f.box.dims.nx != r.cells.dims.nx + 2 * r.pad || f.box.dims.ny != r.cells.dims.ny + 2 * r.pad ||
+      f.box.dims.nz != r.cells.dims.nz + 2 * r.pad)
+    throw std::logic_error("answer_box: the field is not of the box's padded grid");
   BoxDistances b;
   b.cells = r.cells;
   b.cell_size = f.cell_size;
@@ -168,7 +192,7 @@ BoxDistances answer_box(const BoxRead& r, const SquaredEdt& edt, bool with_gradi
 }
 
 PathRead read_path(const octomap::OcTree& tree, std::span<const double> v, const DistanceOptions& opt,
-                   const DistanceLimits& lim) {
+                   const DistanceLimits& lim, const std::function<std::optional<CellBox>(const CellBox&)>& cover) {
   const size_t n = v.size() / 3;
   if (n == 0) throw DistanceError("a path needs at least one vertex");
   for (double x : v)
@@ -204,12 +228,15 @@ PathRead read_path(const octomap::OcTree& tree, std::span<const double> v, const
     arc += len;
   }
   add(v[3 * n - 3], v[3 * n - 2], v[3 * n - 1], arc);
-  r.points = read_points(tree, xyz, opt, lim);
+  r.points = read_points(tree, xyz, opt, lim, cover);
   return r;
 }
 
 PathClearance answer_path(const PathRead& r, const SquaredEdt& edt) {
-  const std::vector<PointDistance> d = answer_points(r.points, edt);
+  return path_clearance(r, answer_points(r.points, edt));
+}
+
+PathClearance path_clearance(const PathRead& r, const std::vector<PointDistance>& d) {
   PathClearance c;
   c.num_samples = static_cast<int64_t>(d.size());
   for (size_t i = 0; i < d.size(); ++i)

@@ -6,6 +6,8 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -46,9 +48,15 @@ struct PointsRead {
   std::vector<Cell> cells;  // per point
 };
 // xyz: 3 floats a point. Throws DistanceError (a point outside the key range, too many cells).
+// `cover`: a box (field_cache.h's covering) to read as the one grid when it holds the points'
+// padded cells; it answers the same (its extra obstacles are at least a padding away).
 PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, const DistanceOptions& opt,
                        const DistanceLimits& lim);
+PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, const DistanceOptions& opt,
+                       const DistanceLimits& lim, const std::function<std::optional<CellBox>(const CellBox&)>& cover);
 std::vector<PointDistance> answer_points(const PointsRead& read, const SquaredEdt& edt);
+// The same from fields already computed, one per grid of `read` (in order).
+std::vector<PointDistance> answer_points(const PointsRead& read, std::span<const DistanceField* const> fields);
 
 // --- a dense box -------------------------------------------------------------------------
 struct BoxRead {
@@ -70,6 +78,8 @@ struct BoxDistances {
   std::vector<float> gradient;  // 3 per cell when asked for, else empty
 };
 BoxDistances answer_box(const BoxRead& read, const SquaredEdt& edt, bool with_gradient);
+// The same from the field of read.grid already computed (field_cache.h).
+BoxDistances answer_box(const BoxRead& read, const DistanceField& field, bool with_gradient);
 
 // --- a path ------------------------------------------------------------------------------
 struct PathRead {
@@ -79,7 +89,7 @@ struct PathRead {
 };
 // vertices: 3 doubles a vertex (>= 1 vertex); samples every resolution along each segment.
 PathRead read_path(const octomap::OcTree& tree, std::span<const double> vertices, const DistanceOptions& opt,
-                   const DistanceLimits& lim);
+                   const DistanceLimits& lim, const std::function<std::optional<CellBox>(const CellBox&)>& cover = {});
 struct PathClearance {
   float min_distance = 0;
   int64_t min_sample = 0;
@@ -88,5 +98,7 @@ struct PathClearance {
   int64_t num_samples = 0;
 };
 PathClearance answer_path(const PathRead& read, const SquaredEdt& edt);
+// The clearance from the samples' distances (answer_points of read.points, in order).
+PathClearance path_clearance(const PathRead& read, const std::vector<PointDistance>& samples);
 
 }  // namespace ort::distance

@@ -7,6 +7,7 @@ find_package(dynamicEDT3D QUIET)
 octomap_rt_add_test(distance_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/distance_exactness_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/brute_distance.cpp
+          ${CMAKE_CURRENT_LIST_DIR}/field_cache_test.cpp
           $<TARGET_OBJECTS:octomap_rt_query_test_maps>
   LIBS octomap_rt_distance
   TIMEOUT 600)

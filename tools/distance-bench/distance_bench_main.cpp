@@ -28,6 +28,7 @@
 #include "octomap_rt/distance_query_t.hpp"
 #include "protocol/channels.h"
 #include "reference_timing.h"
+#include "reply_timing.h"
 #include "scene/scan_set.h"
 
 namespace {
@@ -188,6 +189,17 @@ int main(int argc, char** argv) {
           "(cell) ours theirs brute: %s",
           (long long)r.differ_ours_brute, (long long)r.differ_theirs_larger, r.differ_examples.c_str());
     std::printf("\n");
+    const ort::bench::ReplyTimes rt = server.with_map([&](const octomap::OcTree& t) {
+      return ort::bench::time_box_reply(t, bmin, bmax, opt, cfg.queries.distance.threads,
+                                        cfg.queries.distance.zstd_level, reference_reps);
+    });
+    std::printf(
+        "box reply stages (CPU EDT, %d threads, zstd %d): read %.1f ms; finish %.1f ms with the field computed "
+        "whole, %.1f ms from the cache with the grid unchanged (of it: box cut and clamped %.1f ms, bytes + zstd "
+        "%.1f ms); blob %lld of %lld bytes in %lld chunks\n",
+        cfg.queries.distance.threads, cfg.queries.distance.zstd_level, rt.read_ms, rt.whole_ms, rt.cached_ms,
+        rt.clamp_ms, rt.zstd_ms, (long long)rt.blob_bytes, (long long)rt.raw_bytes, (long long)rt.chunks);
+    std::printf("  zstd levels on the box's bytes:%s\n", rt.levels.c_str());
   }
 
   std::mt19937 rng(27);

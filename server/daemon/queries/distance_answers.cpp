@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <string_view>
 
 #include "octomap_rt/distance_box_chunk_t.hpp"
 #include "octomap_rt/distance_path_reply_t.hpp"
@@ -40,9 +41,18 @@ distance::DistanceOptions options_of(const Query& q, const DistanceServiceConfig
   return o;
 }
 
+// The points' field: from the cache when the read took its box (read_points' cover), else computed.
+std::vector<distance::PointDistance> answer_points(distance::PointsRead& read, const distance::SquaredEdt& edt,
+                                                   distance::FieldCache* cache) {
+  if (!cache || read.grids.size() != 1 || !cache->holds(read.grids[0].box, read.opt))
+    return distance::answer_points(read, edt);
+  const distance::DistanceField* f = &cache->update(std::move(read.grids[0]), edt, read.resolution, read.opt);
+  return distance::answer_points(read, std::span<const distance::DistanceField* const>(&f, 1));
+}
+
 void points_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id,
-                  const distance::PointsRead& read, const distance::SquaredEdt& edt) {
-  const auto d = distance::answer_points(read, edt);
+                  distance::PointsRead& read, const distance::SquaredEdt& edt, distance::FieldCache* cache) {
+  const auto d = answer_points(read, edt, cache);
   octomap_rt::distance_points_reply_t r{};
   stamp(r, q, s, id, Reply::REPLY_OK, "");
   r.cell_size = read.resolution * read.opt.cell_voxels;
@@ -55,9 +65,9 @@ void points_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const 
   out.messages.push_back(encode_message(r));
 }
 
-void path_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id,
-                const distance::PathRead& read, const distance::SquaredEdt& edt) {
-  const auto c = distance::answer_path(read, edt);
+void path_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id, distance::PathRead& read,
+                const distance::SquaredEdt& edt, distance::FieldCache* cache) {
+  const auto c = distance::path_clearance(read, answer_points(read.points, edt, cache));
   octomap_rt::distance_path_reply_t r{};
   stamp(r, q, s, id, Reply::REPLY_OK, "");
   r.min_distance = c.min_distance;
@@ -68,15 +78,27 @@ void path_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const st
   out.messages.push_back(encode_message(r));
 }
 
-void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id,
-               const distance::BoxRead& read, const distance::SquaredEdt& edt, const DistanceServiceConfig& cfg) {
-  const auto b = distance::answer_box(read, edt, q.with_gradient != 0);
-  std::string raw(b.squared.size() * 4 + b.gradient.size() * 4, '\0');
-  // Little-endian hosts only (x86-64, arm64). An empty part (no gradient asked) is not copied:
-  // memcpy from an empty vector's null data() is undefined even for 0 bytes.
-  if (!b.squared.empty()) std::memcpy(raw.data(), b.squared.data(), b.squared.size() * 4);
-  if (!b.gradient.empty()) std::memcpy(raw.data() + b.squared.size() * 4, b.gradient.data(), b.gradient.size() * 4);
-  const std::string blob = cfg.zstd_level > 0 ? protocol::zstd_compress(raw, cfg.zstd_level) : raw;
+void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id, distance::BoxRead& read,
+               const distance::SquaredEdt& edt, const DistanceServiceConfig& cfg, distance::FieldCache* cache) {
+  // A box the cache can hold is transformed where its grid changed only (field_cache.h).
+  const bool cached = cache && read.grid.box.dims.cells() <= cfg.limits.single_grid_cells;
+  const auto b = cached
+                     ? distance::answer_box(read, cache->update(std::move(read.grid), edt, read.resolution, read.opt),
+                                            q.with_gradient != 0)
+                     : distance::answer_box(read, edt, q.with_gradient != 0);
+  // Little-endian hosts only (x86-64, arm64). Without the gradient the distances are the blob's
+  // bytes as they are (no copy); an empty part is not copied: memcpy from an empty vector's null
+  // data() is undefined even for 0 bytes.
+  std::string joined;
+  if (!b.gradient.empty()) {
+    joined.resize(b.squared.size() * 4 + b.gradient.size() * 4);
+    if (!b.squared.empty()) std::memcpy(joined.data(), b.squared.data(), b.squared.size() * 4);
+    std::memcpy(joined.data() + b.squared.size() * 4, b.gradient.data(), b.gradient.size() * 4);
+  }
+  const std::string_view raw =
+      b.gradient.empty() ? std::string_view(reinterpret_cast<const char*>(b.squared.data()), b.squared.size() * 4)
+                         : std::string_view(joined);
+  const std::string blob = cfg.zstd_level != 0 ? protocol::zstd_compress(raw, cfg.zstd_level) : std::string(raw);
   if (int64_t(blob.size()) > cfg.max_reply_bytes) {
     const std::string why = "the box's field is " + std::to_string(blob.size()) + " bytes compressed (at most " +
                             std::to_string(cfg.max_reply_bytes) +
@@ -95,7 +117,7 @@ void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std
     for (int a = 0; a < 3; ++a) m.origin[a] = b.origin[a];
     m.size[0] = b.cells.dims.nx, m.size[1] = b.cells.dims.ny, m.size[2] = b.cells.dims.nz;
     m.with_gradient = q.with_gradient ? 1 : 0;
-    m.compression = cfg.zstd_level > 0 ? m.COMPRESSION_ZSTD : m.COMPRESSION_NONE;
+    m.compression = cfg.zstd_level != 0 ? m.COMPRESSION_ZSTD : m.COMPRESSION_NONE;
     m.uncompressed_size = static_cast<int64_t>(raw.size());
     m.total_size = static_cast<int64_t>(blob.size());
     m.blob_hash = hash;
@@ -144,26 +166,28 @@ std::string validate_distance(const Query& q, double resolution, const DistanceS
 
 EncodedReplies read_distance(const octomap::OcTree& tree, const Query& q, const MapStamp& s,
                              const std::string& server_id, const DistanceServiceConfig& cfg,
-                             const distance::SquaredEdt& edt) {
+                             const distance::SquaredEdt& edt, distance::FieldCache* cache) {
   EncodedReplies out;
   out.channel = q.reply_channel;
   out.client_id = q.client_id;
   const distance::DistanceOptions opt = options_of(q, cfg);
   auto query = std::make_shared<const Query>(q);
+  // Points and paths read the cached field's box where it holds theirs (their answer is the same).
+  std::function<std::optional<distance::CellBox>(const distance::CellBox&)> cover;
+  if (cache) cover = [cache, &opt](const distance::CellBox& want) { return cache->covering(want, opt); };
   if (q.mode == Query::MODE_POINTS) {
-    auto read = std::make_shared<const distance::PointsRead>(distance::read_points(tree, q.xyz, opt, cfg.limits));
-    out.finish =
-        guarded(query, s, server_id, [=](EncodedReplies& r) { points_reply(r, *query, s, server_id, *read, edt); });
+    auto read = std::make_shared<distance::PointsRead>(distance::read_points(tree, q.xyz, opt, cfg.limits, cover));
+    out.finish = guarded(query, s, server_id,
+                         [=](EncodedReplies& r) { points_reply(r, *query, s, server_id, *read, edt, cache); });
   } else if (q.mode == Query::MODE_PATH) {
     const std::vector<double> v(q.xyz.begin(), q.xyz.end());
-    auto read = std::make_shared<const distance::PathRead>(distance::read_path(tree, v, opt, cfg.limits));
-    out.finish =
-        guarded(query, s, server_id, [=](EncodedReplies& r) { path_reply(r, *query, s, server_id, *read, edt); });
-  } else {
-    auto read =
-        std::make_shared<const distance::BoxRead>(distance::read_box(tree, q.box_min, q.box_max, opt, cfg.limits));
+    auto read = std::make_shared<distance::PathRead>(distance::read_path(tree, v, opt, cfg.limits, cover));
     out.finish = guarded(query, s, server_id,
-                         [=, &cfg](EncodedReplies& r) { box_reply(r, *query, s, server_id, *read, edt, cfg); });
+                         [=](EncodedReplies& r) { path_reply(r, *query, s, server_id, *read, edt, cache); });
+  } else {
+    auto read = std::make_shared<distance::BoxRead>(distance::read_box(tree, q.box_min, q.box_max, opt, cfg.limits));
+    out.finish = guarded(query, s, server_id,
+                         [=, &cfg](EncodedReplies& r) { box_reply(r, *query, s, server_id, *read, edt, cfg, cache); });
   }
   return out;
 }

@@ -11,6 +11,7 @@
 #include "daemon/queries/query_answers.h"
 #include "daemon/queries/query_config.h"
 #include "distance/distance_queries.h"
+#include "distance/field_cache.h"
 #include "octomap_rt/distance_query_t.hpp"
 
 namespace ort::daemon {
@@ -21,9 +22,12 @@ std::string validate_distance(const octomap_rt::distance_query_t& q, double reso
 
 // Under the map lock: reads what the answer needs; the returned replies have no messages
 // yet and a `finish` that computes them after the lock. Throws distance::DistanceError.
+// `cache` (may be null): the last field, reused where the grid read is its box's
+// (distance/field_cache.h); the finish calls must then run in the order of the reads, on one
+// thread, while the cache lives.
 EncodedReplies read_distance(const octomap::OcTree& tree, const octomap_rt::distance_query_t& q, const MapStamp& stamp,
                              const std::string& server_id, const DistanceServiceConfig& cfg,
-                             const distance::SquaredEdt& edt);
+                             const distance::SquaredEdt& edt, distance::FieldCache* cache = nullptr);
 
 // A reply of the distance query's mode with `status` and `error`, no results.
 std::vector<uint8_t> distance_error_message(const octomap_rt::distance_query_t& q, int8_t status,

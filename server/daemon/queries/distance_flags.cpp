@@ -11,6 +11,14 @@ void add_distance_flags(CLI::App& app, DistanceServiceConfig& d) {
   app.add_option("--distance-threads", d.threads, "CPU threads of a distance query's EDT")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
+  app.add_option("--distance-zstd-level", d.zstd_level,
+                 "zstd level of a distance box's field: 1..19, or -1..-50 for zstd's fast levels (the same frames, "
+                 "less time, more bytes); 0: sent uncompressed (COMPRESSION_NONE: more chunks)")
+      ->check(CLI::Range(-50, 19))
+      ->capture_default_str();
+  app.add_option("--distance-field-cache", d.field_cache,
+                 "keep the last distance field and transform again only where its grid changed (the same answer)")
+      ->capture_default_str();
   app.add_option("--distance-device", d.device,
                  "Vulkan device of distance queries (index or name substring; default automatic)");
 }

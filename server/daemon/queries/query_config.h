@@ -42,7 +42,8 @@ struct DistanceServiceConfig {
   int threads = 2;              // CPU EDT workers
   distance::DistanceLimits limits{.max_grid_cells = 16'000'000, .max_box_cells = 4'000'000};
   int64_t max_reply_bytes = 16 << 20;  // compressed box blob; larger is refused as too large
-  int zstd_level = 1;
+  int zstd_level = 1;                  // 1..19; negative: zstd's fast levels (same frames); 0: none
+  bool field_cache = true;             // keep the last field for the next query (distance/field_cache.h)
   // The server's shard set (ServerConfig::shard, set where the query service is made): a
   // shard answers for the obstacles of its own regions (distance_types.h's RegionOwnership).
   protocol::ShardSet shard;
@@ -71,6 +72,10 @@ struct QueryServiceConfig {
   QueryBounds bounds;
   GridPublishConfig grid;
   DistanceServiceConfig distance;
+  // Pause between two messages of one reply (a distance box's chunks, regions, grids): 60 KB
+  // datagrams in a burst overrun default receive buffers (lcm-1.3.1 notes §3.3). 0: none (memq://,
+  // or receive buffers sized for the burst).
+  double reply_chunk_interval_ms = 0.5;
   // The server's shard set (ServerConfig::shard, set where the query service is made): a
   // shard's rays stop only in its own regions (query/ray_query.h's RayBatchOptions::owns).
   protocol::ShardSet shard;

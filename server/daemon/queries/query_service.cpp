@@ -278,7 +278,8 @@ bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& o
   try {
     if (const auto* d = std::get_if<octomap_rt::distance_query_t>(&q.msg)) {
       // Only the grid is read here (bounded in cells); the EDT runs after the lock, counted there.
-      out.push_back(read_distance(*map.tree, *d, stamp, server_id_, cfg_.distance, edt_));
+      out.push_back(read_distance(*map.tree, *d, stamp, server_id_, cfg_.distance, edt_,
+                                  cfg_.distance.field_cache ? &field_cache_ : nullptr));
       return true;
     }
     out.push_back(answer_query(*map.tree, q.msg, stamp, server_id_, cfg_.bounds, budget, cfg_.shard));
@@ -300,7 +301,8 @@ bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& o
 void QueryService::publish(const EncodedReplies& r) {
   for (size_t i = 0; i < r.messages.size(); ++i) {
     // Paced: a burst of 60 KB datagrams overruns default receive buffers (lcm-1.3.1 notes §3.3).
-    if (i > 0) std::this_thread::sleep_for(std::chrono::microseconds(500));
+    if (i > 0 && cfg_.reply_chunk_interval_ms > 0)
+      std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(cfg_.reply_chunk_interval_ms));
     loop_.publish(r.channel, r.messages[i].data(), r.messages[i].size());
   }
 }

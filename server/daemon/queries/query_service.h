@@ -98,7 +98,8 @@ class QueryService {
   MapState* turn_map_ = nullptr;
   uint64_t answered_version_ = 0;
   GridPublisher grids_;
-  distance::SquaredEdt edt_;  // CPU threads or the device; used by the worker thread only
+  distance::SquaredEdt edt_;          // CPU threads or the device; used by the worker thread only
+  distance::FieldCache field_cache_;  // the last distance field (distance/field_cache.h); the worker's
   std::string distance_backend_;
   std::mutex wake_mutex_;
   std::condition_variable wake_;

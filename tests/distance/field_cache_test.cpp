@@ -1,0 +1,143 @@
+// The field cache (distance/field_cache.h) answers what a fresh EDT answers: a real map's box
+// read once, then its grid changed step by step (single cells, clusters, two far apart, a
+// block) as scans change a map; after every step the box's distances and gradients from the
+// updated field equal those of the field computed whole. The changes must show in the answer
+// (a cache that kept its old field would then fail), and some updates must be partial.
+// Points read through the cached box answer as they do from their own grid.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "distance/distance_queries.h"
+#include "distance/field_cache.h"
+#include "distance/squared_edt.h"
+#include "query/query_test_maps.h"
+
+namespace ort::test {
+namespace {
+
+using distance::UnknownAs;
+constexpr int64_t kOrigin = 32768;
+
+double key_center(const octomap::OcTree& t, int64_t k) { return (double(k - kOrigin) + 0.5) * t.getResolution(); }
+
+// A box of about 40 x 36 x 24 cells around an occupied voxel of the map.
+void box_around_obstacle(const octomap::OcTree& t, int m, double lo[3], double hi[3]) {
+  std::array<int64_t, 3> key{};
+  int seen = 0;
+  for (auto it = t.begin_leafs(), end = t.end_leafs(); it != end; ++it)
+    if (t.isNodeOccupied(*it) && ++seen == 200) {
+      for (int a = 0; a < 3; ++a) key[a] = it.getKey()[a];
+      break;
+    }
+  const int64_t n[3] = {40, 36, 24};
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = key_center(t, key[a] - n[a] / 2 * m);
+    hi[a] = key_center(t, key[a] + n[a] / 2 * m - 1);
+  }
+}
+
+void expect_same_box(const distance::BoxDistances& got, const distance::BoxDistances& want, int& wrong) {
+  ASSERT_EQ(got.squared.size(), want.squared.size());
+  for (size_t c = 0; c < got.squared.size(); ++c) {
+    if (got.squared[c] != want.squared[c] && ++wrong < 5)
+      ADD_FAILURE() << "cell " << c << ": " << got.squared[c] << " != fresh " << want.squared[c];
+    for (int a = 0; a < 3; ++a)
+      if (got.gradient[3 * c + a] != want.gradient[3 * c + a] && ++wrong < 5)
+        ADD_FAILURE() << "gradient of cell " << c << ": " << got.gradient[3 * c + a] << " != fresh "
+                      << want.gradient[3 * c + a];
+  }
+}
+
+TEST(FieldCache, UpdatedFieldsAnswerAsFreshOnesOnARealMap) {
+  const octomap::OcTree& t = *query_test_maps()[0].tree;
+  const auto edt = distance::cpu_edt(2);
+  std::mt19937 rng(27);
+  for (int m : {1, 2})
+    for (UnknownAs unknown : {UnknownAs::kFree, UnknownAs::kOccupied}) {
+      SCOPED_TRACE("cell_voxels " + std::to_string(m) + (unknown == UnknownAs::kFree ? " free" : " occupied"));
+      distance::DistanceOptions opt;
+      opt.max_distance = 6.45 * t.getResolution() * m, opt.cell_voxels = m, opt.unknown = unknown;
+      double lo[3], hi[3];
+      box_around_obstacle(t, m, lo, hi);
+      const distance::BoxRead read = distance::read_box(t, lo, hi, opt, {});
+      distance::FieldCache cache;
+      distance::OccupancyGrid grid = read.grid;
+      cache.update(grid, edt, read.resolution, opt);
+      cache.update(grid, edt, read.resolution, opt);
+      EXPECT_EQ(cache.stats().full, 1);
+      EXPECT_EQ(cache.stats().unchanged, 1);
+      const distance::GridDims d = grid.box.dims;
+      auto cell = [&](int64_t i, int64_t j, int64_t k) -> uint8_t& {
+        return grid.occupied[size_t((k * d.ny + j) * d.nx + i)];
+      };
+      auto random_cell = [&](int axis) { return std::uniform_int_distribution<int64_t>(0, (&d.nx)[axis] - 1)(rng); };
+      distance::BoxDistances before =
+          distance::answer_box(read, distance::compute_field(grid, edt, read.resolution, opt), true);
+      int wrong = 0, visible = 0;
+      for (int step = 0; step < 24; ++step) {
+        const int kind = step % 4;  // one cell; a 3-cell cluster; two far apart; a 6-cell block
+        const int clusters = kind == 2 ? 2 : 1, side = kind == 3 ? 6 : kind == 0 ? 1 : 3;
+        for (int c = 0; c < clusters; ++c) {
+          const int64_t x = random_cell(0), y = random_cell(1), z = random_cell(2);
+          for (int64_t k = z; k < std::min<int64_t>(d.nz, z + side); ++k)
+            for (int64_t j = y; j < std::min<int64_t>(d.ny, y + side); ++j)
+              for (int64_t i = x; i < std::min<int64_t>(d.nx, x + side); ++i) cell(i, j, k) ^= 1;
+        }
+        const distance::BoxDistances got =
+            distance::answer_box(read, cache.update(grid, edt, read.resolution, opt), true);
+        const distance::BoxDistances want =
+            distance::answer_box(read, distance::compute_field(grid, edt, read.resolution, opt), true);
+        expect_same_box(got, want, wrong);
+        if (want.squared != before.squared) ++visible;
+        before = want;
+      }
+      EXPECT_EQ(wrong, 0);
+      EXPECT_GE(visible, 8) << "the changes must move the answer, or a cache that kept its field would pass";
+      EXPECT_GE(cache.stats().partial, 12);
+    }
+}
+
+TEST(FieldCache, PointsReadThroughTheCachedBoxAnswerAsFromTheirOwnGrid) {
+  const octomap::OcTree& t = *query_test_maps()[0].tree;
+  const auto edt = distance::cpu_edt(2);
+  distance::DistanceOptions opt;
+  opt.max_distance = 6.45 * t.getResolution();
+  double lo[3], hi[3];
+  box_around_obstacle(t, 1, lo, hi);
+  distance::BoxRead box = distance::read_box(t, lo, hi, opt, {});
+  distance::FieldCache cache;
+  const distance::CellBox cached = box.grid.box;
+  cache.update(std::move(box.grid), edt, box.resolution, opt);
+  std::mt19937 rng(5);
+  std::vector<float> xyz;
+  for (int p = 0; p < 300; ++p)
+    for (int a = 0; a < 3; ++a) xyz.push_back(float(std::uniform_real_distribution<double>(lo[a], hi[a])(rng)));
+  auto cover = [&](const distance::CellBox& want) { return cache.covering(want, opt); };
+  distance::PointsRead through = distance::read_points(t, xyz, opt, {}, cover);
+  ASSERT_EQ(through.grids.size(), 1u);
+  ASSERT_TRUE(cache.holds(through.grids[0].box, opt));
+  EXPECT_EQ(through.grids[0].box.key_lo, cached.key_lo);
+  const distance::DistanceField* f = &cache.update(std::move(through.grids[0]), edt, box.resolution, opt);
+  const auto got = distance::answer_points(through, std::span<const distance::DistanceField* const>(&f, 1));
+  const auto want = distance::answer_points(distance::read_points(t, xyz, opt, {}), edt);
+  ASSERT_EQ(got.size(), want.size());
+  int near = 0;
+  for (size_t p = 0; p < got.size(); ++p) {
+    EXPECT_EQ(got[p].distance, want[p].distance) << "point " << p;
+    EXPECT_EQ(got[p].gradient, want[p].gradient) << "point " << p;
+    EXPECT_EQ(got[p].cell_center, want[p].cell_center) << "point " << p;
+    near += got[p].distance < opt.max_distance;
+  }
+  EXPECT_GT(near, 30);  // not all at the clamp
+  // A point outside the cached box: its own grid.
+  xyz.insert(xyz.end(), {float(hi[0] + 3), float(hi[1]), float(hi[2])});
+  EXPECT_FALSE(cache.holds(distance::read_points(t, xyz, opt, {}, cover).grids[0].box, opt));
+  // Other options (unknown as occupied): not covered.
+  distance::DistanceOptions other = opt;
+  other.unknown = UnknownAs::kOccupied;
+  EXPECT_FALSE(cache.covering(cached, other).has_value());
+}
+
+}  // namespace
+}  // namespace ort::test
