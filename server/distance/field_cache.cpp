@@ -70,6 +70,8 @@ bool FieldCache::same_key(const CellBox& box, const DistanceOptions& opt, double
 
 std::optional<CellBox> FieldCache::covering(const CellBox& want, const DistanceOptions& opt) const {
   if (!same_key(want, opt, resolution_) || !inside(want, grid_.box)) return std::nullopt;
+  // Reading the cached box costs its cells: for far fewer, their own grid's EDT is the cheaper.
+  if (want.dims.cells() * 4 < grid_.box.dims.cells()) return std::nullopt;
   return grid_.box;
 }
 

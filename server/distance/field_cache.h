@@ -34,7 +34,8 @@ struct FieldCacheStats {
 class FieldCache {
  public:
   // The cached grid's box when it can answer cells `want` under `opt` (same cell size, unknown
-  // space and padding, and `want` inside it), so the caller reads that box from the map.
+  // space and padding, `want` inside it and at least a quarter of its cells: reading the box
+  // costs its cells), so the caller reads that box from the map.
   std::optional<CellBox> covering(const CellBox& want, const DistanceOptions& opt) const;
   // Whether the entry is for exactly this box under `opt` (update would reuse it).
   bool holds(const CellBox& box, const DistanceOptions& opt) const;

@@ -133,6 +133,12 @@ TEST(FieldCache, PointsReadThroughTheCachedBoxAnswerAsFromTheirOwnGrid) {
   // A point outside the cached box: its own grid.
   xyz.insert(xyz.end(), {float(hi[0] + 3), float(hi[1]), float(hi[2])});
   EXPECT_FALSE(cache.holds(distance::read_points(t, xyz, opt, {}, cover).grids[0].box, opt));
+  // A few cells inside it: their own grid is the cheaper read.
+  distance::CellBox small = cached;
+  small.dims = {8, 8, 8};
+  for (int a = 0; a < 3; ++a) small.key_lo[a] += 10;
+  EXPECT_FALSE(cache.covering(small, opt).has_value());
+  EXPECT_TRUE(cache.covering(cached, opt).has_value());
   // Other options (unknown as occupied): not covered.
   distance::DistanceOptions other = opt;
   other.unknown = UnknownAs::kOccupied;

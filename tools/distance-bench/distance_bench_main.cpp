@@ -108,6 +108,7 @@ int main(int argc, char** argv) {
   ort::daemon::ServerFlags flags;
   ort::daemon::add_server_flags(app, flags);
   CLI11_PARSE(app, argc, argv);
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // a run cut by its caller's timeout keeps the lines it printed
   ort::daemon::ServerConfig cfg = ort::daemon::to_server_config(flags);
   cfg.save_interval_s = 0;
   cfg.map_path.clear();
