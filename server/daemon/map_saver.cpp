@@ -48,24 +48,31 @@ void MapSaver::save(bool force, bool clean) {
   if (path_.empty()) return;
   std::lock_guard save_lock(save_mutex_);
   const auto t0 = SteadyClock::now();
-  // Copy under the map lock (a state between two whole scans); serialize and write outside it.
-  std::optional<MapCopy> copy = force ? std::optional<MapCopy>(copy_map(readable_map(map_)))
-                                      : copy_map_if_changed(readable_map(map_), saved_version_);
-  if (!copy) return;
-  const std::string bytes = serialize_map(*copy->tree);
-  copy->tree.reset();
-  // The order file holds at least the copy's scans once synced (stage 2 appends each scan's
-  // line before the replica or a copy can contain it); then the map; last its identity, which
-  // names the map file and how many order lines belong to it: one left older by a crash
-  // between the renames does not match the new map (a new epoch at the next start: safe).
+  // A version of the read replica when there is one (no copy, no lock anyone waits for);
+  // else a copy under its lock (a state between two whole scans), serialized outside it.
+  std::string bytes;
+  uint64_t version = 0, epoch = 0;
+  size_t scans = 0;
+  double lock_ms = 0;
+  if (auto v = readable_version(map_)) {
+    if (!force && v->version == saved_version_) return;
+    bytes = v->map->ot_bytes();
+    version = v->version, epoch = v->epoch, scans = v->scans;
+  } else {
+    std::optional<MapCopy> copy = force ? std::optional<MapCopy>(copy_map(readable_map(map_)))
+                                        : copy_map_if_changed(readable_map(map_), saved_version_);
+    if (!copy) return;
+    bytes = serialize_map(*copy->tree);
+    version = copy->version, epoch = copy->epoch, scans = copy->scans, lock_ms = copy->lock_ms;
+  }
   map_.order.sync();
   write_file_atomically(path_, bytes);
-  write_identity(MapIdentityRecord{copy->epoch, copy->version, bytes.size(), map_file_hash(bytes), copy->scans, clean,
-                                   absolute_map_path()});
-  saved_version_ = copy->version;
+  write_identity(
+      MapIdentityRecord{epoch, version, bytes.size(), map_file_hash(bytes), scans, clean, absolute_map_path()});
+  saved_version_ = version;
   saves_++;
   last_save_utime_ = now_utime();
-  max_save_lock_ms_ = std::max(max_save_lock_ms_.load(), copy->lock_ms);
+  max_save_lock_ms_ = std::max(max_save_lock_ms_.load(), lock_ms);
   last_save_ms_ = ms_since(t0);
 }
 

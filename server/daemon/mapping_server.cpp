@@ -66,8 +66,10 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
     // take what the octree stage leaves idle and yield to it (daemon/map/map_replica.h).
     o.threads = cfg_.replica_threads;
     o.helper_nice = 19;
-    replica_ =
-        std::make_unique<MapReplica>(map_, o, cfg_.replica_pending_bytes, cfg_.replica_batch_voxels, cfg_.replica_nice);
+    // Whole-map readers read versions of it kept per region of the eviction's grid.
+    replica_ = std::make_unique<MapReplica>(
+        map_, o, cfg_.replica_pending_bytes, cfg_.replica_batch_voxels, cfg_.replica_nice,
+        cfg_.replica_versions ? std::optional(region_grid(evict_region_depth(cfg_))) : std::nullopt);
     map_.replica = replica_.get();
   }
   engine_ = std::make_unique<MapEngine>(cfg_.engine, log_);

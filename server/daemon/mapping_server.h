@@ -94,6 +94,9 @@ class MappingServer {
     std::shared_lock lock(m.mutex);
     return f(static_cast<const octomap::OcTree&>(*m.tree));
   }
+  // What snapshots, saves and the viewer map read: a version of the read replica at the map's
+  // state now or newer (daemon/map/map_replica.h); null without a replica.
+  std::shared_ptr<const ReplicaVersion> readable_version() { return daemon::readable_version(map_); }
   // Holds the read replica's lock (shared) until `release` is set, as a slow whole-map
   // reader would (tests: the octree stage goes on meanwhile). No-op without a replica.
   void hold_replica_until(const std::atomic<bool>& release) {

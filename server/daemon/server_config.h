@@ -98,6 +98,10 @@ struct ServerConfig {
   uint64_t replica_batch_voxels = uint64_t{1} << 23;
   unsigned replica_threads = 0;  // its octree stage's threads (0: every hardware thread)
   int replica_nice = 10;         // how much the replica's thread lowers its priority: the octree stage goes first
+  // Snapshots, saves and the viewer map read versions of the replica kept per region, no lock
+  // held (daemon/map/map_replica.h); false: they copy the replica under its lock, the design
+  // before (octomap-rt-bigmap-bench --replica-versions off compares).
+  bool replica_versions = true;
 };
 
 // "" when the memory bound's flags fit together; else why not (a bound or a store bound

@@ -34,5 +34,11 @@ octomap_rt_add_test(eviction_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/eviction_tes
   LIBS octomap_rt_query
   TIMEOUT 300)
 
-set_property(TEST octree_test region_test forgetting_test eviction_test APPEND PROPERTY LABELS data)
+# Versions kept per region (octree/versions/map_version.h), what whole-map readers read: OctoMap's .ot
+# byte for byte after every real scan and while nodes above the region depth prune and expand.
+octomap_rt_add_test(map_version_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_version_test.cpp
+                    $<TARGET_OBJECTS:octomap_rt_octree_test_helpers>
+  TIMEOUT 120)
+
+set_property(TEST octree_test region_test map_version_test forgetting_test eviction_test APPEND PROPERTY LABELS data)
 set_property(TEST octree_test APPEND PROPERTY LABELS slow)

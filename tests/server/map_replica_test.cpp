@@ -3,7 +3,8 @@
 // holds it for a long time does not stop the octree stage: scans go on being applied, and the
 // replica catches up once the reader lets go (the scans that waited applied as one list);
 // while stage 2 holds the map of record, queries are answered from the replica; while stage 2
-// waits for the replica's room it does not hold the map of record.
+// waits for the replica's room it does not hold the map of record; whole-map readers hold
+// versions of it (octree/versions/map_version.h) that it goes on past.
 #include <sstream>
 #include <thread>
 
@@ -50,16 +51,21 @@ TEST(MapReplica, EqualsTheMapOfRecordAfterScansEditsAndAReset) {
   };
   publish_as_rover(lc, set);
   ASSERT_TRUE(wait_until_done(server, static_cast<int64_t>(set.scans.size())));
+  // Whole-map readers' versions too (a version before the edits, so that the next ones are
+  // made from it: edits do not list their keys).
+  EXPECT_EQ(server.readable_version()->map->ot_bytes(), map_bytes(server));
   edit(1, octomap_rt::map_edit_t::OP_CLEAR_TO_FREE, 1.05);
   edit(2, octomap_rt::map_edit_t::OP_CLEAR_TO_UNKNOWN, 4.4);
   const std::string after_edits = map_bytes(server);
   EXPECT_GT(after_edits.size(), 10'000u);
   EXPECT_EQ(replica_bytes(server), after_edits) << "the replica differs from the map of record";
+  EXPECT_EQ(server.readable_version()->map->ot_bytes(), after_edits);
   edit(3, octomap_rt::map_edit_t::OP_RESET, 0);
   const auto again = scan_message(set.scans[0], "rover", static_cast<int64_t>(set.scans.size()));
   lc.publish("OCTOMAP_RT_SCAN_ROVER", &again);
   ASSERT_TRUE(wait_until_done(server, static_cast<int64_t>(set.scans.size()) + 1));
   EXPECT_EQ(replica_bytes(server), map_bytes(server));
+  EXPECT_EQ(server.readable_version()->map->ot_bytes(), map_bytes(server));
   server.stop();
 }
 
@@ -89,6 +95,44 @@ TEST(MapReplica, AReaderHoldingItDoesNotStopTheOctreeStage) {
   const auto after = server.replica_stats();
   EXPECT_GT(after->largest_batch, 1u);
   EXPECT_LT(after->updates, set.scans.size());
+  server.stop();
+}
+
+TEST(MapReplica, WholeMapReadersHoldVersionsThatTheReplicaDoesNotWaitFor) {
+  // What snapshots, saves and the viewer map read: a version of the replica at the map's state
+  // (read your writes), OctoMap's .ot of the map of record byte for byte; held while the map
+  // goes on, it stays what it was, and the replica applies every scan meanwhile.
+  const ScanSet set = make_synthetic_rooms();
+  ASSERT_GE(set.scans.size(), 4u);
+  MemqServer fixture(test_config(0.1, true));
+  auto& [lc, log, server] = fixture;
+  const size_t half = set.scans.size() / 2;
+  auto publish = [&](size_t from, size_t to) {
+    for (size_t k = from; k < to; ++k) {
+      const auto msg = scan_message(set.scans[k], "rover", static_cast<int64_t>(k));
+      lc.publish("OCTOMAP_RT_SCAN_ROVER", &msg);
+    }
+  };
+  publish(0, half);
+  ASSERT_TRUE(wait_until_done(server, static_cast<int64_t>(half)));
+  const auto held = server.readable_version();
+  ASSERT_TRUE(held);
+  const std::string held_bytes = held->map->ot_bytes();
+  EXPECT_EQ(held_bytes, map_bytes(server));
+  EXPECT_EQ(held->version, static_cast<uint64_t>(server.status().map_version));
+  EXPECT_EQ(held->scans, half);
+  publish(half, set.scans.size());
+  ASSERT_TRUE(wait_until_done(server, static_cast<int64_t>(set.scans.size())));
+  const std::string now = map_bytes(server);
+  EXPECT_EQ(replica_bytes(server), now) << "the replica did not catch up while a version was held";
+  EXPECT_EQ(held->map->ot_bytes(), held_bytes) << "a held version changed";
+  EXPECT_NE(held_bytes, now);
+  const auto newer = server.readable_version();
+  EXPECT_EQ(newer->map->ot_bytes(), now);
+  EXPECT_EQ(newer->version, static_cast<uint64_t>(server.status().map_version));
+  EXPECT_EQ(newer->map->nodes(), server.with_map([](const octomap::OcTree& t) { return t.size(); }));
+  const auto stats = server.replica_stats();
+  EXPECT_GE(stats->versions_built, 2u);
   server.stop();
 }
 

@@ -78,6 +78,7 @@ struct Args {
   uint64_t replica_batch_voxels = daemon::MapReplica::kDefaultBatchVoxels;
   uint64_t replica_pending_bytes = daemon::ServerConfig{}.replica_pending_bytes;
   int replica_nice = 10;
+  std::string replica_versions = "on";
   unsigned replica_threads = 0;
   double snapshot_period = 1, save_interval = 10, raw_rate = 1, query_rate = 100;
   cli::EngineFlags engine;
@@ -94,6 +95,7 @@ daemon::ServerConfig server_config(const Args& a) {
   cfg.replica_batch_voxels = a.replica_batch_voxels;
   cfg.replica_pending_bytes = a.replica_pending_bytes;
   cfg.replica_nice = a.replica_nice;
+  cfg.replica_versions = a.replica_versions == "on";
   cfg.replica_threads = a.replica_threads;
   // The producers go round the preset's scans (origins far apart, many new nodes a second at
   // the GPU machine's rates): the per-producer cost gates would refuse the scans it measures.
@@ -203,11 +205,11 @@ int run(const Args& a) {
   const auto replica = server.replica_stats();
   std::filesystem::remove_all(dir);
   std::printf(
-      "bigmap: readers %s (read replica %s), map %lld nodes (loaded in %.1f s), %lld scans applied of %lld in %.1f s (%d producers x "
+      "bigmap: readers %s (read replica %s, versions %s), map %lld nodes (loaded in %.1f s), %lld scans applied of %lld in %.1f s (%d producers x "
       "%.2f Hz, %s at point scale %g), backend %s\n",
-      readers ? "on" : "off", a.replica.c_str(), (long long)loaded.num_nodes, load_s, (long long)st.scans_applied,
-      (long long)published.load(), seconds, a.producers, a.rate, a.preset.c_str(), a.stream_point_scale,
-      st.backend.c_str());
+      readers ? "on" : "off", a.replica.c_str(), a.replica_versions.c_str(), (long long)loaded.num_nodes, load_s,
+      (long long)st.scans_applied, (long long)published.load(), seconds, a.producers, a.rate, a.preset.c_str(),
+      a.stream_point_scale, st.backend.c_str());
   std::printf("  octree stage: lock wait max %.1f ms (waited for: %s), p99 %.2f ms; octree p50 %.1f ms p99 %.1f ms\n",
               st.octree_lock_wait_ms_max, metrics.lock_wait_max_holder, st.octree_lock_wait_ms_p99, st.octree_ms_p50,
               st.octree_ms_p99);
@@ -238,6 +240,12 @@ int run(const Args& a) {
         (unsigned long long)replica->scans_in_batches, (unsigned long long)replica->largest_batch,
         double(replica->max_pending_bytes_seen) / 1e6, replica->writer_waited_ms, replica->lock_wait_ms_total / 1e3,
         replica->lock_wait_ms_max);
+  if (replica && replica->versions_built > 0)
+    std::printf(
+        "  versions for whole-map readers: %llu made on the replica's thread, %.1f s in all, at most %.1f ms; the "
+        "last wrote %llu of its %llu regions\n",
+        (unsigned long long)replica->versions_built, replica->version_ms_total / 1e3, replica->version_ms_max,
+        (unsigned long long)replica->version_regions_written, (unsigned long long)replica->version_regions);
   std::printf("  memory: RSS %.0f MiB before the map, %.0f MiB loaded, %.0f MiB at the end, peak %.0f MiB\n",
               rss_before, rss_loaded, rss_end, hwm);
   // readers, replica, nodes, scans, s, stall max, stall p99, e2e p50, e2e p99, query p50, query p99, snapshots,
@@ -290,6 +298,11 @@ int main(int argc, char** argv) {
   r->add_option("--replica-threads", a.replica_threads, "the read replica's octree threads (0: every hardware thread)")
       ->capture_default_str();
   r->add_option("--replica-nice", a.replica_nice, "how much the read replica's thread lowers its priority (nice)")
+      ->capture_default_str();
+  r->add_option("--replica-versions", a.replica_versions,
+                "on: snapshots, saves and the viewer map read versions of the read replica (no lock); off: they "
+                "copy it under its lock")
+      ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
   r->add_option("--snapshot-period", a.snapshot_period, "a fresh snapshot pulled this often [s]")
       ->capture_default_str();

@@ -9,6 +9,8 @@
 #   off        readers off (no snapshot, autosave, viewer map or queries), no replica: the baseline
 #   after      readers on, the read replica as the server runs it (scans that wait applied together, its
 #              thread 10 nice steps below the server, its octree stage's helpers at the lowest priority)
+#   nover      readers on, the replica without versions for whole-map readers (they copy it under its lock:
+#              the design before session 5; `after` reads versions kept per region, octree/versions/map_version.h)
 #   nice0      readers on, the replica as above but at the server's priority (what the nice step buys)
 #   unbatched  readers on, the replica one scan per update on one thread at the server's priority (the design
 #              before: a quarter of the cores, at least one)
@@ -25,16 +27,18 @@ map=${MAP:-${TMPDIR:-/tmp}/issue23-bigmap-$$.ot}
 [ -f "$map" ] || "$B" grow "${E[@]}" --point-scale 0.2 --target-nodes 5000000 --map "$map" > "$out/grow.txt" 2>&1
 R=(--map "$map" --stream-point-scale 0.01 --producers 3 --rate 0.2 --duration 40)
 run() { local name=$1; shift; "$B" run "${E[@]}" "${R[@]}" "$@" > "$out/run-$name.txt" 2>&1; uptime >> "$out/machine.txt"; }
-# RUNS picks the kinds of run (default all four), e.g. RUNS="off after" for the shorter variant.
+# RUNS picks the kinds of run (default off after nice0 unbatched), e.g. RUNS="off nover after" for session 5's.
 has() { case " ${RUNS:-off after nice0 unbatched} " in *" $1 "*) return 0;; esac; return 1; }
 for round in ${ROUNDS:-a b c}; do
   has off && run "off-$round" --readers off --read-replica off
   has after && run "after-$round" --readers on --read-replica on --snapshot-period 10
+  has nover && run "nover-$round" --readers on --read-replica on --snapshot-period 10 --replica-versions off
   has nice0 && run "nice0-$round" --readers on --read-replica on --snapshot-period 10 --replica-nice 0
   has unbatched && run "unbatched-$round" --readers on --read-replica on --snapshot-period 10 --replica-batch-voxels 0 --replica-nice 0 --replica-threads 1
 done
 if [ -z "${SKIP_SNAPSHOT_1S:-}" ]; then
   run before-1s --readers on --read-replica off --snapshot-period 1
+  has nover && run nover-1s --readers on --read-replica on --snapshot-period 1 --replica-versions off
   run after-1s --readers on --read-replica on --snapshot-period 1
 fi
 grep -H '^csv' "$out"/run-*.txt | sed 's|^.*/run-||; s|\.txt:csv|,csv|' > "$out/runs.csv"

@@ -13,8 +13,12 @@
 namespace ort::daemon {
 
 MapReplica::MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
-                       uint64_t max_batch_voxels, int nice)
-    : stage_(octree), max_pending_bytes_(max_pending_bytes), max_batch_voxels_(max_batch_voxels) {
+                       uint64_t max_batch_voxels, int nice, std::optional<RegionGrid> version_grid)
+    : stage_(octree),
+      max_pending_bytes_(max_pending_bytes),
+      max_batch_voxels_(max_batch_voxels),
+      has_versions_(version_grid.has_value()),
+      builder_(version_grid.value_or(region_grid(11))) {
   state_.mutex.prefer_writers();  // readers overlap one another: the writer must get in between
   state_.tree = std::make_unique<octomap::OcTree>(*map.tree);
   state_.version = map.version;
@@ -140,15 +144,37 @@ double MapReplica::apply_batch(std::deque<Item>& batch) {
 void MapReplica::run() {
   std::deque<Item> batch;
   for (;;) {
+    bool note_regions = false;
     {
       std::unique_lock lock(mutex_);
-      work_.wait(lock, [&] { return stop_ || !queue_.empty(); });
-      if (queue_.empty()) return;  // stopped with nothing left
+      // A reader waiting for a version the tree has reached goes before the next batch.
+      auto version_due = [&] { return wanted_ && stats_.version >= wanted_version_; };
+      work_.wait(lock, [&] { return stop_ || !queue_.empty() || version_due(); });
+      if (version_due()) {
+        wanted_ = false;
+        lock.unlock();
+        make_version();
+        continue;
+      }
+      if (queue_.empty()) {  // stopped with nothing left
+        exited_ = true;
+        progress_.notify_all();
+        return;
+      }
       take_batch(batch);
+      note_regions = versions_on_;
     }
     const auto t0 = SteadyClock::now();
     const double waited = apply_batch(batch);
     const double applied_ms = ms_since(t0);
+    if (note_regions) {  // what the next version writes again
+      std::lock_guard build(build_mutex_);
+      for (const Item& it : batch)
+        if (it.step)
+          builder_.changed_all();
+        else
+          builder_.changed(it.voxels);
+    }
     uint64_t bytes = 0;
     for (const Item& it : batch) bytes += it.bytes;
     const uint64_t items = batch.size();
@@ -172,6 +198,50 @@ void MapReplica::run() {
   }
 }
 
+void MapReplica::make_version() {
+  // Only the replica's thread changes the tree (and, once it exited, nothing does): it is
+  // read here without its lock, while query turns read it under theirs.
+  std::lock_guard build(build_mutex_);
+  const auto t0 = SteadyClock::now();
+  auto v = std::make_shared<ReplicaVersion>();
+  v->map = builder_.build(*state_.tree);
+  v->version = state_.version;
+  v->epoch = state_.epoch;
+  v->scans = state_.scans;
+  v->last_scan_utime = state_.last_scan_utime;
+  v->newest_scan = state_.newest_scan;
+  const double ms = ms_since(t0);
+  const auto figures = builder_.last_build();
+  {
+    std::lock_guard lock(mutex_);
+    if (!latest_ || latest_->version <= v->version) latest_ = std::move(v);
+    stats_.versions_built++;
+    stats_.version_ms_total += ms;
+    stats_.version_ms_max = std::max(stats_.version_ms_max, ms);
+    stats_.version_regions = figures.regions;
+    stats_.version_regions_written = figures.regions_written;
+  }
+  progress_.notify_all();
+}
+
+std::shared_ptr<const ReplicaVersion> MapReplica::read_version(uint64_t min_version) {
+  std::unique_lock lock(mutex_);
+  versions_on_ = true;
+  for (;;) {
+    if (latest_ && latest_->version >= min_version) return latest_;
+    if (exited_) {  // nothing changes the tree any more: the reader makes the version itself
+      lock.unlock();
+      make_version();
+      lock.lock();
+      return latest_;
+    }
+    wanted_ = true;
+    wanted_version_ = std::max(wanted_version_, min_version);
+    work_.notify_one();
+    progress_.wait(lock);
+  }
+}
+
 bool MapReplica::wait_for(uint64_t version, double timeout_s) {
   std::unique_lock lock(mutex_);
   return progress_.wait_for(lock, std::chrono::duration<double>(timeout_s),
@@ -188,6 +258,11 @@ MapState& readable_map(MapState& map) {
   // The map of record's id without its lock: a reader never holds the octree stage up.
   map.replica->wait_for(map.replica->record_version(), 1e9);
   return map.replica->state();
+}
+
+std::shared_ptr<const ReplicaVersion> readable_version(MapState& map) {
+  if (!map.replica || !map.replica->has_versions()) return nullptr;
+  return map.replica->read_version(map.replica->record_version());
 }
 
 MapState& lock_for_short_read(MapState& map, uint64_t min_version, std::shared_lock<MapMutex>& lock) {

@@ -4,11 +4,17 @@
 // and in the map's order; the replica's own thread applies them with its own octree stage,
 // the same code on the same input in the same order, so at every state id its tree equals
 // the map of record's node for node (tests/server/map_replica_test.cpp compares the .ot
-// bytes). Readers lock the replica's MapState, never the map of record's: however long a
-// copy or a serialization takes, the octree stage does not wait for it (docs/ARCHITECTURE.md
+// bytes). Short readers (query turns, the status' figures) lock the replica's MapState.
+// Whole-map readers (snapshots, saves, the viewer map) lock nothing: they take an immutable
+// version of it (read_version), kept per region (octree/versions/map_version.h), that the replica's
+// thread makes between two batches from its own tree, writing again only the regions the
+// batches since the last version touched; however long a reader holds or serializes its
+// version, neither the octree stage nor the replica waits for it (docs/ARCHITECTURE.md
 // "Readers and the read replica").
 //
-// Memory: one more tree, plus the voxel lists and steps not applied yet, at most
+// Memory: one more tree; once a whole-map reader asked, the newest version (5 bytes a node)
+// and what older versions readers still hold do not share with it (at most the regions
+// changed since each); plus the voxel lists and steps not applied yet, at most
 // `max_pending_bytes`; past that, stage 2 waits for the replica (only while a reader holds
 // the replica longer than it takes the producers to send that much); plus one buffer of at
 // most `max_batch_voxels` voxels (8 bytes each), kept from batch to batch.
@@ -32,8 +38,10 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <shared_mutex>
 #include <string>
 #include <thread>
@@ -43,9 +51,21 @@
 #include "core/voxel_update.h"
 #include "daemon/map/map_identity.h"
 #include "daemon/map/map_state.h"
+#include "octree/versions/map_version.h"
 #include "octree/octree_update.h"
+#include "octree/region.h"
 
 namespace ort::daemon {
+
+// What a whole-map reader reads: an immutable version of the replica's tree (kept per region,
+// octree/versions/map_version.h) at a state between two whole scans, with that state's identity.
+struct ReplicaVersion {
+  std::shared_ptr<const MapVersion> map;
+  uint64_t version = 0, epoch = 0;
+  size_t scans = 0;
+  int64_t last_scan_utime = 0;
+  std::map<std::string, MapState::NewestScan> newest_scan;
+};
 
 struct ReplicaStats {
   uint64_t version = 0;  // the replica's map state id
@@ -55,9 +75,12 @@ struct ReplicaStats {
   double apply_ms_total = 0;      // the replica thread's own update time (its lock held)
   double lock_wait_ms_total = 0;  // the replica thread's wait for its lock (readers inside)
   double lock_wait_ms_max = 0;
-  uint64_t updates = 0;           // tree updates it made: one per batch of scans or per step
-  uint64_t scans_in_batches = 0;  // scans applied together with others
-  uint64_t largest_batch = 0;     // most scans in one update
+  uint64_t updates = 0;                             // tree updates it made: one per batch of scans or per step
+  uint64_t scans_in_batches = 0;                    // scans applied together with others
+  uint64_t largest_batch = 0;                       // most scans in one update
+  uint64_t versions_built = 0;                      // versions made for whole-map readers
+  double version_ms_total = 0, version_ms_max = 0;  // the replica thread's time making them
+  uint64_t version_regions = 0, version_regions_written = 0;  // of the last one
 };
 
 class MapReplica {
@@ -68,8 +91,12 @@ class MapReplica {
   // its priority below the server's (core/thread_priority.h; its octree stage's helpers:
   // octree.helper_nice).
   static constexpr uint64_t kDefaultBatchVoxels = uint64_t{1} << 23;
+  // `version_grid`: the regions versions for whole-map readers are kept in (the eviction's
+  // grid); none: no versions (whole-map readers copy the replica under its lock, the design
+  // before them: benchmarks compare).
   MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
-             uint64_t max_batch_voxels = kDefaultBatchVoxels, int nice = 0);
+             uint64_t max_batch_voxels = kDefaultBatchVoxels, int nice = 0,
+             std::optional<RegionGrid> version_grid = region_grid(11));
   ~MapReplica();
   MapReplica(const MapReplica&) = delete;
   MapReplica& operator=(const MapReplica&) = delete;
@@ -97,6 +124,13 @@ class MapReplica {
   bool caught_up() const {
     return applied_version_.load(std::memory_order_acquire) == record_version_.load(std::memory_order_acquire);
   }
+  // A version at `min_version` or newer, for whole-map readers: the newest made when it is
+  // new enough, else the replica's thread makes one as soon as it reached `min_version`
+  // (between two batches, from its own tree: no lock a reader or the octree stage waits for).
+  // The first call turns versions on (the replica's thread then notes the regions each batch
+  // touches). The caller may hold it as long as it likes: the replica goes on.
+  std::shared_ptr<const ReplicaVersion> read_version(uint64_t min_version);
+  bool has_versions() const { return has_versions_; }
   ReplicaStats stats() const;
   void stop();
 
@@ -120,6 +154,9 @@ class MapReplica {
   // Applies a batch to the tree and takes its last item's state (under state_.mutex).
   // Returns how long it waited for that lock (ms).
   double apply_batch(std::deque<Item>& batch);
+  // Makes a version of the tree as the replica's thread left it (after its last batch, or
+  // after it exited) and publishes it.
+  void make_version();
 
   MapState state_;
   OctreeStage stage_;
@@ -132,6 +169,14 @@ class MapReplica {
   bool stop_ = false;
   ReplicaStats stats_;
   std::atomic<uint64_t> record_version_{0}, applied_version_{0};
+  // Versions: on after the first read_version; the newest made; the version a reader waits for.
+  bool has_versions_;
+  bool versions_on_ = false, exited_ = false;
+  uint64_t wanted_version_ = 0;
+  bool wanted_ = false;
+  std::shared_ptr<const ReplicaVersion> latest_;
+  std::mutex build_mutex_;  // the builder: the replica's thread, or a reader after it exited
+  MapVersionBuilder builder_;
   std::thread thread_;
 };
 
@@ -139,6 +184,11 @@ class MapReplica {
 // record as it was at the call (read-your-writes: a reader that saw id N there gets N or
 // newer); else the map of record itself.
 MapState& readable_map(MapState& map);
+// The same for readers that serialize or copy the whole map: a version of the replica (read
+// your writes as above) that neither the replica nor the octree stage waits for; null
+// without a replica or without versions (the reader then copies readable_map's tree under
+// its lock).
+std::shared_ptr<const ReplicaVersion> readable_version(MapState& map);
 
 // For short readers (a turn of queries): a shared lock on the map of record when stage 2 does
 // not hold it; while it does, on the read replica if its thread is not writing it and it is at

@@ -45,9 +45,16 @@ void OctomapRawPublisher::encode_if_changed() {
   RawMap raw;
   const RawMapOptions options{cfg_.max_bytes, cfg_.min_depth};
   const bool band = std::isfinite(cfg_.occupancy_min_z) || std::isfinite(cfg_.occupancy_max_z);
-  if (map_.replica && !band) {
-    // Encoded straight from the read replica, under its lock: no copy of the map, and the
-    // octree stage does not wait (the replica's thread does).
+  if (auto v = readable_version(map_)) {
+    // A version of the read replica: the tree made from it is the viewer's own (the band
+    // filter may change it), and no lock the octree stage or the replica waits for is held.
+    if (v->version == encoded_version_) return;
+    encoded_version_ = v->version;
+    const std::unique_ptr<octomap::OcTree> tree = v->map->tree();
+    if (band) drop_occupied_outside_band(*tree, cfg_.occupancy_min_z, cfg_.occupancy_max_z);
+    raw = make_raw_map(*tree, v->last_scan_utime, options);
+  } else if (map_.replica && !band) {
+    // Without versions: encoded straight from the read replica, under its lock (its thread waits).
     MapState& r = readable_map(map_);
     std::shared_lock lock(r.mutex);
     if (r.version == encoded_version_) return;
@@ -56,7 +63,7 @@ void OctomapRawPublisher::encode_if_changed() {
     ++encodings_;
   } else {
     // The band filter changes the tree it encodes: a copy (of the replica when there is one).
-    auto copy = copy_map_if_changed(map_.replica ? readable_map(map_) : map_, encoded_version_);
+    auto copy = copy_map_if_changed(readable_map(map_), encoded_version_);
     if (!copy) return;
     ++map_copies_;
     encoded_version_ = copy->version;

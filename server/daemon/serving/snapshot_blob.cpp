@@ -32,9 +32,8 @@ std::string serialize(const octomap::OcTree& tree, int8_t format) {
 
 }  // namespace
 
-SnapshotContents describe_snapshot(const octomap::OcTree& tree,
-                                   const std::map<std::string, MapState::NewestScan>& newest_scan, size_t scans,
-                                   int64_t map_utime) {
+SnapshotContents describe_snapshot_producers(const std::map<std::string, MapState::NewestScan>& newest_scan,
+                                             size_t scans, int64_t map_utime) {
   SnapshotContents c;
   c.scans = scans;
   c.map_utime = map_utime;
@@ -44,6 +43,13 @@ SnapshotContents describe_snapshot(const octomap::OcTree& tree,
   if (recent.size() > SnapshotContents::kMaxListedProducers) recent.resize(SnapshotContents::kMaxListedProducers);
   for (const auto* r : recent) c.producer_last_seq.push_back({r->robot_id, r->seq});
   c.producers_total = static_cast<int64_t>(newest_scan.size());
+  return c;
+}
+
+SnapshotContents describe_snapshot(const octomap::OcTree& tree,
+                                   const std::map<std::string, MapState::NewestScan>& newest_scan, size_t scans,
+                                   int64_t map_utime) {
+  SnapshotContents c = describe_snapshot_producers(newest_scan, scans, map_utime);
   if (tree.size() > 0) {
     tree.getMetricMin(c.bbox_min[0], c.bbox_min[1], c.bbox_min[2]);
     tree.getMetricMax(c.bbox_max[0], c.bbox_max[1], c.bbox_max[2]);
@@ -53,14 +59,19 @@ SnapshotContents describe_snapshot(const octomap::OcTree& tree,
 
 SnapshotBlob make_snapshot_blob(const octomap::OcTree& tree, const SnapshotContents& contents, int8_t format,
                                 int zstd_level) {
+  const auto t0 = SteadyClock::now();
+  std::string raw = serialize(tree, format);
+  return make_snapshot_blob_of_bytes(std::move(raw), contents, format, zstd_level, ms_since(t0));
+}
+
+SnapshotBlob make_snapshot_blob_of_bytes(std::string raw, const SnapshotContents& contents, int8_t format,
+                                         int zstd_level, double serialize_ms) {
   SnapshotBlob b;
   b.contents = contents;
   b.format = format;
-  auto t0 = SteadyClock::now();
-  std::string raw = serialize(tree, format);
-  b.serialize_ms = ms_since(t0);
+  b.serialize_ms = serialize_ms;
   b.raw_size = static_cast<int64_t>(raw.size());
-  t0 = SteadyClock::now();
+  const auto t0 = SteadyClock::now();
   if (zstd_level > 0) {
     b.bytes = protocol::zstd_compress(raw, zstd_level);
     b.compression = Chunk::COMPRESSION_ZSTD;

@@ -49,6 +49,9 @@ struct SnapshotBlob {
 SnapshotContents describe_snapshot(const octomap::OcTree& tree,
                                    const std::map<std::string, MapState::NewestScan>& newest_scan, size_t scans,
                                    int64_t map_utime);
+// The same without the bbox (the caller sets it: a version of the map knows it, octree/versions/map_version.h).
+SnapshotContents describe_snapshot_producers(const std::map<std::string, MapState::NewestScan>& newest_scan,
+                                             size_t scans, int64_t map_utime);
 
 // Serializes `tree` (FORMAT_OCTOMAP_FULL: AbstractOcTree::write; FORMAT_OCTOMAP_BINARY:
 // OcTree::writeBinary as OctoMap's own .bt, i.e. of a max-likelihood pruned copy) and
@@ -56,5 +59,8 @@ SnapshotContents describe_snapshot(const octomap::OcTree& tree,
 // unknown format.
 SnapshotBlob make_snapshot_blob(const octomap::OcTree& tree, const SnapshotContents& contents, int8_t format,
                                 int zstd_level);
+// The same from the format's bytes already made (`serialize_ms`: the time that took).
+SnapshotBlob make_snapshot_blob_of_bytes(std::string raw, const SnapshotContents& contents, int8_t format,
+                                         int zstd_level, double serialize_ms);
 
 }  // namespace ort::daemon

@@ -4,8 +4,10 @@
 #include <thread>
 
 #include "core/clock.h"
+#include "core/file_checks/octree_binary.h"
 #include "daemon/map/map_replica.h"
 #include "daemon/serving/map_snapshot.h"
+#include "octomap_rt/map_chunk_t.hpp"
 
 namespace ort::daemon {
 
@@ -34,22 +36,34 @@ std::shared_ptr<const SnapshotBlob> SnapshotStore::latest(MapState& map, int8_t 
 std::shared_ptr<const SnapshotBlob> SnapshotStore::find(uint64_t id, int8_t format) {
   for (Entry& e : kept_)
     if (e.contents.snapshot_id == id) {
-      if (e.blob[format] || e.tree) return blob_of(e, format);
+      if (e.blob[format] || e.tree || e.version) return blob_of(e, format);
       return nullptr;  // an older snapshot never made in this format
     }
   return nullptr;
 }
 
 void SnapshotStore::take(MapState& map) {
-  // From the read replica when there is one: the octree stage does not wait for the copy.
-  MapCopy copy = copy_map(readable_map(map));
   Entry e;
-  e.contents = describe_snapshot(*copy.tree, copy.newest_scan, copy.scans, copy.last_scan_utime);
-  e.contents.snapshot_id = copy.version;
-  e.contents.epoch = copy.epoch;
-  e.contents.copy_lock_ms = copy.lock_ms;
-  e.tree = std::move(copy.tree);
-  if (!kept_.empty()) kept_.back().tree.reset();
+  if (auto v = readable_version(map)) {
+    // A version of the read replica: no copy, and no lock the octree stage or the replica
+    // waits for.
+    e.contents = describe_snapshot_producers(v->newest_scan, v->scans, v->last_scan_utime);
+    if (v->map->nodes() > 0) {
+      v->map->metric_min(e.contents.bbox_min[0], e.contents.bbox_min[1], e.contents.bbox_min[2]);
+      v->map->metric_max(e.contents.bbox_max[0], e.contents.bbox_max[1], e.contents.bbox_max[2]);
+    }
+    e.contents.snapshot_id = v->version;
+    e.contents.epoch = v->epoch;
+    e.version = std::move(v);
+  } else {
+    MapCopy copy = copy_map(readable_map(map));  // the replica's copy holds only the replica
+    e.contents = describe_snapshot(*copy.tree, copy.newest_scan, copy.scans, copy.last_scan_utime);
+    e.contents.snapshot_id = copy.version;
+    e.contents.epoch = copy.epoch;
+    e.contents.copy_lock_ms = copy.lock_ms;
+    e.tree = std::move(copy.tree);
+  }
+  if (!kept_.empty()) kept_.back().tree.reset(), kept_.back().version.reset();
   kept_.push_back(std::move(e));
   while (kept_.size() > std::max<size_t>(policy_.kept, 1)) kept_.pop_front();
   taken_at_ = SteadyClock::now();
@@ -60,9 +74,23 @@ void SnapshotStore::take(MapState& map) {
 std::shared_ptr<const SnapshotBlob> SnapshotStore::blob_of(Entry& e, int8_t format) {
   if (format < 1 || format > 2) throw std::invalid_argument("unknown snapshot format");
   if (!e.blob[format]) {
-    if (!e.tree) return nullptr;
-    e.blob[format] =
-        std::make_shared<const SnapshotBlob>(make_snapshot_blob(*e.tree, e.contents, format, policy_.zstd_level));
+    if (e.version && format == octomap_rt::map_chunk_t::FORMAT_OCTOMAP_FULL) {
+      const auto t0 = SteadyClock::now();  // the .ot is the version's bytes written in order
+      std::string raw = e.version->map->ot_bytes();
+      e.blob[format] = std::make_shared<const SnapshotBlob>(
+          make_snapshot_blob_of_bytes(std::move(raw), e.contents, format, policy_.zstd_level, ms_since(t0)));
+    } else if (e.version) {
+      const auto t0 = SteadyClock::now();  // the .bt: of the tree made from the version
+      const std::unique_ptr<octomap::OcTree> tree = e.version->map->tree();
+      std::string raw = octomap_binary_bytes(*tree);
+      e.blob[format] = std::make_shared<const SnapshotBlob>(
+          make_snapshot_blob_of_bytes(std::move(raw), e.contents, format, policy_.zstd_level, ms_since(t0)));
+    } else if (e.tree) {
+      e.blob[format] =
+          std::make_shared<const SnapshotBlob>(make_snapshot_blob(*e.tree, e.contents, format, policy_.zstd_level));
+    } else {
+      return nullptr;
+    }
     last_made_ = e.blob[format];
   }
   return e.blob[format];

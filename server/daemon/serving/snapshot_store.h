@@ -1,6 +1,7 @@
 // The snapshots a map service keeps: the last few, each in the formats asked for, so that a
 // re-send of some chunks (or another client's request for the same state) does not copy or
-// serialize the map again. Only the newest keeps its tree copy (to add the other format).
+// serialize the map again. Only the newest keeps its tree copy or its version of the read
+// replica (to add the other format).
 // Used by one thread (the map service's); the counters may be read from any.
 #pragma once
 
@@ -11,6 +12,7 @@
 #include <memory>
 
 #include "core/clock.h"
+#include "daemon/map/map_replica.h"
 #include "daemon/map/map_state.h"
 #include "daemon/serving/snapshot_blob.h"
 
@@ -50,8 +52,9 @@ class SnapshotStore {
  private:
   struct Entry {
     SnapshotContents contents;
-    std::unique_ptr<octomap::OcTree> tree;        // newest only
-    std::shared_ptr<const SnapshotBlob> blob[3];  // by format (1: .bt, 2: .ot)
+    std::unique_ptr<octomap::OcTree> tree;          // newest only: a copy of the map of record, or
+    std::shared_ptr<const ReplicaVersion> version;  // a version of the read replica (no copy)
+    std::shared_ptr<const SnapshotBlob> blob[3];    // by format (1: .bt, 2: .ot)
   };
   std::shared_ptr<const SnapshotBlob> blob_of(Entry& e, int8_t format);
   void take(MapState& map);
