@@ -170,6 +170,72 @@ void free_detached(DetachedSubtree& d) {
   d = {};
 }
 
+namespace {
+void size_below(const octomap::OcTreeNode* node, SubtreeSize& s) {
+  auto* const* children = detail::ChildArrayAccess::of(const_cast<octomap::OcTreeNode&>(*node));
+  if (children == nullptr) return;
+  bool inner = false;
+  for (unsigned i = 0; i < 8; ++i) {
+    if (children[i] == nullptr) continue;
+    inner = true;
+    ++s.nodes_below;
+    size_below(static_cast<const octomap::OcTreeNode*>(children[i]), s);
+  }
+  s.inner += inner;
+}
+
+void encode_below(octomap::AbstractOcTreeNode* const* children, std::vector<uint8_t>& out, uint64_t& count) {
+  for (unsigned i = 0; i < 8; ++i) {
+    auto* node = static_cast<octomap::OcTreeNode*>(children[i]);
+    if (node == nullptr) continue;
+    ++count;
+    octomap::AbstractOcTreeNode** below = detail::ChildArrayAccess::of(*node);
+    uint8_t bits = 0;
+    if (below != nullptr)
+      for (unsigned j = 0; j < 8; ++j)
+        if (below[j] != nullptr) bits = static_cast<uint8_t>(bits | (1u << j));
+    const float value = node->getLogOdds();
+    put(out, value);
+    out.push_back(bits);
+    if (bits) encode_below(below, out, count);
+  }
+}
+}  // namespace
+
+SubtreeSize region_size(const octomap::OcTree& tree, const RegionGrid& grid, RegionId id) {
+  SubtreeSize s;
+  const RegionNode r = find_region(tree, grid, id);
+  if (r.node == nullptr || r.depth != grid.depth) return s;
+  size_below(r.node, s);
+  return s;
+}
+
+std::vector<uint8_t> encode_detached(RegionId id, unsigned depth, float root_log_odds, const DetachedSubtree& d) {
+  if (d.children == nullptr) throw RegionCodecError("region " + std::to_string(id) + ": nothing detached to encode");
+  std::vector<uint8_t> out(kHeaderBytes);
+  out.reserve(kHeaderBytes + (d.nodes + 1) * kNodeBytes);
+  uint8_t bits = 0;
+  for (unsigned i = 0; i < 8; ++i)
+    if (d.children[i] != nullptr) bits = static_cast<uint8_t>(bits | (1u << i));
+  put(out, root_log_odds);
+  out.push_back(bits);
+  uint64_t count = 1;
+  encode_below(d.children, out, count);
+  write_header(out, id, depth, count);
+  return out;
+}
+
+void reattach_region(octomap::OcTree& tree, const RegionGrid& grid, RegionId id, DetachedSubtree& d) {
+  const RegionNode r = find_region(tree, grid, id);
+  if (r.node == nullptr || r.depth != grid.depth || tree.nodeHasChildren(r.node))
+    throw RegionCodecError("region " + std::to_string(id) + " has no stand-in to put its nodes back under");
+  octomap::AbstractOcTreeNode**& children = detail::ChildArrayAccess::of(*r.node);
+  delete[] children;  // an empty array a deleteNodeChild may have left (none is expected)
+  children = d.children;
+  add_to_node_count(tree, static_cast<int64_t>(d.nodes));
+  d = {};
+}
+
 void restore_region(octomap::OcTree& tree, const RegionGrid& grid, RegionId id, std::span<const uint8_t> bytes) {
   const RegionHeader h = read_region_header(bytes);
   if (h.id != id || h.depth != grid.depth)

@@ -51,6 +51,19 @@ struct DetachedSubtree {
 // `nodes_below`: the subtree's nodes without its root (an encoding's count minus one).
 DetachedSubtree detach_region(octomap::OcTree& tree, const RegionGrid& grid, RegionId id, uint64_t nodes_below);
 void free_detached(DetachedSubtree& d);
+// The nodes below region `id`'s root, and the inner nodes of its subtree (the root with them),
+// as detach_region and OctoMap's memoryUsage() count them (0, 0 without a subtree).
+struct SubtreeSize {
+  uint64_t nodes_below = 0, inner = 0;
+};
+SubtreeSize region_size(const octomap::OcTree& tree, const RegionGrid& grid, RegionId id);
+// The bytes encode_region gives for a region whose subtree was detached, from its stand-in's
+// value and the detached nodes, without the tree: any thread may call it while nothing
+// changes or frees those nodes.
+std::vector<uint8_t> encode_detached(RegionId id, unsigned depth, float root_log_odds, const DetachedSubtree& d);
+// Puts a detached subtree back below region `id`'s stand-in (the tree's node counter goes up
+// by d.nodes; `d` is emptied). Throws RegionCodecError (tree unchanged) without a stand-in.
+void reattach_region(octomap::OcTree& tree, const RegionGrid& grid, RegionId id, DetachedSubtree& d);
 
 // Puts the subtree of `bytes` back below region `id`'s stand-in (a childless node at the
 // region depth). Throws RegionCodecError when the bytes are not a whole region of this id

@@ -11,11 +11,47 @@ namespace ort {
 RegionResidency::RegionResidency(const RegionGrid& grid, RegionSpill& spill, uint64_t max_bytes)
     : grid_(grid), spill_(spill), max_bytes_(max_bytes), tally_(grid) {}
 
+RegionResidency::~RegionResidency() {
+  stop_writer();
+  for (auto& [id, p] : pending_) free_detached(p.nodes);  // the tree holds stand-ins only: nothing refers to them
+}
+
 void RegionResidency::restore(octomap::OcTree& tree, RegionId id) {
   auto it = spilled_.find(id);
   if (it == spilled_.end()) return;
   const auto t0 = SteadyClock::now();
-  const std::vector<uint8_t> bytes = spill_.get(id);
+  if (background_) {
+    std::unique_lock lock(write_mutex_);
+    auto p = pending_.find(id);
+    if (p != pending_.end()) {
+      if (p->second.state == Pending::State::kWriting) {
+        written_.wait(lock, [&] { return pending_.at(id).state != Pending::State::kWriting; });
+        stats_.costs.write_wait_ms += ms_since(t0);
+        p = pending_.find(id);
+      }
+      Pending back = std::move(p->second);
+      pending_.erase(p);
+      pending_nodes_ -= back.nodes.nodes;
+      if (back.state == Pending::State::kWritten || back.state == Pending::State::kFailed) --writes_done_;
+      lock.unlock();  // a queued id left in queue_ is skipped by the writer
+      tally_.changed(id);
+      reattach_region(tree, grid_, id, back.nodes);
+      if (back.state == Pending::State::kWritten) {
+        std::lock_guard spill(spill_mutex_);
+        spill_.erase(id);
+      }
+      spilled_.erase(it);
+      stats_.costs.rebuild_ms += ms_since(t0);
+      stats_.costs.reattached++;
+      stats_.restores++;
+      return;
+    }
+  }
+  std::vector<uint8_t> bytes;
+  {
+    std::lock_guard spill(spill_mutex_);
+    bytes = spill_.get(id);
+  }
   const auto t1 = SteadyClock::now();
   tally_.changed(id);
   restore_region(tree, grid_, id, bytes);
@@ -23,7 +59,10 @@ void RegionResidency::restore(octomap::OcTree& tree, RegionId id) {
   stats_.costs.rebuild_ms += ms_since(t1);
   stats_.evicted_bytes -= it->second;
   spilled_.erase(it);
-  spill_.erase(id);
+  {
+    std::lock_guard spill(spill_mutex_);
+    spill_.erase(id);
+  }
   stats_.restores++;
 }
 
@@ -79,9 +118,22 @@ uint64_t inner_nodes(const std::vector<uint8_t>& encoded) {
 
 size_t RegionResidency::enforce(octomap::OcTree& tree) { return enforce(tree, memory(tree), max_bytes_).regions; }
 
-EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, uint64_t target, size_t max_groups) {
+EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, uint64_t target, size_t max_groups,
+                                       double budget_ms) {
   EnforceResult result;
-  if (bytes <= target) return result;
+  const auto start = SteadyClock::now();
+  std::string write_error;  // a background put that failed: thrown after this pass
+  if (background_) {
+    try {
+      collect_writes(tree);
+    } catch (const std::exception& e) {
+      write_error = e.what();
+    }
+  }
+  if (bytes <= target) {
+    if (!write_error.empty()) throw std::runtime_error(write_error);
+    return result;
+  }
   // Siblings go together, as the group's most recent touch: a touch brings a region's seven
   // siblings back with it (region_residency.h), so a sibling spilled alone would come back at
   // the next touch of its neighbour and go again at the next enforce.
@@ -113,8 +165,17 @@ EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, ui
   for (const Candidate& c : candidates) {
     if (c.group != group) {  // whole groups only: stop between two
       if (bytes <= target || groups == max_groups) break;
+      // The budget cuts the way from the bound down to `target`, never the way to the bound.
+      if (budget_ms > 0 && groups > 0 && bytes <= max_bytes_ && ms_since(start) >= budget_ms) break;
       group = c.group;
       ++groups;
+    }
+    if (background_) {
+      const uint64_t freed_bytes = detach_for_writer(tree, c.id);
+      bytes -= std::min(bytes, freed_bytes);
+      result.bytes_freed += freed_bytes;
+      result.regions++;
+      continue;
     }
     const auto t0 = SteadyClock::now();
     const std::vector<uint8_t> encoded = encode_region(tree, grid_, c.id);
@@ -142,6 +203,7 @@ EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, ui
     result.bytes_freed += freed_bytes;
     result.regions++;
   }
+  if (!write_error.empty()) throw std::runtime_error(write_error);
   return result;
 }
 
@@ -171,6 +233,14 @@ std::vector<RegionId> RegionResidency::spilled_in(const octomap::OcTreeKey& lo, 
   return out;
 }
 
+void RegionResidency::adopt_spilled(RegionId id, std::span<const uint8_t> bytes) {
+  {
+    std::lock_guard spill(spill_mutex_);
+    spill_.put(id, bytes);
+  }
+  adopt_spilled(id, bytes.size());
+}
+
 void RegionResidency::adopt_spilled(RegionId id, uint64_t bytes) {
   tally_.changed(id);
   auto [it, added] = spilled_.emplace(id, bytes);
@@ -189,6 +259,16 @@ std::vector<RegionId> RegionResidency::spilled_ids() const {
 }
 
 void RegionResidency::forget_all() {
+  flush();
+  {
+    std::lock_guard lock(write_mutex_);  // the tree was emptied: kept nodes are nobody's
+    for (auto& [id, p] : pending_) let_go(p.nodes);
+    pending_.clear();
+    queue_.clear();
+    pending_nodes_ = 0;
+    writes_done_ = 0;
+  }
+  std::lock_guard spill(spill_mutex_);
   for (RegionId id : spilled_ids()) spill_.erase(id);
   spilled_.clear();
   stats_.evicted_bytes = 0;
@@ -202,6 +282,9 @@ void RegionResidency::restore_all(octomap::OcTree& tree) {
 ResidencyStats RegionResidency::stats() const {
   ResidencyStats s = stats_;
   s.evicted_regions = spilled_.size();
+  std::lock_guard lock(write_mutex_);
+  s.costs.encode_ms += writer_encode_ms_;
+  s.costs.put_ms += writer_put_ms_;
   return s;
 }
 

@@ -10,10 +10,15 @@
 // stand-in below it has children, so it is never pruned).
 #pragma once
 
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <functional>
+#include <mutex>
 #include <span>
+#include <string>
+#include <thread>
 #include <unordered_map>
 #include <vector>
 
@@ -27,7 +32,9 @@
 namespace ort {
 
 // Where spilled regions go (daemon/persistence/region_store.h on disk; tests keep them in
-// memory). put() must hold the bytes durably before it returns, or throw.
+// memory). put() must hold the bytes durably before it returns, or throw. With background
+// writes (RegionResidency::start_background_writes) put() runs on the writer's thread; the
+// residency never calls two of these at once.
 class RegionSpill {
  public:
   virtual ~RegionSpill() = default;
@@ -45,6 +52,12 @@ struct ResidencyCosts {
   double strip_ms = 0;    // freeing the spilled subtree's nodes (or detaching them, with set_free_later)
   double get_ms = 0;      // the spill's get on restore (the store's file read)
   double rebuild_ms = 0;  // decoding and rebuilding a restored subtree
+  // With background writes: encode_ms and put_ms are the writer's (off the caller's thread);
+  // size_ms is the caller's count of a region's nodes before it detaches them, and
+  // write_wait_ms the time the caller waited for the writer (a full queue, a restore of a
+  // region being written, a flush).
+  double size_ms = 0, write_wait_ms = 0;
+  uint64_t reattached = 0;  // restores of regions not yet written, or not yet let go: no store read
 };
 
 struct ResidencyStats {
@@ -64,6 +77,19 @@ struct EnforceResult {
 class RegionResidency {
  public:
   RegionResidency(const RegionGrid& grid, RegionSpill& spill, uint64_t max_bytes);
+  ~RegionResidency();
+  RegionResidency(const RegionResidency&) = delete;
+  RegionResidency& operator=(const RegionResidency&) = delete;
+
+  // From now on enforce() only detaches a region's nodes (counting them) and a writer thread
+  // encodes and puts them; until put() has returned and a later call of this object's let
+  // them go, the region is pending: its nodes are kept, restoring it puts them back (no store
+  // read), and spilled_bytes() encodes them. At most `max_pending_nodes` wait: past that,
+  // enforce() waits for the writer. A put() that throws puts the region back at the next
+  // enforce(), which then throws (nothing was lost).
+  void start_background_writes(uint64_t max_pending_nodes);
+  // Nodes detached and not yet let go (pending writes), for the caller's memory count.
+  uint64_t pending_nodes() const;
 
   // The regions named are about to be read or changed: each becomes the most recently
   // touched, and each spilled one (with its parent's other children) is brought back.
@@ -77,13 +103,24 @@ class RegionResidency {
   // own count: memoryUsage() walks the whole tree), spilling at most `max_groups` sibling
   // groups (a caller that spreads eviction over several calls). A put() that throws leaves
   // that region in the tree and ends the call with the exception (nothing was lost).
-  EnforceResult enforce(octomap::OcTree& tree, uint64_t bytes_now, uint64_t target, size_t max_groups = SIZE_MAX);
+  // `budget_ms` (> 0) ends the call between two groups once that much time has gone and the
+  // memory is within the bound (at least one group goes): a caller that spreads the way from
+  // the bound down to `target` over several calls.
+  EnforceResult enforce(octomap::OcTree& tree, uint64_t bytes_now, uint64_t target, size_t max_groups = SIZE_MAX,
+                        double budget_ms = 0);
+  // The bytes of spilled region `id` (the store's, or a pending region's encoded from its
+  // kept nodes). Call while nothing changes the tree (any lock that keeps writers out).
+  std::vector<uint8_t> spilled_bytes(RegionId id) const;
+  // Waits until every pending region is in the store.
+  void flush();
   // Brings one spilled region back without counting it as touched (a sweep visiting every
   // region must not make the whole map "recent"). No-op when it is not spilled.
   void bring_back(octomap::OcTree& tree, RegionId id) { restore(tree, id); }
   // Region `id` is in the spill already (`bytes` of it) and a stand-in in the tree: a map
   // loaded under the bound (octree/map_file_split.h). Not counted as an eviction.
   void adopt_spilled(RegionId id, uint64_t bytes);
+  // The same with the region's bytes, which go to the spill first (throws when it refuses).
+  void adopt_spilled(RegionId id, std::span<const uint8_t> bytes);
   // The spilled regions whose cubes meet the key box [lo, hi] (inclusive).
   std::vector<RegionId> spilled_in(const octomap::OcTreeKey& lo, const octomap::OcTreeKey& hi) const;
   std::vector<RegionId> spilled_ids() const;
@@ -96,6 +133,9 @@ class RegionResidency {
   // Brings every spilled region back (a whole-map save or snapshot without the bound).
   void restore_all(octomap::OcTree& tree);
   bool spilled(RegionId id) const { return spilled_.count(id) != 0; }
+  // After a failed or finished background put: puts failed regions back, lets written ones'
+  // nodes go (to the free_later hook). Throws the first failure's error after putting back.
+  void collect_writes(octomap::OcTree& tree);
   // The tree's memory as OctoMap's memoryUsage() counts it, exactly, without walking every
   // node (octree/region_tally.h): touches, restores and evictions tell the tally what they
   // change; whoever else changes the tree (edits, sweeps) calls changed_box or changed_all.
@@ -108,6 +148,21 @@ class RegionResidency {
 
  private:
   void restore(octomap::OcTree& tree, RegionId id);
+  void let_go(DetachedSubtree d);
+  // Background writes: detaches region `id` for the writer; returns the tree memory it freed.
+  uint64_t detach_for_writer(octomap::OcTree& tree, RegionId id);
+  void write_loop();
+  void stop_writer();
+
+  // A region detached and not yet let go (background writes).
+  struct Pending {
+    enum class State { kQueued, kWriting, kWritten, kFailed };
+    DetachedSubtree nodes;
+    float root_log_odds = 0;
+    State state = State::kQueued;
+    uint64_t bytes = 0;
+    std::string error;
+  };
 
   RegionGrid grid_;
   RegionSpill& spill_;
@@ -118,6 +173,20 @@ class RegionResidency {
   std::unordered_map<RegionId, uint64_t> spilled_;  // id -> bytes spilled
   ResidencyStats stats_;
   RegionTally tally_;
+
+  // Background writes: pending_ and queue_ (and the writer's costs) behind write_mutex_; the
+  // writer reads a pending region's nodes without it (nothing else touches them then).
+  bool background_ = false;
+  uint64_t max_pending_nodes_ = 0, pending_nodes_ = 0;
+  mutable std::mutex write_mutex_;
+  mutable std::mutex spill_mutex_;  // every call into spill_ (the writer's puts and this thread's reads)
+  std::condition_variable written_, wake_writer_;
+  std::unordered_map<RegionId, Pending> pending_;
+  std::deque<RegionId> queue_;
+  size_t writes_done_ = 0;  // kWritten or kFailed entries in pending_
+  double writer_encode_ms_ = 0, writer_put_ms_ = 0;
+  bool stopping_ = false;
+  std::thread writer_;
 };
 
 }  // namespace ort

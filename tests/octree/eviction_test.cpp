@@ -2,11 +2,14 @@
 // real scans: a map built with regions spilled past a small bound and brought back when a scan
 // touches them is, once everything is back, the map built without the bound, node for node
 // and log-odds for log-odds (and OctoMap's own file bytes).
+#include <chrono>
 #include <map>
 #include <memory>
 #include <span>
 #include <sstream>
+#include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -33,6 +36,22 @@ class MemorySpill : public RegionSpill {
   std::vector<uint8_t> get(RegionId id) override { return regions.at(id); }
   void erase(RegionId id) override { regions.erase(id); }
   std::map<RegionId, std::vector<uint8_t>> regions;
+};
+
+// A store that is slow (so the background writer lags behind and restores find regions not
+// yet written) and refuses every `refuse_every`-th put (0: none).
+class SlowRefusingSpill : public MemorySpill {
+ public:
+  explicit SlowRefusingSpill(int refuse_every) : refuse_every_(refuse_every) {}
+  void put(RegionId id, std::span<const uint8_t> b) override {
+    std::this_thread::sleep_for(std::chrono::microseconds(300));
+    if (refuse_every_ > 0 && ++puts_ % refuse_every_ == 0) throw std::runtime_error("disk full (test)");
+    MemorySpill::put(id, b);
+  }
+
+ private:
+  int refuse_every_;
+  int puts_ = 0;
 };
 
 std::string ot_bytes(const octomap::OcTree& t) {
@@ -184,6 +203,56 @@ TEST(Eviction, ExactMemoryCountEqualsTheWalkAfterEveryChange) {
   query::clear_box(tree, small, query::ClearTo::kUnknown);
   ASSERT_NE(tree.memoryUsage(), before);
   EXPECT_NE(residency.memory(tree), tree.memoryUsage());
+}
+
+// Eviction with the encode and the store's write on the writer thread: the map is the
+// unbounded one whether a region came back from the store or from its kept nodes (before its
+// bytes were written), a refused write puts the region back, and a whole-map copy taken with
+// regions pending (spilled_bytes) is the whole map.
+TEST(Eviction, BackgroundWritesKeepTheMapAndLoseNothingARefusedWriteHeld) {
+  const std::vector<VoxelList> lists = test::shoot_real_scans("3dtk_dat/3dtk_3scans.graph", 2);
+  ASSERT_FALSE(lists.empty());
+  octomap::OcTree unbounded(0.1);
+  OctreeStage stage(OctreeUpdateOptions{OctreeUpdateMode::kBatched, 2});
+  for (int pass = 0; pass < 2; ++pass)
+    for (const VoxelList& l : lists) stage.apply(unbounded, l);
+  const uint64_t bound = unbounded.memoryUsage() / 3;
+
+  octomap::OcTree bounded(0.1);
+  SlowRefusingSpill spill(7);
+  const RegionGrid grid = region_grid(10);
+  RegionResidency residency(grid, spill, bound);
+  residency.start_background_writes(20'000);  // small: enforce also waits for room
+  size_t refusals = 0, copies = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const VoxelList& l : lists) {
+      residency.touch_voxels(bounded, l);
+      stage.apply(bounded, l);
+      try {
+        residency.enforce(bounded, residency.memory(bounded), bound * 9 / 10);
+      } catch (const std::runtime_error&) {
+        ++refusals;
+      }
+      ASSERT_EQ(residency.memory(bounded), bounded.memoryUsage()) << "the exact count with regions pending";
+      // A whole-map copy while regions are pending or written (as map_snapshot.cpp takes it).
+      octomap::OcTree copy(bounded);
+      for (RegionId id : residency.spilled_ids()) restore_region(copy, grid, id, residency.spilled_bytes(id));
+      ++copies;
+    }
+  }
+  octomap::OcTree last_copy(bounded);
+  for (RegionId id : residency.spilled_ids()) restore_region(last_copy, grid, id, residency.spilled_bytes(id));
+  EXPECT_TRUE(test::same_tree(unbounded, last_copy)) << "a copy with regions pending is the whole map";
+  const ResidencyStats st = residency.stats();
+  EXPECT_GT(st.evictions, 20u);
+  EXPECT_GT(st.costs.reattached, 0u) << "some restores found their region not yet let go";
+  EXPECT_GT(refusals, 0u) << "refused writes reach the caller";
+  residency.flush();
+  residency.restore_all(bounded);
+  EXPECT_TRUE(spill.regions.empty());
+  ASSERT_TRUE(test::same_tree(unbounded, bounded));
+  EXPECT_EQ(ot_bytes(unbounded), ot_bytes(bounded));
+  EXPECT_GT(copies, 0u);
 }
 
 TEST(Eviction, BoundedBuildOfRealScansIsTheUnboundedMap) {

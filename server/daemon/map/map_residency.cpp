@@ -13,7 +13,6 @@ namespace ort::daemon {
 MapResidency::MapResidency(MapState& map, const RegionGrid& grid, RegionSpill& spill, uint64_t max_bytes, Log log)
     : map_(map),
       grid_(grid),
-      spill_(spill),
       max_bytes_(max_bytes),
       log_(std::move(log)),
       // What waits to be freed: at most about a quarter of the bound (OctoMap's bytes a node).
@@ -21,6 +20,10 @@ MapResidency::MapResidency(MapState& map, const RegionGrid& grid, RegionSpill& s
       residency_(grid, spill, max_bytes) {
   stats_.max_bytes = max_bytes;
   residency_.set_free_later([this](DetachedSubtree d) { reaper_.push(d); });
+  // Encoding and the store's writes go to the residency's writer thread: an eviction on
+  // stage 2 only counts and detaches a region's nodes. As many may wait as the reaper holds.
+  residency_.start_background_writes(
+      std::max<uint64_t>(uint64_t(1) << 16, max_bytes / 4 / sizeof(octomap::OcTreeNode)));
 }
 
 // The one place eviction and restore are counted as a change of the map (its state id,
@@ -76,18 +79,20 @@ void MapResidency::note_costs(double touch_ms, double enforce_ms, double walk_ms
 
 std::string residency_cost_line(const MapResidencyStats& a, const MapResidencyStats& b) {
   const ResidencyCosts &x = a.costs, &y = b.costs;
-  char line[768];
+  char line[1024];
   std::snprintf(line, sizeof line,
                 "memory bound costs: %llu passes evicted %llu regions in %.1f ms (most %.1f ms a pass; walks %.1f, "
                 "list %.1f, encode %.1f, store write %.1f, strip %.1f); %llu restores in %.1f ms (most %.1f ms a "
-                "scan; store read %.1f, rebuild %.1f); exact counts recounted %llu regions, reused %llu",
+                "scan; store read %.1f, rebuild %.1f); exact counts recounted %llu regions, reused %llu; off stage: "
+                "sizing %.1f ms, waits for the writer %.1f ms, %llu restores from kept nodes",
                 (unsigned long long)(b.enforce_passes - a.enforce_passes),
                 (unsigned long long)(b.evictions - a.evictions), b.enforce_ms - a.enforce_ms, b.max_enforce_ms,
                 b.walk_ms - a.walk_ms, y.list_ms - x.list_ms, y.encode_ms - x.encode_ms, y.put_ms - x.put_ms,
                 y.strip_ms - x.strip_ms, (unsigned long long)(b.restores - a.restores), b.touch_ms - a.touch_ms,
                 b.max_touch_ms, y.get_ms - x.get_ms, y.rebuild_ms - x.rebuild_ms,
                 (unsigned long long)(b.regions_recounted - a.regions_recounted),
-                (unsigned long long)(b.regions_reused - a.regions_reused));
+                (unsigned long long)(b.regions_reused - a.regions_reused), y.size_ms - x.size_ms,
+                y.write_wait_ms - x.write_wait_ms, (unsigned long long)(y.reattached - x.reattached));
   return line;
 }
 
@@ -106,7 +111,33 @@ bool MapResidency::touch_scan(octomap::OcTree& tree, std::span<const VoxelUpdate
     stats_.last_error = error;
     return false;
   }
-  if (residency_.stats().restores != before) count_residency_change();
+  if (residency_.stats().restores != before) {
+    count_residency_change();
+    // Restores can take the tree past the bound before the update adds to it: room is made
+    // now (the scan's regions, just touched, go last), so the map stays near the bound at
+    // every moment, not only after the scan. The count that pass makes took the scan's
+    // regions as counted: they are touched again (nothing to restore unless the pass took
+    // one), so the update's changes to them are recounted.
+    const double touch_ms = ms_since(t0);
+    // The estimate (bytes a node at the last count) can miss what restored regions weigh:
+    // near the bound, the count decides.
+    if (estimate(tree) > static_cast<uint64_t>(kSoftStart * static_cast<double>(max_bytes_))) {
+      enforce_locked(tree, /*exact=*/true);
+      try {
+        residency_.touch_voxels(tree, voxels);
+      } catch (const std::exception& e) {
+        error = std::string("a region of the scan could not be read back from the region store: ") + e.what();
+        publish_stats(tree);
+        std::lock_guard s(stats_mutex_);
+        stats_.restore_failures++;
+        stats_.last_error = error;
+        return false;
+      }
+    }
+    publish_stats(tree);
+    note_costs(touch_ms, 0, 0);
+    return true;
+  }
   publish_stats(tree);
   note_costs(ms_since(t0), 0, 0);
   return true;
@@ -150,15 +181,19 @@ bool MapResidency::any_spilled_in(std::span<const query::KeyBox> boxes) const {
 
 void MapResidency::enforce(octomap::OcTree& tree) {
   std::lock_guard lock(mutex_);
+  enforce_locked(tree);
+}
+
+void MapResidency::enforce_locked(octomap::OcTree& tree, bool exact) {
   const uint64_t estimated = estimate(tree);
   const auto soft = static_cast<uint64_t>(kSoftStart * static_cast<double>(max_bytes_));
-  if (estimated <= soft) return publish_stats(tree);
+  if (estimated <= soft && !exact) return publish_stats(tree);
   const auto target = static_cast<uint64_t>(kLowWater * static_cast<double>(max_bytes_));
   const auto t0 = SteadyClock::now();
   double walk_ms = 0;
   uint64_t bytes = estimated;
   size_t groups = 1;  // between the soft start and the bound: one sibling group a change
-  if (estimated > max_bytes_ || bytes_per_node_ <= 0) {
+  if (exact || estimated > max_bytes_ || bytes_per_node_ <= 0) {
     // Over by the estimate: count exactly (the tally recounts only what changed since its
     // last count), and go down to the low-water mark at once.
     bytes = residency_.memory(tree);
@@ -170,7 +205,7 @@ void MapResidency::enforce(octomap::OcTree& tree) {
     const uint64_t before = residency_.stats().evictions;
     EnforceResult r;
     try {
-      r = residency_.enforce(tree, bytes, groups == 1 ? soft : target, groups);
+      r = residency_.enforce(tree, bytes, groups == 1 ? soft : target, groups, kSliceMs);
     } catch (const std::exception& e) {  // the store refused a put: that region stays here
       std::lock_guard s(stats_mutex_);
       if (stats_.evict_failures++ == 0 || stats_.evict_failures % 1000 == 0)
@@ -209,8 +244,7 @@ SweepSpill MapResidency::sweep_hooks(const RegionGrid& sweep) {
 
 void MapResidency::adopt_loaded(RegionId id, std::span<const uint8_t> bytes) {
   std::lock_guard lock(mutex_);
-  spill_.put(id, bytes);
-  residency_.adopt_spilled(id, bytes.size());
+  residency_.adopt_spilled(id, bytes);
 }
 
 void MapResidency::forget_all() {
@@ -227,7 +261,7 @@ void MapResidency::forget_all() {
 MapResidency::SpilledRegions MapResidency::spilled_regions() const {
   std::lock_guard lock(mutex_);
   SpilledRegions out;
-  for (RegionId id : residency_.spilled_ids()) out.emplace_back(id, spill_.get(id));
+  for (RegionId id : residency_.spilled_ids()) out.emplace_back(id, residency_.spilled_bytes(id));
   return out;
 }
 

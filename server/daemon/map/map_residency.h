@@ -69,6 +69,11 @@ class MapResidency {
   // long pass; past the bound itself (counted exactly) it spills down to kLowWater at once.
   static constexpr double kSoftStart = 0.95;
   static constexpr double kLowWater = 0.9;
+  // The most one change's eviction pass takes (ms) once the map is within the bound: it
+  // stops between two sibling groups, and the next change goes on down to kLowWater. The way
+  // back to the bound itself is never cut. Eviction only counts and detaches nodes (the
+  // writer thread encodes and stores them).
+  static constexpr double kSliceMs = 3;
   // How often the cost breakdown is logged while regions move.
   static constexpr double kCostReportS = 10;
 
@@ -112,11 +117,12 @@ class MapResidency {
 
  private:
   void count_residency_change();
+  // enforce() with mutex_ held; `exact`: counts the memory exactly whatever the estimate says.
+  void enforce_locked(octomap::OcTree& tree, bool exact = false);
   uint64_t estimate(const octomap::OcTree& tree) const;
 
   MapState& map_;
   RegionGrid grid_;
-  RegionSpill& spill_;
   uint64_t max_bytes_;
   Log log_;
   void publish_stats(const octomap::OcTree& tree);

@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "core/clock.h"
+#include "core/file_checks/bt_file.h"
 #include "core/file_checks/octree_file_check.h"
 #include "daemon/persistence/map_identity_file.h"
 
@@ -185,10 +186,24 @@ std::unique_ptr<octomap::OcTree> load_prior_map(const std::string& path, double 
     throw MapStoreError(other_tree ? Kind::kWrongType : Kind::kCorrupt,
                         "prior map '" + path + "' is not a complete OctoMap OcTree file (.bt or .ot): " + check.error);
   }
-  // A .ot prior is split like the map file; a .bt one (another body) is loaded whole, and the
-  // bound's first pass takes it down.
-  if (bound && check.format == OctreeFileFormat::kFull)
+  // A .ot prior is split like the map file; a .bt one is first turned into the .ot readBinary
+  // and the value rule below would make of it (core/file_checks/bt_file.h), then split the same way.
+  const bool binary = check.format == OctreeFileFormat::kBinary;
+  bool values_set = false;
+  if (bound && binary) {
+    try {
+      bytes = ot_file_from_bt(bytes, check.data_offset, octomap::logodds(sensor.clamping_max),
+                              octomap::logodds(sensor.clamping_min));
+    } catch (const std::runtime_error& e) {
+      throw MapStoreError(Kind::kCorrupt, "prior map '" + path + "': " + e.what());
+    }
+    const OctreeFileCheck ot = check_octree_file(bytes);
+    if (!ot.ok) throw MapStoreError(Kind::kCorrupt, "prior map '" + path + "' as .ot: " + ot.error);
+    keep_within_bound(bytes, ot.data_offset, *bound, "prior map '" + path + "'");
+    values_set = true;
+  } else if (bound) {
     keep_within_bound(bytes, check.data_offset, *bound, "prior map '" + path + "'");
+  }
   std::unique_ptr<octomap::OcTree> tree;
   try {
     tree = read_octree_file_bytes(bytes, "prior map '" + path + "'");
@@ -196,7 +211,7 @@ std::unique_ptr<octomap::OcTree> load_prior_map(const std::string& path, double 
     throw MapStoreError(Kind::kCorrupt, e.what());
   }
   require_resolution(*tree, resolution, path, "--prior");
-  if (check.format == OctreeFileFormat::kBinary) {
+  if (binary && !values_set) {
     // readBinary gave every node OctoMap's default clamping bounds: move them to this sensor
     // model's (a monotonic map, so inner nodes stay their children's maximum).
     const float occupied = octomap::logodds(sensor.clamping_max), free = octomap::logodds(sensor.clamping_min);
