@@ -19,19 +19,26 @@
 #   docs/bench/dev/issue25-bound/summary.py docs/bench/gpu/issue25-bound
 #   docs/bench/dev/issue25-bound/plot.sh docs/bench/gpu/issue25-bound docs/bench/gpu/issue25-bound/bound.png \
 #     "skt-corridor, 4 robots x 10 Hz, H200, bound 8MiB (round 1)" -r1
-. docs/bench/gpu/lib.sh issue25b
+# Shorter calls (a share of one call): SECS=40 ROUNDS=1 (one off and one on round, ~2.5 min);
+# OLD=issue25b-old (a second bundle, built like the first from an older commit) adds a round
+# "oldon-rK" with the old binary and the bound on after each on round (same call, same load:
+# the before/after of a change to the bound).
+secs=${SECS:-60}; rounds=${ROUNDS:-2}
+. docs/bench/gpu/lib.sh issue25b ${OLD:-}
 ( while :; do echo "$(date -u +%T) $(cut -d' ' -f1-3 /proc/loadavg) $(nproc)"; sleep 15; done ) > "$O/load.txt" &
 load_pid=$!
-for round in 1 2; do
-  for mode in off on; do
-    left 350 || break 2
+modes="off on"; [ -n "$OLD" ] && modes="off on oldon"
+for round in $(seq 1 "$rounds"); do
+  for mode in $modes; do
+    left $((470 - secs - 45)) || break 2
     log "bound-$mode-r$round"
     rm -rf "$T/$mode.ot" "$T/$mode.ot".*
     extra=(--map "$T/$mode.ot")
-    [ "$mode" = on ] && extra+=(--max-map-memory 8MiB)
+    [ "$mode" != off ] && extra+=(--max-map-memory 8MiB)
+    bin=$N/bin; [ "$mode" = oldon ] && bin=$OLD/bin
     r="$mode-r$round"
-    timeout 100 "$N/bin/octomap-rt-loadtest" --server "$N/bin/octomap-rt-server" --producers 4 --rate 10 \
-      --duration 60 --settle 20 --points 89000 --scene skt-corridor \
+    timeout $((secs + 40)) "$N/bin/octomap-rt-loadtest" --server "$bin/octomap-rt-server" --producers 4 --rate 10 \
+      --duration "$secs" --settle 20 --points 89000 --scene skt-corridor \
       --series "$O/series-$r.csv" --log "$O/server-$r.log" -- -r 0.1 --backend vulkan "${extra[@]}" \
       > "$O/report-$r.txt" 2>&1
     echo "rc=$?" >> "$O/report-$r.txt"

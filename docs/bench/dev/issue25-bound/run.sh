@@ -8,7 +8,8 @@
 # MODES="off on" by default; MODES=on runs only the bounded run (beside an earlier off run).
 # ROUNDS=N alternates the modes N times (off, on, off, on, ...: the machine's load falls on
 # both alike); round k's files are series-MODE-rK.csv, report-MODE-rK.txt, server-MODE-rK.log
-# (ROUNDS unset: one round, files without the suffix, as before).
+# (ROUNDS unset: one round, files without the suffix, as before). MODE oldon: the bound on with
+# the server of OLD_BUILD (an older build dir: the same load's before/after of a change).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 b=${1:-build}; o=${2:-$here/out}; secs=${3:-240}; bound=${4:-8MiB}; scene=${5:-fr079-real}
@@ -26,9 +27,10 @@ for round in $(seq 1 "${ROUNDS:-1}"); do
   for mode in ${MODES:-off on}; do
     rm -rf "$maps/$mode.ot" "$maps/$mode.ot".*
     extra=(--map "$maps/$mode.ot")
-    [ "$mode" = on ] && extra+=(--max-map-memory "$bound")
+    [ "$mode" != off ] && extra+=(--max-map-memory "$bound")
+    server=$b/server/octomap-rt-server; [ "$mode" = oldon ] && server=${OLD_BUILD:?oldon needs OLD_BUILD}/server/octomap-rt-server
     echo "scene $scene, $secs s, server flags: ${flags[*]} ${extra[*]}" > "$o/report-$mode$suffix.txt"
-    "$b/tools/loadtest/octomap-rt-loadtest" --server "$b/server/octomap-rt-server" --producers 2 --rate 2 \
+    "$b/tools/loadtest/octomap-rt-loadtest" --server "$server" --producers 2 --rate 2 \
       --duration "$secs" --points 20000 --scene "$scene" --data "$data" --series "$o/series-$mode$suffix.csv" \
       --log "$o/server-$mode$suffix.log" -- "${flags[@]}" "${extra[@]}" >> "$o/report-$mode$suffix.txt" 2>&1 ||
       echo "loadtest exit $?" >> "$o/report-$mode$suffix.txt"

@@ -4,7 +4,7 @@ K the round when run.sh alternated rounds), the status windows' end-to-end and o
 run's second half (median and max), the tree memory's and RSS's most over it, the bound, and the
 evictions and restores at the end; then the ratio of the bounded runs' p99 to the unbounded ones'
 (medians over the rounds), and where the bound's time went (the server's "memory bound costs"
-lines in server-on[-rK].log, summed over the run).
+lines in server-on[-rK].log, summed over the run). MODE oldon: the bound on with an older binary.
     summary.py OUT_DIR"""
 import csv
 import re
@@ -18,9 +18,9 @@ from bound_costs import bound_costs, costs_text  # noqa: E402 (docs/bench/dev/bo
 out = Path(sys.argv[1])
 print("run      e2e p99 ms (median, max)  octree p99 ms (median, max)  tree MiB max  RSS MiB max  bound MiB"
       "  evictions  restores")
-per_mode = {"off": [], "on": []}
+per_mode = {"off": [], "on": [], "oldon": []}
 for path in sorted(out.glob("series-*.csv")):
-    m = re.fullmatch(r"series-(off|on)(-r\d+)?\.csv", path.name)
+    m = re.fullmatch(r"series-(off|on|oldon)(-r\d+)?\.csv", path.name)
     if not m:
         continue
     mode, mode_run = m.group(1), m.group(1) + (m.group(2) or "")
@@ -37,15 +37,17 @@ for path in sorted(out.glob("series-*.csv")):
     print(f"{mode_run:8} {statistics.median(e2e):10.1f} {max(e2e):8.1f} {statistics.median(octree):14.1f} "
           f"{max(octree):8.1f} {tree:16.2f} {rss:11.1f} {float(rows[-1]['bound_mib']):10.1f} "
           f"{rows[-1]['region_evictions']:>10} {rows[-1]['region_restores']:>9}")
-if per_mode["off"] and per_mode["on"]:
+for bounded in ("on", "oldon"):  # oldon: the bound on with an older binary (OLD bundle or build)
+    if not (per_mode["off"] and per_mode[bounded]):
+        continue
     off_e2e = statistics.median(r[0] for r in per_mode["off"])
-    on_e2e = statistics.median(r[0] for r in per_mode["on"])
+    on_e2e = statistics.median(r[0] for r in per_mode[bounded])
     off_oct = statistics.median(r[1] for r in per_mode["off"])
-    on_oct = statistics.median(r[1] for r in per_mode["on"])
-    print(f"on / off (medians over {len(per_mode['on'])} and {len(per_mode['off'])} runs): e2e p99 "
+    on_oct = statistics.median(r[1] for r in per_mode[bounded])
+    print(f"{bounded} / off (medians over {len(per_mode[bounded])} and {len(per_mode['off'])} runs): e2e p99 "
           f"{on_e2e:.1f} / {off_e2e:.1f} = {on_e2e / off_e2e:.2f}x, octree p99 {on_oct:.1f} / {off_oct:.1f} = "
           f"{on_oct / off_oct:.2f}x")
-for path in sorted(out.glob("server-on*.log")):
+for path in sorted(list(out.glob("server-on*.log")) + list(out.glob("server-oldon*.log"))):
     total = bound_costs(path.open(errors="replace"))
     if any(total):
         print(f"{path.name}: " + costs_text(total))
