@@ -12,8 +12,8 @@
 #include <octomap/OcTree.h>
 
 #include "core/file_checks/octree_binary.h"
-#include "octree/versions/map_version.h"
 #include "octree/octree_update.h"
+#include "octree/versions/map_version.h"
 #include "random_batches.h"
 #include "real_scan_voxels.h"
 

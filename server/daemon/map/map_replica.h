@@ -51,9 +51,9 @@
 #include "core/voxel_update.h"
 #include "daemon/map/map_identity.h"
 #include "daemon/map/map_state.h"
-#include "octree/versions/map_version.h"
 #include "octree/octree_update.h"
 #include "octree/region.h"
+#include "octree/versions/map_version.h"
 
 namespace ort::daemon {
 
