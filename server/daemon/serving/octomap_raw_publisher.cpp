@@ -53,6 +53,7 @@ void OctomapRawPublisher::encode_if_changed() {
     const std::unique_ptr<octomap::OcTree> tree = v->map->tree();
     if (band) drop_occupied_outside_band(*tree, cfg_.occupancy_min_z, cfg_.occupancy_max_z);
     raw = make_raw_map(*tree, v->last_scan_utime, options);
+    ++encodings_;
   } else if (map_.replica && !band) {
     // Without versions: encoded straight from the read replica, under its lock (its thread waits).
     MapState& r = readable_map(map_);

@@ -50,8 +50,9 @@ class OctomapRawPublisher {
   // For the status: "" while the whole map goes out; else what was cut or why nothing is sent.
   std::string note() const;
   int64_t published() const { return published_; }
-  // Whole-map copies made (only when the map changed, and only to drop cells outside the
-  // occupancy band when there is a read replica) and encodings made (one per map version).
+  // Whole-map copies made under a lock (only when the map changed, and with a read replica
+  // only without versions, to drop cells outside the occupancy band) and encodings made (one
+  // per map version; a tree made from a replica's version is the publisher's own, no copy).
   int64_t map_copies() const { return map_copies_; }
   int64_t encodings() const { return encodings_; }
 
