@@ -54,6 +54,20 @@ void reset_extent(double* mn, double* mx) {
     mn[a] = std::numeric_limits<double>::max(), mx[a] = -std::numeric_limits<double>::max();
 }
 
+// Calls fn(child, child's key) for each existing child of `node` (at `depth`, key `key`), in
+// OctoMap's child order: the order writeNodesRecurs writes them.
+template <class Fn>
+void for_each_child(const octomap::OcTree& tree, const octomap::OcTreeNode* node, const octomap::OcTreeKey& key,
+                    unsigned depth, Fn&& fn) {
+  const octomap::key_type offset = kRootKey >> (depth + 1);
+  for (unsigned i = 0; i < 8; ++i)
+    if (tree.nodeChildExists(node, i)) {
+      octomap::OcTreeKey child;
+      octomap::computeChildKey(i, offset, key, child);
+      fn(tree.getNodeChild(node, i), child);
+    }
+}
+
 // writeNodesRecurs below `node` into `r`, with the keys OctoMap's leaf iterator gives.
 void write_subtree(const octomap::OcTree& tree, const octomap::OcTreeNode* node, const octomap::OcTreeKey& key,
                    unsigned depth, RegionBytes& r) {
@@ -63,13 +77,9 @@ void write_subtree(const octomap::OcTree& tree, const octomap::OcTreeNode* node,
     extend(tree, key, depth, r.min, r.max);
     return;
   }
-  const octomap::key_type offset = kRootKey >> (depth + 1);
-  for (unsigned i = 0; i < 8; ++i)
-    if (tree.nodeChildExists(node, i)) {
-      octomap::OcTreeKey child;
-      octomap::computeChildKey(i, offset, key, child);
-      write_subtree(tree, tree.getNodeChild(node, i), child, depth + 1, r);
-    }
+  for_each_child(tree, node, key, depth, [&](const octomap::OcTreeNode* c, const octomap::OcTreeKey& k) {
+    write_subtree(tree, c, k, depth + 1, r);
+  });
 }
 
 }  // namespace
@@ -182,13 +192,8 @@ void MapVersionBuilder::walk(const octomap::OcTree& tree, const octomap::OcTreeN
     extend(tree, key, depth, v.min_, v.max_);
     return;
   }
-  const octomap::key_type offset = kRootKey >> (depth + 1);
-  for (unsigned i = 0; i < 8; ++i)
-    if (tree.nodeChildExists(node, i)) {
-      octomap::OcTreeKey child;
-      octomap::computeChildKey(i, offset, key, child);
-      walk(tree, tree.getNodeChild(node, i), child, depth + 1, v);
-    }
+  for_each_child(tree, node, key, depth,
+                 [&](const octomap::OcTreeNode* c, const octomap::OcTreeKey& k) { walk(tree, c, k, depth + 1, v); });
 }
 
 std::shared_ptr<const MapVersion> MapVersionBuilder::build(const octomap::OcTree& tree) {
