@@ -24,19 +24,14 @@
 #include "query/map_edit.h"
 #include "real_scan_voxels.h"
 #include "scene/scan_set.h"
+#include "support/memory_spill.h"
 #include "support/test_data.h"
 #include "tree_checks.h"
 
 namespace ort {
 namespace {
 
-class MemorySpill : public RegionSpill {
- public:
-  void put(RegionId id, std::span<const uint8_t> b) override { regions[id].assign(b.begin(), b.end()); }
-  std::vector<uint8_t> get(RegionId id) override { return regions.at(id); }
-  void erase(RegionId id) override { regions.erase(id); }
-  std::map<RegionId, std::vector<uint8_t>> regions;
-};
+using test::MemorySpill;
 
 // A store that is slow (so the background writer lags behind and restores find regions not
 // yet written) and refuses every `refuse_every`-th put (0: none).

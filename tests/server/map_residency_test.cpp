@@ -20,19 +20,12 @@
 #include "octree/octree_update.h"
 #include "scene/scan_set.h"
 #include "server/scan_fixtures.h"
+#include "support/memory_spill.h"
 #include "support/test_data.h"
 #include "support/tree_compare.h"
 
 namespace ort::test {
 namespace {
-
-class MemorySpill : public RegionSpill {
- public:
-  void put(RegionId id, std::span<const uint8_t> b) override { regions[id].assign(b.begin(), b.end()); }
-  std::vector<uint8_t> get(RegionId id) override { return regions.at(id); }
-  void erase(RegionId id) override { regions.erase(id); }
-  std::map<RegionId, std::vector<uint8_t>> regions;
-};
 
 // The real 3DTK scans cut into wedges around their sensor (each of them sees the whole map; a
 // scan that sees more than the bound cannot fit it), every 4th point, shot as the daemon does.
