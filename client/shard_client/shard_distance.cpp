@@ -58,6 +58,16 @@ std::vector<uint32_t> shards_meeting(const protocol::ShardSet& set, std::array<i
     if (hi[a] < lo[a]) return {};
     r0[a] = uint32_t(lo[a]) >> shift, r1[a] = uint32_t(hi[a]) >> shift;
   }
+  if (set.rule == protocol::ShardRule::kBoxes) {  // the boxes met, without a walk over the regions
+    std::vector<uint32_t> out;
+    for (uint32_t i = 0; i < set.count && i < set.boxes.size(); ++i) {
+      const protocol::RegionBox& b = set.boxes[i];
+      bool meet = true;
+      for (int a = 0; a < 3; ++a) meet = meet && r0[a] < b.max[a] && r1[a] >= b.min[a];
+      if (meet) out.push_back(i);
+    }
+    return out;
+  }
   std::vector<bool> meets(set.count, false);
   uint32_t found = 0;
   for (uint32_t z = r0[2]; z <= r1[2] && found < set.count; ++z)

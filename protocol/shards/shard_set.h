@@ -24,6 +24,11 @@ enum class ShardRule : int8_t {
   kBoxes = 2,  // shard i owns the regions of box i; the boxes tile the key space
 };
 
+// The regions' default depth: 8 voxels a side (0.8 m at 0.1 m). Fine enough that one indoor
+// scan's voxels spread evenly over the hash rule's shards (coarser regions are too few for one
+// scan: the busiest shard gets several times the mean; docs/BENCHMARKS.md, "Shards").
+inline constexpr uint32_t kDefaultShardRegionDepth = 13;
+
 struct RegionCoords {
   uint32_t x = 0, y = 0, z = 0;
 };
@@ -40,8 +45,8 @@ struct ShardSet {
   uint32_t index = 0;  // this daemon's shard, 0 .. count - 1
   uint32_t count = 1;
   ShardRule rule = ShardRule::kWhole;
-  uint32_t region_depth = 10;    // 1 .. 16
-  std::vector<RegionBox> boxes;  // kBoxes: box i is shard i's, `count` of them
+  uint32_t region_depth = kDefaultShardRegionDepth;  // 1 .. 16
+  std::vector<RegionBox> boxes;                      // kBoxes: box i is shard i's, `count` of them
   bool sharded() const { return rule != ShardRule::kWhole; }
 };
 

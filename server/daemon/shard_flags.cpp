@@ -37,7 +37,8 @@ void add_shard_flags(CLI::App& app, ShardFlags& f) {
                  "(repeat): shard i owns the regions whose min corner lies in box i; the boxes must cover the key "
                  "space without overlap");
   app.add_option("--shard-region-depth", f.region_depth,
-                 "octree depth of the regions shards own (10: 64 voxels a side)")
+                 "octree depth of the regions shards own (13: 8 voxels a side; coarser regions balance the "
+                 "hash rule's shards worse, docs/BENCHMARKS.md \"Shards\")")
       ->capture_default_str();
 }
 

@@ -11,13 +11,14 @@
 #include <CLI/CLI.hpp>
 
 #include "daemon/server_config.h"
+#include "protocol/shards/shard_set.h"
 
 namespace ort::daemon {
 
 struct ShardFlags {
   std::string shard;               // "i/N"; "": not sharded
   std::vector<std::string> boxes;  // "X0,Y0,Z0:X1,Y1,Z1" in metres, inf allowed
-  unsigned region_depth = 10;
+  unsigned region_depth = protocol::kDefaultShardRegionDepth;
 };
 
 void add_shard_flags(CLI::App& app, ShardFlags& f);

@@ -1,4 +1,4 @@
-// octomap-rt-shard-bench GRAPH -r RES [--shards 1,2,3,4] [--depth 10] [--backend cpu-grid]
+// octomap-rt-shard-bench GRAPH -r RES [--shards 1,2,3,4] [--depth 13] [--backend cpu-grid]
 //                        [--rule hash|boxes] [--clip]
 //
 // One process, one thread a stage: every scan is encoded as a robot sends it (scan_t), decoded
@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
   CLI::App app("octomap-rt-shard-bench: per-shard cost of a shard set against one daemon");
   std::string input, backend = "cpu-grid", shards = "1,2,3,4";
   double res = 0.1, max_range = -1;
-  unsigned depth = 10;
+  unsigned depth = ort::protocol::kDefaultShardRegionDepth;
   int repeat = 1, only = -1;
   bool clip = false;
   std::string rule = "hash";
@@ -179,8 +179,9 @@ int main(int argc, char** argv) {
   else
     std::printf("every shard: decode %.2f ms, walk %.2f ms a scan (rule %s)\n", decode_ms / n, walk_ms / n,
                 rule.c_str());
-  std::printf("%6s %12s %14s %14s %12s %12s %12s %12s %14s %10s\n", "shards", "cut ms", "update ms max",
-              "update ms mean", "voxels max", "walk ms max", "walk ms mean", "rays kept", "bound scans/s", "merged");
+  std::printf("%6s %12s %14s %14s %12s %12s %12s %12s %14s %10s %14s\n", "shards", "cut ms", "update ms max",
+              "update ms mean", "voxels max", "walk ms max", "walk ms mean", "rays kept", "bound scans/s", "merged",
+              "voxels max/mean");
   const octomap::OcTree* whole = nullptr;
   for (size_t s = 0; s < sizes.size(); ++s)
     if (sizes[s] == 1) whole = runs[s].trees[0].get();
@@ -192,6 +193,11 @@ int main(int argc, char** argv) {
     for (double a : r.apply_ms) upd_sum += a;
     if (only >= 0) upd_sum = upd_max * n;  // the one shard kept: the mean is its own
     const uint64_t vox = *std::max_element(r.voxels.begin(), r.voxels.end());
+    uint64_t vox_sum = 0;
+    for (uint64_t v : r.voxels) vox_sum += v;
+    // The busiest shard's voxels against the mean shard's: the set's load imbalance (every
+    // shard kept; with --only-shard the others are not counted).
+    const double imbalance = only >= 0 || vox_sum == 0 ? 0 : double(vox) * double(r.voxels.size()) / double(vox_sum);
     // Without --clip every shard's walk is the one shared walk.
     const size_t kept_shards = only >= 0 ? 1 : r.trees.size();
     double walk_max = walk_ms / n, walk_sum = 0;
@@ -211,9 +217,9 @@ int main(int argc, char** argv) {
       const auto m = ort::client::merge_shard_trees(views, depth);
       merged = (m->size() == whole->size() && *m == *whole) ? "identical" : "DIFFERS";
     }
-    std::printf("%6d %12.2f %14.2f %14.2f %12.0f %12.2f %12.2f %11.1f%% %14.1f %10s\n", sizes[s], cut, upd_max,
+    std::printf("%6d %12.2f %14.2f %14.2f %12.0f %12.2f %12.2f %11.1f%% %14.1f %10s %14.2f\n", sizes[s], cut, upd_max,
                 upd_sum / n / double(kept_shards), vox / n, walk_max, walk_sum / n / double(kept_shards), 100 * kept,
-                1000.0 / (decode_ms / n + walk_max + cut + upd_max), merged.c_str());
+                1000.0 / (decode_ms / n + walk_max + cut + upd_max), merged.c_str(), imbalance);
   }
   return 0;
 }
