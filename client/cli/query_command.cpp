@@ -22,12 +22,13 @@ namespace ort::cli {
 void add_shards_flag(CLI::App* cmd, CommonArgs& a) {
   cmd->add_flag("--shards", a.shards,
                 "the namespace is a shard set (octomap-rt-server --shard): route by region, say which shard did "
-                "not answer (exit status 3); no --wait-robot/--min-snapshot");
+                "not answer (exit status 3); --wait-robot waits on every shard asked; no --min-snapshot (each shard "
+                "has its own map states)");
 }
 
 std::unique_ptr<ShardQueries> connect_shards(const CommonArgs& a) {
-  if (!a.wait_robot.empty() || a.min_snapshot != 0)
-    throw CLI::ValidationError("--shards", "does not wait for a robot or a map state (each shard has its own)");
+  if (a.min_snapshot != 0)
+    throw CLI::ValidationError("--shards", "does not wait for a map state (each shard has its own; --wait-robot does)");
   const std::string url = ort::protocol::lcm_url_or_default(a.lcm_url), ns = protocol::namespace_from(a.ns);
   const ShardRoster roster = find_shards_for_query(url, ns, a.timeout_s);
   const std::string id = a.client_id.empty() ? "cli-" + std::to_string(::getpid()) : a.client_id;
@@ -63,7 +64,7 @@ void register_points(CLI::App& parent) {
     }
     if (xyz.empty()) throw CLI::ValidationError("points", "give X,Y,Z points or --file");
     bool partial = false;
-    const auto r = a->shards ? routed(connect_shards(*a)->points(xyz, *depth), partial)
+    const auto r = a->shards ? routed(connect_shards(*a)->points(xyz, *depth, shard_wait(*a)), partial)
                              : connect(*a)->points(xyz, *depth, wait_for(*a));
     if (a->json) write_points_json(std::cout, xyz, r);
     if (refused(r)) std::exit(2);
@@ -93,7 +94,7 @@ void register_rays(CLI::App& parent) {
       d.insert(d.end(), {float(b.max[0]), float(b.max[1]), float(b.max[2])});
     }
     bool partial = false;
-    const auto r = a->shards ? routed(connect_shards(*a)->rays(o, d, *max_range, *ignore), partial)
+    const auto r = a->shards ? routed(connect_shards(*a)->rays(o, d, *max_range, *ignore, shard_wait(*a)), partial)
                              : connect(*a)->rays(o, d, *max_range, *ignore, wait_for(*a));
     if (a->json) write_rays_json(std::cout, r);
     if (refused(r)) std::exit(2);
@@ -135,7 +136,7 @@ void register_box(CLI::App& parent) {
       if (*region) throw CLI::ValidationError("--region", "is not routed across shards; ask each shard's namespace");
       bool partial = false;
       const int8_t mode = *any ? octomap_rt::box_query_t::MODE_ANY_OCCUPIED : octomap_rt::box_query_t::MODE_COUNTS;
-      const auto r = routed(connect_shards(*a)->boxes(bs, mode), partial);
+      const auto r = routed(connect_shards(*a)->boxes(bs, mode, shard_wait(*a)), partial);
       print_boxes(r, a->json);
       if (partial) std::exit(3);
       return;
@@ -181,7 +182,7 @@ void register_grid(CLI::App& parent) {
     }
     bool partial = false;
     const Box* win = window->empty() ? nullptr : &w;
-    const Grid g = a->shards ? routed(connect_shards(*a)->grid(z0, z1, *cell, win), partial)
+    const Grid g = a->shards ? routed(connect_shards(*a)->grid(z0, z1, *cell, win, shard_wait(*a)), partial)
                              : connect(*a)->grid(z0, z1, *cell, win, wait_for(*a));
     if (refused(g.header)) {
       if (a->json) write_grid_json(std::cout, g, "");

@@ -54,7 +54,7 @@ Grid merge_grids(const std::vector<const Grid*>& got) {
   return out;
 }
 
-Routed<Grid> ShardQueries::grid(double z_min, double z_max, double cell_size, const Box* window) {
+Routed<Grid> ShardQueries::grid(double z_min, double z_max, double cell_size, const Box* window, const ShardWait& w) {
   std::vector<uint32_t> which = detail::every_shard(set_.count);
   if (window) {  // only the shards owning a region the window's columns in the band meet
     const double lo[3] = {window->min[0], window->min[1], z_min}, hi[3] = {window->max[0], window->max[1], z_max};
@@ -66,8 +66,9 @@ Routed<Grid> ShardQueries::grid(double z_min, double z_max, double cell_size, co
     if (which.empty()) which = {0};
   }
   Routed<Grid> out;
-  const auto got = detail::ask_each<Grid>(
-      which, set_.count, out.shards, [&](uint32_t i) { return clients_[i]->grid(z_min, z_max, cell_size, window); });
+  const auto got = detail::ask_each<Grid>(which, set_.count, out.shards, [&](uint32_t i) {
+    return clients_[i]->grid(z_min, z_max, cell_size, window, w.on_shard(i));
+  });
   std::vector<const Grid*> views;
   for (const auto& g : got) views.push_back(g ? &*g : nullptr);
   out.reply = merge_grids(views);

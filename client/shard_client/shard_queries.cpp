@@ -38,6 +38,13 @@ void merged_header(Reply& out, const std::vector<std::optional<Reply>>& got) {
 
 }  // namespace
 
+WaitFor ShardWait::on_shard(uint32_t i) const {
+  WaitFor w;
+  w.robot_id = robot_id, w.seq = seq, w.timeout_ms = timeout_ms;
+  if (i < min_snapshot_ids.size() && min_snapshot_ids[i] > 0) w.min_snapshot_id = min_snapshot_ids[i];
+  return w;
+}
+
 std::string ShardAnswer::shortfall() const {
   std::string out;
   for (size_t k = 0; k < missing.size(); ++k)
@@ -66,7 +73,7 @@ uint32_t ShardQueries::shard_of_point(double x, double y, double z) const {
   return protocol::shard_of(set_, protocol::region_coords(set_.region_depth, key[0], key[1], key[2]));
 }
 
-Routed<Occ> ShardQueries::points(const std::vector<float>& xyz, int depth) {
+Routed<Occ> ShardQueries::points(const std::vector<float>& xyz, int depth, const ShardWait& w) {
   const size_t n = xyz.size() / 3;
   Routed<Occ> out;
   out.reply.num_results = static_cast<int32_t>(n);
@@ -88,7 +95,7 @@ Routed<Occ> ShardQueries::points(const std::vector<float>& xyz, int depth) {
   const auto got = ask_each<Occ>(asked, set_.count, out.shards, [&](uint32_t i) {
     std::vector<float> sub;
     for (size_t j : mine[i]) sub.insert(sub.end(), {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]});
-    return clients_[i]->points(sub, depth);
+    return clients_[i]->points(sub, depth, w.on_shard(i));
   });
   merged_header(out.reply, got);
   if (asked.empty()) out.reply.status = Occ::REPLY_OK, out.reply.error.clear();
@@ -106,10 +113,11 @@ Routed<Occ> ShardQueries::points(const std::vector<float>& xyz, int depth) {
   return out;
 }
 
-Routed<octomap_rt::box_reply_t> ShardQueries::boxes(const std::vector<Box>& boxes, int8_t mode) {
+Routed<octomap_rt::box_reply_t> ShardQueries::boxes(const std::vector<Box>& boxes, int8_t mode, const ShardWait& w) {
   Routed<octomap_rt::box_reply_t> out;
-  const auto got = ask_each<octomap_rt::box_reply_t>(every_shard(set_.count), set_.count, out.shards,
-                                                     [&](uint32_t i) { return clients_[i]->boxes(boxes, mode); });
+  const auto got = ask_each<octomap_rt::box_reply_t>(every_shard(set_.count), set_.count, out.shards, [&](uint32_t i) {
+    return clients_[i]->boxes(boxes, mode, w.on_shard(i));
+  });
   auto& r = out.reply;
   merged_header(r, got);
   const size_t n = boxes.size();
@@ -132,10 +140,10 @@ Routed<octomap_rt::box_reply_t> ShardQueries::boxes(const std::vector<Box>& boxe
 
 Routed<octomap_rt::ray_reply_t> ShardQueries::rays(const std::vector<float>& origins,
                                                    const std::vector<float>& directions, float max_range,
-                                                   bool ignore_unknown) {
+                                                   bool ignore_unknown, const ShardWait& w) {
   Routed<octomap_rt::ray_reply_t> out;
   const auto got = ask_each<octomap_rt::ray_reply_t>(every_shard(set_.count), set_.count, out.shards, [&](uint32_t i) {
-    return clients_[i]->rays(origins, directions, max_range, ignore_unknown);
+    return clients_[i]->rays(origins, directions, max_range, ignore_unknown, w.on_shard(i));
   });
   merged_header(out.reply, got);
   merge_shard_rays(out.reply, got, origins, set_, resolution_);
@@ -181,7 +189,8 @@ void add_batch(ShardAnswer& all, const ShardAnswer& batch, bool first) {
 }  // namespace
 
 Routed<octomap_rt::distance_points_reply_t> ShardQueries::distance_points(const std::vector<float>& xyz,
-                                                                          const DistanceRequest& d) {
+                                                                          const DistanceRequest& d,
+                                                                          const ShardWait& w) {
   using R = octomap_rt::distance_points_reply_t;
   const size_t n = xyz.size() / 3, per = d.gradient ? 7 : 1;
   const size_t batch = std::max<size_t>(1, size_t(protocol::kMaxQueryPoints) / per);
@@ -197,7 +206,7 @@ Routed<octomap_rt::distance_points_reply_t> ShardQueries::distance_points(const 
         d.gradient ? with_neighbours(part, resolution_) : std::vector<float>(part.begin(), part.end());
     ShardAnswer answer;
     const auto got = ask_each<R>(within_reach(set_, part, resolution_, pad), set_.count, answer,
-                                 [&](uint32_t i) { return clients_[i]->distance_points(asked, plain); });
+                                 [&](uint32_t i) { return clients_[i]->distance_points(asked, plain, w.on_shard(i)); });
     const R merged = merge_distance_points(views_of(got), count, d.gradient);
     add_batch(out.shards, answer, first == 0);
     std::vector<float> distance = std::move(out.reply.distance), gradient = std::move(out.reply.gradient);
@@ -216,7 +225,7 @@ Routed<octomap_rt::distance_points_reply_t> ShardQueries::distance_points(const 
   return out;
 }
 
-Routed<DistanceBox> ShardQueries::distance_box(const Box& box, const DistanceRequest& d) {
+Routed<DistanceBox> ShardQueries::distance_box(const Box& box, const DistanceRequest& d, const ShardWait& w) {
   const Box asked = d.gradient ? grown_distance_box(box, resolution_, d.cell_voxels) : box;
   DistanceRequest plain = d;
   plain.gradient = false;
@@ -224,8 +233,9 @@ Routed<DistanceBox> ShardQueries::distance_box(const Box& box, const DistanceReq
   const std::vector<float> corners = {float(asked.min[0]), float(asked.min[1]), float(asked.min[2]),
                                       float(asked.max[0]), float(asked.max[1]), float(asked.max[2])};
   Routed<DistanceBox> out;
-  const auto got = ask_each<DistanceBox>(within_reach(set_, corners, resolution_, pad), set_.count, out.shards,
-                                         [&](uint32_t i) { return clients_[i]->distance_box(asked, plain); });
+  const auto got =
+      ask_each<DistanceBox>(within_reach(set_, corners, resolution_, pad), set_.count, out.shards,
+                            [&](uint32_t i) { return clients_[i]->distance_box(asked, plain, w.on_shard(i)); });
   const auto views = views_of(got);
   if (std::none_of(views.begin(), views.end(), [](const DistanceBox* b) { return b != nullptr; })) {
     out.reply.header.status = Occ::REPLY_BAD_REQUEST;
@@ -237,14 +247,14 @@ Routed<DistanceBox> ShardQueries::distance_box(const Box& box, const DistanceReq
 }
 
 Routed<octomap_rt::distance_path_reply_t> ShardQueries::distance_path(const std::vector<float>& vertices,
-                                                                      const DistanceRequest& d) {
+                                                                      const DistanceRequest& d, const ShardWait& w) {
   using R = octomap_rt::distance_path_reply_t;
   DistanceRequest plain = d;
   plain.gradient = false, plain.cell_voxels = 1;
   const int64_t pad = distance_padding_cells(d.max_distance, resolution_, 1) + 1;
   Routed<R> out;
   const auto got = ask_each<R>(within_reach(set_, vertices, resolution_, pad), set_.count, out.shards,
-                               [&](uint32_t i) { return clients_[i]->distance_path(vertices, plain); });
+                               [&](uint32_t i) { return clients_[i]->distance_path(vertices, plain, w.on_shard(i)); });
   out.reply = merge_distance_paths(views_of(got));
   return out;
 }

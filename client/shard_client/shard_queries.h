@@ -27,6 +27,21 @@ struct ShardAnswer {
   std::string shortfall() const;  // "shard 2 did not answer: ...; its part is unknown"
 };
 
+// Read-your-writes and map-state conditions of a routed query. Every shard hears and applies
+// every scan (a scan touching none of its regions too), so a robot's wait (its scan `seq`
+// applied) holds on each shard asked alike; map state ids are each shard's own, so the least
+// one is given per shard (by index, e.g. an earlier answer's `shards.snapshot_ids`; a shard
+// past the list's end or at -1: none). A shard that cannot meet them within `timeout_ms`
+// answers REPLY_NOT_READY: it is then missing from the answer, which is partial and says so.
+struct ShardWait {
+  std::string robot_id;  // "": do not wait for a scan
+  int64_t seq = -1;
+  int timeout_ms = 0;  // how long each shard may wait
+  std::vector<int64_t> min_snapshot_ids;
+  // The conditions shard i is asked with.
+  WaitFor on_shard(uint32_t i) const;
+};
+
 template <class Reply>
 struct Routed {
   Reply reply{};  // merged; status REPLY_OK unless every shard refused
@@ -40,23 +55,26 @@ class ShardQueries {
   ShardQueries(const std::string& url, const std::string& client_id, std::chrono::milliseconds timeout,
                const std::string& ns, const protocol::ShardSet& set, double resolution);
 
-  Routed<octomap_rt::occupancy_reply_t> points(const std::vector<float>& xyz, int depth = 0);
-  Routed<octomap_rt::box_reply_t> boxes(const std::vector<Box>& boxes, int8_t mode);
+  // Every query takes the conditions `w` (ShardWait), each shard asked with its own.
+  Routed<octomap_rt::occupancy_reply_t> points(const std::vector<float>& xyz, int depth = 0, const ShardWait& w = {});
+  Routed<octomap_rt::box_reply_t> boxes(const std::vector<Box>& boxes, int8_t mode, const ShardWait& w = {});
   // The one map's castRay answers, stopping at unknown space unless `ignore_unknown` (shard_rays.h).
   Routed<octomap_rt::ray_reply_t> rays(const std::vector<float>& origins, const std::vector<float>& directions,
-                                       float max_range, bool ignore_unknown);
+                                       float max_range, bool ignore_unknown, const ShardWait& w = {});
 
   // Distances (shard_distance.h): the shards with a region within reach of what is asked; per
   // cell the smallest distance, gradients from the merged field. Points go in batches of at
   // most kMaxQueryPoints asked points (7 a point with the gradient). A missing shard's
   // obstacles are left out: the distances are then upper bounds (partial).
-  Routed<octomap_rt::distance_points_reply_t> distance_points(const std::vector<float>& xyz, const DistanceRequest& d);
-  Routed<DistanceBox> distance_box(const Box& box, const DistanceRequest& d);
-  Routed<octomap_rt::distance_path_reply_t> distance_path(const std::vector<float>& vertices, const DistanceRequest& d);
+  Routed<octomap_rt::distance_points_reply_t> distance_points(const std::vector<float>& xyz, const DistanceRequest& d,
+                                                              const ShardWait& w = {});
+  Routed<DistanceBox> distance_box(const Box& box, const DistanceRequest& d, const ShardWait& w = {});
+  Routed<octomap_rt::distance_path_reply_t> distance_path(const std::vector<float>& vertices, const DistanceRequest& d,
+                                                          const ShardWait& w = {});
 
   // A grid of a z band (shard_grid_edit.h): with a window, the shards owning a region in it; without,
   // every shard, merged on the union of their extents (the map's extent).
-  Routed<Grid> grid(double z_min, double z_max, double cell_size, const Box* window);
+  Routed<Grid> grid(double z_min, double z_max, double cell_size, const Box* window, const ShardWait& w = {});
   // A map edit (QueryClient::edit) sent to the shards owning a region the box meets (every shard
   // for OP_RESET); reply status REPLY_OK when each applied it, else REPLY_NOT_READY with the
   // shards that did not (`shards.missing`: a refusal says why). Throws std::invalid_argument for

@@ -13,6 +13,7 @@ import unittest
 import numpy as np
 
 import octomap_rt
+from octomap_rt.shards import ShardClient
 
 SERVER = os.environ.get("OCTOMAP_RT_SERVER", "")
 CLI = os.environ.get("OCTOMAP_RT_CLI", "")
@@ -59,6 +60,37 @@ class ServerGroup:
         if all(c == 0 for c in codes) and not os.environ.get("OCTOMAP_RT_KEEP_TEST_DIRS"):
             shutil.rmtree(self.dir, ignore_errors=True)
         return codes
+
+
+class ShardSetGroup(ServerGroup):
+    """What the shard tests compare (issue 26): `count` servers --shard i/count in namespace
+    "campus" and one whole daemon in namespace "one", all with the flags `common` (after the URL,
+    the cpu back end and no warm-up), on one test URL. `whole` is a MapClient of the whole daemon
+    (its first status awaited), `shards` a ShardClient of the set; stop() closes both."""
+
+    def __init__(self, prefix, port_factor, port_offset, count, depth, common):
+        super().__init__(prefix, port_factor, port_offset)
+        base = [SERVER, "--lcm-url", self.url, "--backend", "cpu", "--warm-up-points", "0"] + list(common)
+        for i in range(count):
+            self.start(base + ["--namespace", "campus", "--shard", f"{i}/{count}", "--shard-region-depth", str(depth),
+                               "--server-id", f"shard-{i}"])
+        self.start(base + ["--namespace", "one", "--server-id", "whole"])
+        self.whole = octomap_rt.MapClient(self.url, namespace="one")
+        self.whole.status(timeout_s=60)
+        self.shards = ShardClient(transport=octomap_rt.open_transport(self.url), namespace="campus", timeout_s=60)
+
+    def wait_statuses(self, client, pred, statuses, timeout_s=120):
+        """Waits for statuses satisfying `pred` on `client`'s namespace from `statuses` servers
+        (told apart by their shard index); returns the indices heard."""
+        done, deadline = set(), time.monotonic() + timeout_s
+        while len(done) < statuses and time.monotonic() < deadline:
+            s = client.wait_for(client.channels.status, octomap_rt.server_status_t.decode, pred, timeout_s=60)
+            done.add(s.shard_index)
+        return done
+
+    def stop(self):
+        self.whole.close(), self.shards.close()
+        return super().stop()
 
 
 class ServerTestCase(unittest.TestCase):

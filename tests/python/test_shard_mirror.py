@@ -12,8 +12,7 @@ import unittest
 
 import octomap_rt
 from octomap_rt import ShardMirror, canonical_leaves, read_bt_leaves
-from octomap_rt.shards import ShardClient
-from server_fixture import CLI, SERVER, ServerGroup
+from server_fixture import CLI, ShardSetGroup
 
 DATA = os.environ.get("OCTOMAP_RT_DATA", "")
 GRAPH = os.path.join(DATA, "3dtk_dat", "3dtk_3scans.graph")
@@ -31,21 +30,12 @@ def snapshot_leaves(client):
 class ShardMirrorTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.group = ServerGroup("ort-py-shard-mirror-", 17, 11)
+        cls.group = ShardSetGroup("ort-py-shard-mirror-", 17, 11, SHARDS, 12, ["-r", "0.2", "--control-token", TOKEN])
         cls.url, cls.servers = cls.group.url, cls.group.servers
-        common = [SERVER, "-r", "0.2", "--lcm-url", cls.url, "--backend", "cpu", "--warm-up-points", "0",
-                  "--control-token", TOKEN]
-        for i in range(SHARDS):
-            cls.group.start(common + ["--namespace", "campus", "--shard", f"{i}/{SHARDS}", "--shard-region-depth", "12",
-                                      "--server-id", f"shard-{i}"])
-        cls.group.start(common + ["--namespace", "one", "--server-id", "whole"])
-        cls.whole = octomap_rt.MapClient(cls.url, namespace="one")
-        cls.whole.status(timeout_s=60)
-        cls.shards = ShardClient(transport=octomap_rt.open_transport(cls.url), namespace="campus", timeout_s=60)
+        cls.whole, cls.shards = cls.group.whole, cls.group.shards
 
     @classmethod
     def tearDownClass(cls):
-        cls.whole.close(), cls.shards.close()
         cls.group.stop()
 
     def replay(self, ns, mirror, *more):
@@ -59,11 +49,7 @@ class ShardMirrorTest(unittest.TestCase):
 
     def wait_applied(self, client, count, statuses):
         """Waits for `statuses` statuses (one per server) that each say `count` scans applied."""
-        done, deadline = set(), time.monotonic() + 120
-        while len(done) < statuses and time.monotonic() < deadline:
-            s = client.wait_for(client.channels.status, octomap_rt.server_status_t.decode,
-                                lambda s: sum(r.scans_applied for r in s.robots) == count, timeout_s=60)
-            done.add(s.shard_index)
+        self.group.wait_statuses(client, lambda s: sum(r.scans_applied for r in s.robots) == count, statuses)
 
     def catch_up(self, mirror, want):
         """Spins until every shard's part is at the map state (id, epoch) of its snapshot in `want`."""

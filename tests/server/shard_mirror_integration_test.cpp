@@ -9,13 +9,12 @@
 
 #include <signal.h>
 
-#include "cli/replay/scan_message.h"
 #include "core/clock.h"
-#include "integration_harness.h"
 #include "scene/scan_set.h"
 #include "shard_client/shard_mirror.h"
 #include "shard_client/shard_roster.h"
 #include "shard_client/shard_snapshot.h"
+#include "shard_set_run.h"
 #include "support/octomap_reference.h"
 #include "support/test_data.h"
 #include "support/tree_compare.h"
@@ -37,9 +36,12 @@ std::unique_ptr<octomap::OcTree> max_likelihood(const octomap::OcTree& t) {
   return out;
 }
 
-// Spins `m` until every shard's part is at the state id of its fresh snapshot in `merged`.
+// Spins `m` until every shard's part is at the state id of its fresh snapshot in `merged`, and
+// at least 1.5 s: every shard's map info (1 Hz) heard afresh, so none is late for the time the
+// test spent elsewhere without spinning (late: no map info for 3 s).
 bool catch_up(client::ShardMirror& m, const client::MergedMap& merged, double timeout_s) {
   const auto t0 = SteadyClock::now();
+  m.spin(1.5);
   auto caught_up = [&] {
     for (const client::ShardMirrorPart& p : m.parts())
       if (p.version != merged.parts[p.index].snapshot_id || p.epoch != merged.parts[p.index].epoch) return false;
@@ -61,20 +63,11 @@ TEST(ShardMirrorIntegration, OneMirrorFollowsEveryShardResyncsOneAndSaysWhichIsL
   const std::string graph = data_file("3dtk_dat/3dtk_3scans.graph");
   if (graph.empty()) return;
   const ScanSet scans = load_scan_graph(graph);
-  NetworkNamespace netns("shardmirror");
-  ASSERT_TRUE(netns.ok()) << netns.error();
-  const std::string dir = make_test_dir("shard_mirror");
-  const std::string url = test_lcm_url(7, netns.rmem_max());
-  const std::string client_url = url.substr(0, url.find("&recv_buf_size"));
-  StatusWatcher status(url, protocol::channels_in(kNs).status);
-  std::vector<std::unique_ptr<ChildProcess>> shards;
-  for (int i = 0; i < kShards; ++i)
-    shards.push_back(std::make_unique<ChildProcess>(
-        std::vector<std::string>{server_program(), "--lcm-url", url, "-r", std::to_string(kRes), "--namespace", kNs,
-                                 "--shard", std::to_string(i) + "/" + std::to_string(kShards), "--warm-up-points", "0",
-                                 "--backend", "cpu", "--control-token", kToken},
-        dir + "/shard" + std::to_string(i) + ".log"));
-  for (auto& s : shards) ASSERT_TRUE(status.wait_for([&](const auto& m) { return m.pid == s->pid(); }, 60)) << s->log();
+  ShardSetRun run("shard_mirror");
+  ASSERT_TRUE(run.netns().ok()) << run.netns().error();
+  ASSERT_TRUE(run.start(kNs, kShards, kRes, {"--control-token", kToken}));
+  const std::string &dir = run.dir, &url = run.url, &client_url = run.client_url;
+  auto& shards = run.shards;
 
   const client::ShardRoster roster = client::discover_shards(url, kNs, 5);
   ASSERT_TRUE(roster.complete()) << roster.shortfall(now_utime(), 3);
@@ -82,22 +75,12 @@ TEST(ShardMirrorIntegration, OneMirrorFollowsEveryShardResyncsOneAndSaysWhichIsL
   mirror.sync();  // the empty maps: every scan below reaches the mirror as deltas
   ASSERT_EQ(mirror.shortfall(now_utime()), "");
 
-  lcm::LCM robot(client_url);
-  ASSERT_TRUE(robot.good());
-  auto publish = [&](size_t k, int64_t seq) {
-    cli::ScanMessageFields fields;
-    fields.robot_id = "rover", fields.seq = seq, fields.utime = now_utime();
-    const octomap_rt::scan_t msg = cli::make_scan_message(scans.scans[k], fields);
-    robot.publish(cli::scan_channel(protocol::channels_in(kNs).scan_prefix, "rover"), &msg);
-  };
   for (size_t k = 0; k < scans.scans.size(); ++k) {
-    publish(k, static_cast<int64_t>(k));
+    run.publish(scans.scans[k], static_cast<int64_t>(k));
     mirror.spin(0.3);
   }
   const int64_t n = static_cast<int64_t>(scans.scans.size());
-  for (auto& s : shards)
-    ASSERT_TRUE(status.wait_for([&](const auto& m) { return m.pid == s->pid() && total_applied(m) == n; }, 120))
-        << s->log();
+  ASSERT_TRUE(run.all_applied(n, 120));
 
   // The merged mirror = the shards' merged snapshot = OctoMap's map of the scans.
   client::MergedMap snap = client::fetch_merged_map(client_url, kNs, roster, 30);
@@ -127,10 +110,8 @@ TEST(ShardMirrorIntegration, OneMirrorFollowsEveryShardResyncsOneAndSaysWhichIsL
                      dir + "/reset.log");
   ASSERT_EQ(reset.wait(30), 0) << reset.log();
   mirror.spin(1.5);
-  publish(0, n);
-  for (auto& s : shards)
-    ASSERT_TRUE(status.wait_for([&](const auto& m) { return m.pid == s->pid() && total_applied(m) == n + 1; }, 120))
-        << s->log();
+  run.publish(scans.scans[0], n);
+  ASSERT_TRUE(run.all_applied(n + 1, 120));
   snap = client::fetch_merged_map(client_url, kNs, roster, 30);
   ASSERT_FALSE(snap.partial) << snap.shortfall;
   ASSERT_TRUE(catch_up(mirror, snap, 30)) << mirror.shortfall(now_utime());

@@ -3,19 +3,19 @@
 // The CLI finds them by their statuses and merges their snapshots into one .bt that is OctoMap's
 // map of those scans; points and rays routed by region get OctoMap's answers, distances (points
 // with the gradient, a box, a path through the CLI) the distances on OctoMap's map, a band's grid
-// OctoMap's projected map, a clear-box goes to the shard owning its box; with one shard
+// OctoMap's projected map, a query right after a scan that waits for it on every shard (read-your-
+// writes) OctoMap's map after it, a clear-box goes to the shard owning its box; with one shard
 // stopped, the map and the answers say they are partial and which shard is missing.
 #include <gtest/gtest.h>
 
 #include <signal.h>
 
 #include <chrono>
+#include <cmath>
 
-#include "cli/replay/scan_message.h"
 #include "core/clock.h"
 #include "distance/distance_queries.h"
 #include "distance/squared_edt.h"
-#include "integration_harness.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "protocol/shards/shard_set.h"
@@ -25,6 +25,7 @@
 #include "scene/scan_set.h"
 #include "shard_client/shard_queries.h"
 #include "shard_client/shard_roster.h"
+#include "shard_set_run.h"
 #include "support/octomap_reference.h"
 #include "support/test_data.h"
 #include "support/tree_compare.h"
@@ -51,34 +52,15 @@ TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
   const std::string graph = data_file("3dtk_dat/3dtk_3scans.graph");
   if (graph.empty()) return;
   const ScanSet scans = load_scan_graph(graph);
-  NetworkNamespace netns("shards");
-  ASSERT_TRUE(netns.ok()) << netns.error();
-  const std::string dir = make_test_dir("shards");
-  const std::string url = test_lcm_url(7, netns.rmem_max());
-  const std::string client_url = url.substr(0, url.find("&recv_buf_size"));
-  StatusWatcher status(url, protocol::channels_in(kNs).status);
-  std::vector<std::unique_ptr<ChildProcess>> shards;
-  for (int i = 0; i < kShards; ++i)
-    shards.push_back(std::make_unique<ChildProcess>(
-        std::vector<std::string>{server_program(), "--lcm-url", url, "-r", std::to_string(kRes), "--namespace", kNs,
-                                 "--shard", std::to_string(i) + "/" + std::to_string(kShards), "--warm-up-points", "0",
-                                 // On 2 loaded cores 300 rays may pass the 10 ms lock bound and be cut.
-                                 "--backend", "cpu", "--query-lock-ms", "2000", "--control-token", kToken},
-        dir + "/shard" + std::to_string(i) + ".log"));
-  for (auto& s : shards) ASSERT_TRUE(status.wait_for([&](const auto& m) { return m.pid == s->pid(); }, 60)) << s->log();
-
-  lcm::LCM robot(client_url);
-  ASSERT_TRUE(robot.good());
-  for (size_t k = 0; k < scans.scans.size(); ++k) {
-    cli::ScanMessageFields fields;
-    fields.robot_id = "rover", fields.seq = static_cast<int64_t>(k), fields.utime = now_utime();
-    const octomap_rt::scan_t msg = cli::make_scan_message(scans.scans[k], fields);
-    robot.publish(cli::scan_channel(protocol::channels_in(kNs).scan_prefix, "rover"), &msg);
-  }
+  ShardSetRun run("shards");
+  ASSERT_TRUE(run.netns().ok()) << run.netns().error();
+  // On 2 loaded cores 300 rays may pass the 10 ms lock bound and be cut.
+  ASSERT_TRUE(run.start(kNs, kShards, kRes, {"--query-lock-ms", "2000", "--control-token", kToken}));
+  const std::string &dir = run.dir, &client_url = run.client_url;
+  auto& shards = run.shards;
+  for (size_t k = 0; k < scans.scans.size(); ++k) run.publish(scans.scans[k], static_cast<int64_t>(k));
   const int64_t n = static_cast<int64_t>(scans.scans.size());
-  for (auto& s : shards)  // every shard applies every scan (each keeps its own regions' voxels)
-    ASSERT_TRUE(status.wait_for([&](const auto& m) { return m.pid == s->pid() && total_applied(m) == n; }, 120))
-        << s->log();
+  ASSERT_TRUE(run.all_applied(n, 120));  // every shard applies every scan (each keeps its own regions' voxels)
   const auto reference = octomap_reference(scans, kRes, -1.0);
 
   // The merged map, through the CLI: OctoMap's map of the scans (its .bt: max likelihood).
@@ -213,6 +195,66 @@ TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
       differing_cells += grid.reply.cells[c] != int8_t(want_grid.cells[c]);
     EXPECT_EQ(differing_cells, 0u) << "of " << want_grid.cells.size() << " cells";
   }
+
+  // Read-your-writes across the set: a scan shifted into space no scan saw, and at once a routed
+  // points query about its end points that waits on every shard for it: OctoMap's map after it
+  // (an answer that did not wait finds those points unknown), each shard at a newer state.
+  PosedScan unseen = scans.scans[0];
+  unseen.pose.trans().x() += 100.0f;
+  run.publish(unseen, n);
+  const std::vector<float> unseen_xyz = [&] {
+    ScanSet one;
+    one.scans.push_back(unseen);
+    return end_points(one, 50);
+  }();
+  // Waits may take longer than the 3 s of `q` on loaded cores.
+  client::ShardQueries waiting(client_url, "rover", std::chrono::seconds(60), kNs, *roster.set(), roster.resolution());
+  client::ShardWait ryw;
+  ryw.robot_id = "rover", ryw.seq = n, ryw.timeout_ms = 30000;
+  ryw.min_snapshot_ids = points.shards.snapshot_ids;
+  const auto fresh = waiting.points(unseen_xyz, 0, ryw);
+  ASSERT_FALSE(fresh.shards.partial()) << fresh.shards.shortfall();
+  reference->insertPointCloud(world_points(unseen), sensor_origin(unseen), -1.0, false, false);
+  const auto fresh_truth = query::query_points(*reference, unseen_xyz, 0);
+  int fresh_differing = 0, fresh_occupied = 0;
+  for (size_t i = 0; i < fresh_truth.size(); ++i) {
+    fresh_differing += fresh.reply.occupancy[i] != int8_t(fresh_truth[i].state) ||
+                       fresh.reply.probability[i] != fresh_truth[i].probability;
+    fresh_occupied += fresh.reply.occupancy[i] == octomap_rt::occupancy_reply_t::OCC_OCCUPIED;
+  }
+  EXPECT_EQ(fresh_differing, 0) << "of " << fresh_truth.size() << " points of the scan just sent";
+  EXPECT_GT(fresh_occupied, int(0.9 * fresh_truth.size())) << "of " << fresh_truth.size();
+  for (uint32_t i = 0; i < uint32_t(kShards); ++i)  // every shard answered from the map with the new scan
+    EXPECT_GT(fresh.shards.snapshot_ids[i], points.shards.snapshot_ids[i]) << "shard " << i;
+  // A state id a shard cannot reach in time: that shard is named, the answer partial.
+  client::ShardWait ahead;
+  ahead.timeout_ms = 200;
+  ahead.min_snapshot_ids = {0, fresh.shards.snapshot_ids[1] + 1000};
+  const auto behind = waiting.points(xyz, 0, ahead);
+  EXPECT_EQ(behind.shards.missing, std::vector<uint32_t>{1}) << behind.shards.shortfall();
+  // The CLI's --wait-robot with --shards: a scan not sent yet is not waited out (the shard asked
+  // answers NOT_READY, named, and no shard answered: exit status 2); one just sent is, and its end
+  // point's voxel is occupied.
+  PosedScan unseen2 = scans.scans[1];
+  unseen2.pose.trans().x() += 200.0f;
+  const octomap::point3d end = world_points(unseen2)[0];
+  std::vector<std::string> centre;  // the end point's voxel centre, far from a voxel border
+  for (int a = 0; a < 3; ++a) centre.push_back(std::to_string((std::floor(end(a) / kRes) + 0.5) * kRes));
+  const std::string point = centre[0] + "," + centre[1] + "," + centre[2];
+  auto cli_wait = [&](int64_t seq, double timeout_s, const std::string& log) {
+    return std::make_unique<ChildProcess>(
+        std::vector<std::string>{client_program(), "query", "points", "--shards", "--namespace", kNs, "--lcm-url",
+                                 client_url, "--wait-robot", "rover", "--wait-seq", std::to_string(seq), "--timeout",
+                                 std::to_string(timeout_s), "--json", point},
+        dir + "/" + log);
+  };
+  auto early = cli_wait(n + 2, 3, "wait_early.log");
+  EXPECT_EQ(early->wait(60), 2) << early->log();
+  EXPECT_NE(early->log().find("did not answer"), std::string::npos) << early->log();
+  run.publish(unseen2, n + 1);
+  auto sent = cli_wait(n + 1, 30, "wait_sent.log");
+  ASSERT_EQ(sent->wait(60), 0) << sent->log();
+  EXPECT_NE(sent->log().find("\"state\": \"occupied\""), std::string::npos) << sent->log();
 
   // A clear-box inside one region goes to its shard alone; afterwards the box is unknown.
   client::Box clear{};

@@ -51,7 +51,7 @@ void register_points(CLI::App& parent) {
     xyz.insert(xyz.end(), more.begin(), more.end());
     if (xyz.empty()) throw CLI::ValidationError("points", "give X,Y,Z points or --file");
     bool partial = false;
-    const auto r = a->shards ? routed(connect_shards(*a)->distance_points(xyz, request(*d)), partial)
+    const auto r = a->shards ? routed(connect_shards(*a)->distance_points(xyz, request(*d), shard_wait(*a)), partial)
                              : connect(*a)->distance_points(xyz, request(*d), wait_for(*a));
     if (a->json) write_distance_points_json(std::cout, xyz, r);
     if (refused(r)) std::exit(2);
@@ -86,8 +86,9 @@ void register_box(CLI::App& parent) {
   cmd->callback([=] {
     const Box b = parse_box(*box);
     bool partial = false;
-    const DistanceBox f = a->shards ? routed(connect_shards(*a)->distance_box(b, request(*d, *cell_voxels)), partial)
-                                    : connect(*a)->distance_box(b, request(*d, *cell_voxels), wait_for(*a));
+    const DistanceBox f =
+        a->shards ? routed(connect_shards(*a)->distance_box(b, request(*d, *cell_voxels), shard_wait(*a)), partial)
+                  : connect(*a)->distance_box(b, request(*d, *cell_voxels), wait_for(*a));
     if (f.header.status != 0) {
       if (a->json) write_distance_box_json(std::cout, f, "");
       refused(f.header);
@@ -120,7 +121,7 @@ void register_path(CLI::App& parent) {
   cmd->callback([=] {
     const auto v = parse_points(*pts);
     bool partial = false;
-    const auto r = a->shards ? routed(connect_shards(*a)->distance_path(v, request(*d)), partial)
+    const auto r = a->shards ? routed(connect_shards(*a)->distance_path(v, request(*d), shard_wait(*a)), partial)
                              : connect(*a)->distance_path(v, request(*d), wait_for(*a));
     if (a->json) write_distance_path_json(std::cout, r);
     if (refused(r)) std::exit(2);

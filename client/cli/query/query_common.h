@@ -49,7 +49,8 @@ inline std::unique_ptr<QueryClient> connect(const CommonArgs& a) {
 }
 
 // --shards (query_command.cpp): the flag, and the namespace's shard set found by its statuses
-// with a client routing to it (no waits: each shard has its own map states).
+// with a client routing to it (--wait-robot goes to every shard asked; no --min-snapshot: each
+// shard has its own map states).
 void add_shards_flag(CLI::App* cmd, CommonArgs& a);
 std::unique_ptr<ShardQueries> connect_shards(const CommonArgs& a);
 
@@ -63,6 +64,15 @@ R routed(const Routed<R>& r, bool& partial) {
 inline WaitFor wait_for(const CommonArgs& a) {
   WaitFor w;
   w.min_snapshot_id = a.min_snapshot;
+  w.robot_id = a.wait_robot;
+  w.seq = a.wait_seq;
+  w.timeout_ms = static_cast<int>(a.timeout_s * 1000 * 0.8);
+  return w;
+}
+
+// --wait-robot / --wait-seq for every shard asked (ShardWait).
+inline ShardWait shard_wait(const CommonArgs& a) {
+  ShardWait w;
   w.robot_id = a.wait_robot;
   w.seq = a.wait_seq;
   w.timeout_ms = static_cast<int>(a.timeout_s * 1000 * 0.8);

@@ -18,7 +18,7 @@ from .bt_reader import TREE_DEPTH, BtMap, read_bt
 from .channels import Channels, in_namespace, namespace_from
 from .map_client import MapClient, ServerTimeout
 from .protocol_table import MAX_SHARDS, SHARD_NAMESPACE_PREFIX
-from .queries import FREE, OCCUPIED, UNKNOWN, QueryError
+from .queries import FREE, OCCUPIED, UNKNOWN, QueryError, Wait
 from .snapshot_fetch import FetchError, new_client_id
 from .transport import open_transport
 
@@ -157,6 +157,18 @@ class ShardClient:
 
     def close(self) -> None:
         self.transport.close()
+
+    def wait(self, robot_id: str = "", seq: int = -1, timeout_s: float = 5.0,
+             min_snapshot_ids: Optional[Dict[int, int]] = None) -> None:
+        """Read-your-writes across the set: every later query waits on each shard it asks until
+        that shard applied robot `robot_id`'s scan `seq` (every shard applies every scan) and
+        reached its own map state id `min_snapshot_ids[i]` (each shard's ids are its own), at
+        most `timeout_s` there; a shard that cannot is missing (the answer partial). No
+        arguments: no wait."""
+        for i, c in enumerate(self.shards):
+            w = Wait(min_snapshot_id=(min_snapshot_ids or {}).get(i, 0), robot_id=robot_id, seq=seq,
+                     timeout_s=timeout_s)
+            c.queries.wait = w if w.waits() else None
 
     def _ask(self, indices, ask) -> ShardAnswer:
         """{index: ask(index, its MapClient)} of the shards asked; a shard that fails (or was not
