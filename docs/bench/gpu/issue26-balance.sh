@@ -8,15 +8,17 @@
 #    shard's voxels against the mean ("voxels max/mean"), merged map = one daemon's, at region depth 10
 #    (the old default) and 13 (the new one).
 # 2. The set with a core per daemon, at depth 10 and 13 in the same call: for each N <= nproc, N
-#    octomap-rt-shard-bench processes side by side, process i pinned to core i (taskset) and keeping shard i
-#    of N only (--only-shard), each decoding every scan, walking every ray and applying its own shard's
+#    octomap-rt-shard-bench processes side by side, process i pinned to CPU i of the machine's CPUs ordered one
+#    thread of every physical core first, then their siblings (so that N <= cores puts no two daemons on one
+#    core's hyperthreads; PIN_ORDER=plain: CPU i, as the 16:44 call did; topology.txt records lscpu and the order),
+#    and keeping shard i of N only (--only-shard), each decoding every scan, walking every ray and applying its own shard's
 #    voxels. The set's octree-stage rate is 1000 / (the slowest shard's update ms a scan); the ratio against
 #    N = 1 of the same call and depth is the scaling (goal: >= 0.8 x N). Per process pinned-GRAPH-D-N-i.txt,
 #    summary in pinned-summary.txt.
 # 3. Routed queries against one daemon (docs/bench/dev/issue26-routed.sh in a network namespace: 3 hashed
 #    shards and a whole daemon, CPU back end, 3DTK at 0.1 m; 1000 rounds of 1000 points and 200 rays each),
 #    at depth 13 and 10: routed-3dtk_3scans-3-depthD.txt. Each takes ~35 s; started only with 45 s left.
-# Every step is skipped, never cut, past ${BALANCE_UNTIL:-140} s. The graphs travel xz-packed (unpacked here, by
+# PINNED_ONLY=1: step 2 alone (~25 s on the H200). Every step is skipped, never cut, past ${BALANCE_UNTIL:-140} s. The graphs travel xz-packed (unpacked here, by
 # python3's lzma where there is no xz).
 for z in "$N"/data/*/*.graph.xz; do
   [ -e "${z%.xz}" ] || xz -dk "$z" 2> /dev/null ||
@@ -25,6 +27,7 @@ done
 balance() {
   local G=$1 d=$2 g
   g=$(basename "$G" .graph)
+  [ -z "${PINNED_ONLY:-}" ] || return 0
   left "${BALANCE_UNTIL:-140}" || return 0
   log "balance $g depth $d"
   timeout 30 "$N/bin/octomap-rt-shard-bench" "$N/data/$G" -r 0.1 --backend cpu-grid --shards 1,2,4,8,16 \
@@ -35,12 +38,12 @@ pinned() {
   g=$(basename "$G" .graph)
   base=0
   for n in 1 2 4 8 16; do
-    [ "$n" -le "$(nproc)" ] || continue
+    [ "$n" -le "${#CPUS[@]}" ] || continue
     left "${BALANCE_UNTIL:-140}" || return 0
     log "pinned $g depth $d N=$n"
     pids=()
     for ((i = 0; i < n; i++)); do
-      timeout 30 taskset -c "$i" "$N/bin/octomap-rt-shard-bench" "$N/data/$G" -r 0.1 --backend cpu-grid \
+      timeout 30 taskset -c "${CPUS[$i]}" "$N/bin/octomap-rt-shard-bench" "$N/data/$G" -r 0.1 --backend cpu-grid \
         --shards "$n" --only-shard "$i" --depth "$d" --repeat "$rep" > "$O/pinned-$g-$d-$n-$i.txt" 2>&1 &
       pids+=($!)
     done
@@ -58,8 +61,21 @@ pinned() {
     fi
   done
 }
+# The CPUs this call may use, one thread of every core first (by package and core id), then the second threads, ...
+cpus_by_core() {
+  local c
+  for c in /sys/devices/system/cpu/cpu[0-9]*; do
+    taskset -c "${c##*cpu}" true 2> /dev/null || continue
+    echo "$(cat "$c/topology/physical_package_id" 2> /dev/null || echo 0) $(cat "$c/topology/core_id" 2> /dev/null ||
+      echo "${c##*cpu}") ${c##*cpu}"
+  done | sort -k1,1n -k2,2n -k3,3n | awk '{k = $1 " " $2; print r[k]++, $1, $2, $3}' | sort -k1,1n -k2,2n -k3,3n |
+    awk '{print $4}'
+}
+if [ "${PIN_ORDER:-core}" = plain ]; then CPUS=($(seq 0 $(($(nproc) - 1)))); else CPUS=($(cpus_by_core)); fi
+{ lscpu; echo "pin order (${PIN_ORDER:-core}): ${CPUS[*]}"; } > "$O/topology.txt" 2>&1
 routed() {
   local d=$1 b=$T/build
+  [ -z "${PINNED_ONLY:-}" ] || return 0
   left $((${BALANCE_UNTIL:-140} - 45)) || return 0
   log "routed depth $d"
   mkdir -p "$b/server" "$b/client" "$b/tools/shard_bench"
