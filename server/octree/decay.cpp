@@ -44,15 +44,32 @@ float decay_factor(double step_s, double half_life_s) {
   return static_cast<float>(std::exp2(-step_s / half_life_s));
 }
 
+bool decay_subtree(octomap::OcTree& tree, octomap::OcTreeNode* node, unsigned depth, const DecayRule& rule) {
+  uint64_t visited = 0, decayed = 0, deleted = 0;
+  return decay_node(tree, node, depth, rule, visited, decayed, deleted);
+}
+
 DecaySweep::DecaySweep(const octomap::OcTree& tree, const RegionGrid& grid, const DecayRule& rule)
-    : sweep_(tree, grid), rule_(rule) {}
+    : sweep_(tree, grid), rule_(rule) {
+  stand_ins_.now = [rule](octomap::OcTree&, octomap::OcTreeNode* stand_in, unsigned, const octomap::OcTreeKey&) {
+    stand_in->setLogOdds(stand_in->getLogOdds() * rule.factor);
+    return StandInFate::kOwes;
+  };
+  stand_ins_.owed = std::make_shared<const RegionStep>(
+      [rule](octomap::OcTree& t, octomap::OcTreeNode* node, unsigned depth, const octomap::OcTreeKey&) {
+        return decay_subtree(t, node, depth, rule);
+      });
+  stand_ins_.prunes = true;
+}
 
 bool DecaySweep::run_slice(octomap::OcTree& tree, uint64_t node_budget) {
-  return sweep_.run_slice(tree, node_budget,
-                          [this](octomap::OcTree& t, octomap::OcTreeNode* node, unsigned depth,
-                                 const octomap::OcTreeKey&, uint64_t& visited) {
-                            return decay_node(t, node, depth, rule_, visited, leaves_decayed_, leaves_deleted_);
-                          });
+  return sweep_.run_slice(
+      tree, node_budget,
+      [this](octomap::OcTree& t, octomap::OcTreeNode* node, unsigned depth, const octomap::OcTreeKey&,
+             uint64_t& visited) {
+        return decay_node(t, node, depth, rule_, visited, leaves_decayed_, leaves_deleted_);
+      },
+      &stand_ins_);
 }
 
 DecayStats DecaySweep::stats() const {

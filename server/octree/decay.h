@@ -15,7 +15,11 @@
 // leaf, updateInnerOccupancy() and prune() (the test builds it that way).
 //
 // A sweep applies one step region by region in slices of bounded work
-// (octree/region_sweep.h, which says what an update between two slices does to it).
+// (octree/region_sweep.h, which says what an update between two slices does to it). A
+// spilled region (a memory bound's stand-in) is owed the step: it is applied to the region,
+// after the steps owed before it, when the region comes back (the per-leaf rule gives the
+// same leaves whenever it runs; the stand-in's value meanwhile is its subtree's maximum times
+// the factor, what the maximum becomes unless the step deletes that leaf).
 #pragma once
 
 #include <cstddef>
@@ -60,8 +64,13 @@ class DecaySweep {
  private:
   RegionSweep sweep_;
   DecayRule rule_;
+  StandInRule stand_ins_;
   uint64_t leaves_decayed_ = 0, leaves_deleted_ = 0;
 };
+
+// One step applied to the subtree of `node` at `depth` (a region's root): true when `node`
+// must go (every leaf below it was deleted). What a spilled region owes, applied on its return.
+bool decay_subtree(octomap::OcTree& tree, octomap::OcTreeNode* node, unsigned depth, const DecayRule& rule);
 
 // One whole step at once (a sweep with no slice limit).
 DecayStats decay_tree(octomap::OcTree& tree, const RegionGrid& grid, const DecayRule& rule);

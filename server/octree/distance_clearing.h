@@ -5,10 +5,14 @@
 // of the cube); a leaf that reaches within the radius is kept whole. Inner nodes left
 // without children go too, the others hold the max of their children (OctoMap's
 // updateInnerOccupancy). No centre: nothing is cleared. Applied region by region in slices
-// (octree/region_sweep.h); whole regions wholly beyond the radius go in one step.
+// (octree/region_sweep.h); whole regions wholly beyond the radius go in one step. A spilled
+// region (a memory bound's stand-in) is never brought back for it: one wholly beyond goes
+// from the store unread, one wholly within is kept as it is, one across the radius is owed
+// the clearing, applied when it comes back.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <octomap/OcTree.h>
@@ -26,20 +30,16 @@ class DistanceClearingSweep {
   bool run_slice(octomap::OcTree& tree, uint64_t node_budget);
   // The sweep under it (a memory bound's hooks: RegionSweep::set_spill).
   RegionSweep& regions() { return sweep_; }
-  bool done() const { return centres_.empty() || sweep_.done(); }
+  bool done() const { return centres_->empty() || sweep_.done(); }
   uint64_t nodes_deleted() const { return deleted_ + sweep_.nodes_deleted(); }
   uint64_t nodes_visited() const { return sweep_.nodes_visited(); }
 
  private:
-  enum class Reach { kBeyond, kWithin, kStraddles };
-  Reach reach(const octomap::OcTree& tree, const octomap::OcTreeKey& min_key, unsigned depth) const;
-  bool visit(octomap::OcTree& tree, octomap::OcTreeNode* node, unsigned depth, const octomap::OcTreeKey& min_key,
-             uint64_t& visited);
-
   RegionSweep sweep_;
-  std::vector<octomap::point3d> centres_;
+  std::shared_ptr<const std::vector<octomap::point3d>> centres_;
   double radius_sq_;
   uint64_t deleted_ = 0;
+  StandInRule stand_ins_;
 };
 
 // The whole clearing at once.

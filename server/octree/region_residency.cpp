@@ -41,6 +41,7 @@ void RegionResidency::restore(octomap::OcTree& tree, RegionId id) {
         spill_.erase(id);
       }
       spilled_.erase(it);
+      apply_owed(tree, id);
       stats_.costs.rebuild_ms += ms_since(t0);
       stats_.costs.reattached++;
       stats_.restores++;
@@ -63,6 +64,7 @@ void RegionResidency::restore(octomap::OcTree& tree, RegionId id) {
     std::lock_guard spill(spill_mutex_);
     spill_.erase(id);
   }
+  apply_owed(tree, id);
   stats_.restores++;
 }
 
@@ -119,7 +121,7 @@ uint64_t inner_nodes(const std::vector<uint8_t>& encoded) {
 size_t RegionResidency::enforce(octomap::OcTree& tree) { return enforce(tree, memory(tree), max_bytes_).regions; }
 
 EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, uint64_t target, size_t max_groups,
-                                       double budget_ms) {
+                                       double budget_ms, uint64_t min_idle) {
   EnforceResult result;
   const auto start = SteadyClock::now();
   std::string write_error;  // a background put that failed: thrown after this pass
@@ -165,13 +167,19 @@ EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, ui
   for (const Candidate& c : candidates) {
     if (c.group != group) {  // whole groups only: stop between two
       if (bytes <= target || groups == max_groups) break;
+      if (min_idle > 0 && c.touched + min_idle > tick_) break;  // the rest were touched later still
       // The budget cuts the way from the bound down to `target`, never the way to the bound.
       if (budget_ms > 0 && groups > 0 && bytes <= max_bytes_ && ms_since(start) >= budget_ms) break;
       group = c.group;
       ++groups;
     }
     if (background_) {
-      const uint64_t freed_bytes = detach_for_writer(tree, c.id);
+      // A refused write put back with owed steps may have reshaped the regions listed.
+      const RegionNode r = find_region(tree, grid_, c.id);
+      if (r.node == nullptr || r.depth != grid_.depth || !tree.nodeHasChildren(r.node)) continue;
+      // Below the bound a pass does not wait for the writer's room: it ends (the rest goes later).
+      const uint64_t freed_bytes = detach_for_writer(tree, c.id, bytes > max_bytes_);
+      if (freed_bytes == 0) break;
       bytes -= std::min(bytes, freed_bytes);
       result.bytes_freed += freed_bytes;
       result.regions++;
@@ -271,6 +279,8 @@ void RegionResidency::forget_all() {
   std::lock_guard spill(spill_mutex_);
   for (RegionId id : spilled_ids()) spill_.erase(id);
   spilled_.clear();
+  owed_.clear();
+  owed_now_ = 0;
   stats_.evicted_bytes = 0;
   tally_.changed_all();
 }
@@ -282,6 +292,7 @@ void RegionResidency::restore_all(octomap::OcTree& tree) {
 ResidencyStats RegionResidency::stats() const {
   ResidencyStats s = stats_;
   s.evicted_regions = spilled_.size();
+  s.owed_now = owed_now_;
   std::lock_guard lock(write_mutex_);
   s.costs.encode_ms += writer_encode_ms_;
   s.costs.put_ms += writer_put_ms_;

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <span>
 #include <string>
@@ -27,6 +28,7 @@
 #include "core/voxel_update.h"
 #include "octree/region.h"
 #include "octree/region_codec.h"
+#include "octree/region_sweep.h"
 #include "octree/region_tally.h"
 
 namespace ort {
@@ -62,6 +64,8 @@ struct ResidencyCosts {
 
 struct ResidencyStats {
   uint64_t evictions = 0, restores = 0;
+  // Sweeps over spilled regions: steps owed (kept, applied on return), regions deleted unread.
+  uint64_t steps_owed = 0, owed_now = 0, dropped = 0;
   uint64_t evicted_regions = 0, evicted_bytes = 0;  // now
   ResidencyCosts costs;
 };
@@ -74,6 +78,14 @@ struct EnforceResult {
   uint64_t bytes_freed = 0;
 };
 
+// Applies `steps` in order to region `id` of `tree` (its subtree in place, at the region
+// depth), then settles the nodes above it as a sweep does: the region and every node it left
+// without children deleted, the others the max of their children, each pruned (never the root,
+// nor a node with a child `stand_in` says is still a stand-in).
+void apply_owed_steps(octomap::OcTree& tree, const RegionGrid& grid, RegionId id,
+                      std::span<const std::shared_ptr<const RegionStep>> steps,
+                      const std::function<bool(RegionId)>& stand_in);
+
 class RegionResidency {
  public:
   RegionResidency(const RegionGrid& grid, RegionSpill& spill, uint64_t max_bytes);
@@ -85,7 +97,8 @@ class RegionResidency {
   // encodes and puts them; until put() has returned and a later call of this object's let
   // them go, the region is pending: its nodes are kept, restoring it puts them back (no store
   // read), and spilled_bytes() encodes them. At most `max_pending_nodes` wait: past that,
-  // enforce() waits for the writer. A put() that throws puts the region back at the next
+  // enforce() waits for the writer on its way back to the bound, and below it ends the pass
+  // instead (the room it would make is not needed yet). A put() that throws puts the region back at the next
   // enforce(), which then throws (nothing was lost).
   void start_background_writes(uint64_t max_pending_nodes);
   // Nodes detached and not yet let go (pending writes), for the caller's memory count.
@@ -106,8 +119,11 @@ class RegionResidency {
   // `budget_ms` (> 0) ends the call between two groups once that much time has gone and the
   // memory is within the bound (at least one group goes): a caller that spreads the way from
   // the bound down to `target` over several calls.
+  // `min_idle` (> 0): only sibling groups no touch has reached in the last `min_idle` touches
+  // go (a caller below the bound that leaves the regions in use alone: under the bound,
+  // spilling a region the next scans touch again only moves it back and forth).
   EnforceResult enforce(octomap::OcTree& tree, uint64_t bytes_now, uint64_t target, size_t max_groups = SIZE_MAX,
-                        double budget_ms = 0);
+                        double budget_ms = 0, uint64_t min_idle = 0);
   // The bytes of spilled region `id` (the store's, or a pending region's encoded from its
   // kept nodes). Call while nothing changes the tree (any lock that keeps writers out).
   std::vector<uint8_t> spilled_bytes(RegionId id) const;
@@ -133,6 +149,21 @@ class RegionResidency {
   // Brings every spilled region back (a whole-map save or snapshot without the bound).
   void restore_all(octomap::OcTree& tree);
   bool spilled(RegionId id) const { return spilled_.count(id) != 0; }
+  // Sweeps over spilled regions (octree/region_sweep.h): a region owes at most kMaxOwed steps
+  // (past that a sweep brings it back); owe() keeps `step` for it, applied after the steps
+  // before it when the region comes back (any way: a touch, a sweep, restore_all, a refused
+  // write), then the nodes above it are settled as the sweep would have settled them (values,
+  // prune, nodes left empty deleted). drop(): the region's stand-in was deleted from the tree
+  // (the sweep's step deletes all of it): its bytes and kept nodes go unread.
+  static constexpr size_t kMaxOwed = 64;
+  bool can_owe(RegionId id) const;
+  void owe(RegionId id, std::shared_ptr<const RegionStep> step);
+  void drop(RegionId id);
+  // The hooks of a sweep over `sweep` regions (as coarse as this grid's or coarser) that
+  // leaves spilled regions on disk (octree/region_sweep.h); the caller serializes the calls.
+  SweepSpill sweep_hooks(const RegionGrid& sweep);
+  // The steps region `id` owes, in order (a whole-map copy applies them: apply_owed_steps).
+  std::vector<std::shared_ptr<const RegionStep>> owed_steps(RegionId id) const;
   // After a failed or finished background put: puts failed regions back, lets written ones'
   // nodes go (to the free_later hook). Throws the first failure's error after putting back.
   void collect_writes(octomap::OcTree& tree);
@@ -148,9 +179,12 @@ class RegionResidency {
 
  private:
   void restore(octomap::OcTree& tree, RegionId id);
+  // After region `id` was put back in the tree: its owed steps, then the nodes above settled.
+  void apply_owed(octomap::OcTree& tree, RegionId id);
   void let_go(DetachedSubtree d);
   // Background writes: detaches region `id` for the writer; returns the tree memory it freed.
-  uint64_t detach_for_writer(octomap::OcTree& tree, RegionId id);
+  // With the kept nodes full: waits for the writer, or (!may_wait) detaches nothing, returns 0.
+  uint64_t detach_for_writer(octomap::OcTree& tree, RegionId id, bool may_wait);
   void write_loop();
   void stop_writer();
 
@@ -171,6 +205,8 @@ class RegionResidency {
   uint64_t tick_ = 0;
   std::unordered_map<RegionId, uint64_t> last_touch_;
   std::unordered_map<RegionId, uint64_t> spilled_;  // id -> bytes spilled
+  std::unordered_map<RegionId, std::vector<std::shared_ptr<const RegionStep>>> owed_;
+  uint64_t owed_now_ = 0;  // steps in owed_
   ResidencyStats stats_;
   RegionTally tally_;
 

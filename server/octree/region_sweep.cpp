@@ -62,14 +62,66 @@ RegionSweep::RegionSweep(const octomap::OcTree& tree, const RegionGrid& grid) : 
   });
 }
 
-void RegionSweep::visit_unit(octomap::OcTree& tree, const Unit& unit, const RegionVisit& visit) {
+void RegionSweep::visit_unit(octomap::OcTree& tree, const Unit& unit, const RegionVisit& visit,
+                             const StandInRule* rule) {
   const size_t nodes = tree.size();  // OctoMap's counter: every node made or deleted changes it
-  sweep_unit(tree, unit, visit);
+  sweep_unit(tree, unit, visit, rule);
   if (spill_.reshaped && tree.size() != nodes) spill_.reshaped(unit.min_key, unit.depth);
 }
 
-void RegionSweep::sweep_unit(octomap::OcTree& tree, const Unit& unit, const RegionVisit& visit) {
-  if (unit.depth == grid_.depth && spill_.bring_back) spill_.bring_back(tree, region_of(grid_, unit.min_key));
+bool RegionSweep::visit_around(octomap::OcTree& tree, octomap::OcTreeNode* node, unsigned depth,
+                               const octomap::OcTreeKey& min_key, const RegionVisit& visit, const StandInRule& rule) {
+  const RegionGrid bound{spill_.depth};
+  if (depth == spill_.depth) {
+    const RegionId id = region_of(bound, min_key);
+    if (tree.nodeHasChildren(node) || !spill_.stand_in(id)) return visit(tree, node, depth, min_key, visited_);
+    ++visited_;
+    switch (rule.now(tree, node, depth, min_key)) {
+      case StandInFate::kUnchanged: return false;
+      case StandInFate::kOwes:
+        spill_.owe(id, rule.owed);
+        ++owed_;
+        return false;
+      case StandInFate::kGone:
+        spill_.drop(id);
+        ++dropped_;
+        return true;
+    }
+    return false;
+  }
+  ++visited_;
+  bool stand_in_child = false;
+  for (unsigned i = 0; i < 8; ++i) {
+    if (!tree.nodeChildExists(node, i)) continue;
+    octomap::OcTreeNode* child = tree.getNodeChild(node, i);
+    const octomap::OcTreeKey k = detail::child_min_key(min_key, depth, i);
+    if (visit_around(tree, child, depth + 1, k, visit, rule)) {
+      delete_subtree(tree, node, i);
+      ++deleted_;
+    } else if (depth + 1 == spill_.depth && !tree.nodeHasChildren(child) && spill_.stand_in(region_of(bound, k))) {
+      stand_in_child = true;
+    }
+  }
+  if (!tree.nodeHasChildren(node)) {
+    free_empty_child_array(node);
+    return true;
+  }
+  node->updateOccupancyChildren();
+  if (rule.prunes && depth > 0 && !stand_in_child) tree.pruneNode(node);  // as the visit prunes its own
+  return false;
+}
+
+void RegionSweep::sweep_unit(octomap::OcTree& tree, const Unit& unit, const RegionVisit& visit,
+                             const StandInRule* rule) {
+  bool around = false;  // the unit holds stand-ins that stay on disk
+  if (unit.depth == grid_.depth && spill_.spilled) {
+    const RegionId id = region_of(grid_, unit.min_key);
+    if (spill_.spilled(id)) {
+      around = rule != nullptr && spill_.owe && spill_.drop && spill_.stand_in && spill_.depth >= grid_.depth &&
+               (!spill_.can_owe || spill_.can_owe(id));
+      if (!around && spill_.bring_back) spill_.bring_back(tree, id);
+    }
+  }
   octomap::OcTreeNode* root = tree.getRoot();
   if (root == nullptr) return;
   octomap::OcTreeNode* path[17];
@@ -85,7 +137,9 @@ void RegionSweep::sweep_unit(octomap::OcTree& tree, const Unit& unit, const Regi
     path[depth + 1] = tree.getNodeChild(node, i);
   }
   ++regions_;
-  if (!visit(tree, path[depth], depth, unit.min_key, visited_)) {
+  const bool gone = around ? visit_around(tree, path[depth], depth, unit.min_key, visit, *rule)
+                           : visit(tree, path[depth], depth, unit.min_key, visited_);
+  if (!gone) {
     for (unsigned d = depth; d-- > 0;) path[d]->updateOccupancyChildren();
     return;
   }
@@ -103,12 +157,13 @@ void RegionSweep::sweep_unit(octomap::OcTree& tree, const Unit& unit, const Regi
   tree.clear();  // nothing left: the root goes too (an empty tree, as OctoMap's after clear())
 }
 
-bool RegionSweep::run_slice(octomap::OcTree& tree, uint64_t node_budget, const RegionVisit& visit) {
+bool RegionSweep::run_slice(octomap::OcTree& tree, uint64_t node_budget, const RegionVisit& visit,
+                            const StandInRule* stand_ins) {
   if (finished_) return true;
   const uint64_t start = visited_;
   do {
     if (next_ == units_.size()) break;
-    visit_unit(tree, units_[next_++], visit);
+    visit_unit(tree, units_[next_++], visit, stand_ins);
   } while (visited_ - start < node_budget);
   if (next_ < units_.size()) return false;
   if (octomap::OcTreeNode* root = tree.getRoot()) settle_top(tree, root, octomap::OcTreeKey(0, 0, 0), 0, grid_, spill_);

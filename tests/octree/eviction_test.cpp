@@ -17,6 +17,7 @@
 
 #include "engine/map_engine.h"
 #include "octree/decay.h"
+#include "octree/distance_clearing.h"
 #include "octree/octree_update.h"
 #include "octree/region_codec.h"
 #include "octree/region_residency.h"
@@ -156,31 +157,22 @@ TEST(Eviction, ExactMemoryCountEqualsTheWalkAfterEveryChange) {
   query::clear_box(tree, box, query::ClearTo::kUnknown);
   ASSERT_NE(tree.memoryUsage(), before_edit) << "the edit changes the tree's memory";
   ASSERT_EQ(residency.memory(tree), tree.memoryUsage()) << "after an edit";
-  // Decay in slices over 6.4 m regions, spilled ones brought back as the sweep reaches them.
+  // Decay in slices over 6.4 m regions, spilled ones left on disk (they owe the step).
   residency.enforce(tree, residency.memory(tree), tree.memoryUsage() / 2);
   DecaySweep decay(tree, region_grid(10), DecayRule{0.5f, 0.6f});
-  SweepSpill hooks;
-  const RegionGrid sweep_grid = region_grid(10);
-  hooks.bring_back = [&](octomap::OcTree& t, RegionId id) {
-    for (RegionId r : residency.spilled_in(region_min_key(sweep_grid, id), region_max_key(sweep_grid, id)))
-      residency.bring_back(t, r);
-  };
-  hooks.spilled = [&](RegionId id) {
-    return !residency.spilled_in(region_min_key(sweep_grid, id), region_max_key(sweep_grid, id)).empty();
-  };
-  hooks.reshaped = [&](const octomap::OcTreeKey& k, unsigned depth) {
-    const auto last = static_cast<uint16_t>((1u << (16 - depth)) - 1);
-    residency.changed_box(k, octomap::OcTreeKey(uint16_t(k[0] | last), uint16_t(k[1] | last), uint16_t(k[2] | last)));
-  };
-  decay.regions().set_spill(hooks);
+  decay.regions().set_spill(residency.sweep_hooks(region_grid(10)));
   size_t slices = 0;
-  while (!decay.run_slice(tree, 20'000)) {
+  while (!decay.run_slice(tree, 5'000)) {
     ++slices;
     ASSERT_EQ(residency.memory(tree), tree.memoryUsage()) << "after decay slice " << slices;
   }
   EXPECT_GT(slices, 2u);
   EXPECT_GT(decay.stats().nodes_deleted, 0u);
   ASSERT_EQ(residency.memory(tree), tree.memoryUsage()) << "after the decay's last slice";
+  ASSERT_GT(residency.stats().owed_now, 0u);
+  const std::vector<RegionId> owing = residency.spilled_ids();
+  residency.touch(tree, owing);  // back with the step they owe applied
+  ASSERT_EQ(residency.memory(tree), tree.memoryUsage()) << "after restores that applied owed steps";
   EXPECT_GT(residency.tally().regions_reused(), residency.tally().regions_recounted())
       << "most counts reuse the regions nothing changed";
 
@@ -248,6 +240,82 @@ TEST(Eviction, BackgroundWritesKeepTheMapAndLoseNothingARefusedWriteHeld) {
   ASSERT_TRUE(test::same_tree(unbounded, bounded));
   EXPECT_EQ(ot_bytes(unbounded), ot_bytes(bounded));
   EXPECT_GT(copies, 0u);
+}
+
+// The whole map from a bounded tree, as a snapshot takes it (daemon/map/map_residency.h
+// fill_copy): the spilled regions' bytes put into a copy, then the steps they owe.
+octomap::OcTree whole_copy(const octomap::OcTree& bounded, RegionResidency& residency) {
+  octomap::OcTree copy(bounded);
+  const std::vector<RegionId> ids = residency.spilled_ids();
+  for (RegionId id : ids) restore_region(copy, residency.grid(), id, residency.spilled_bytes(id));
+  for (RegionId id : ids) apply_owed_steps(copy, residency.grid(), id, residency.owed_steps(id), nullptr);
+  return copy;
+}
+
+// Decay and clearing sweeps over a map with regions spilled leave them on disk: each owes the
+// step (applied when a scan or a touch brings it back, or a copy is taken), regions wholly
+// beyond the clearing radius go unread; one owing the most a region may owe comes back for the
+// sweep. The map is the one the same scans and sweeps make without the bound, bit for bit.
+TEST(Eviction, SweepsOwedBySpilledRegionsGiveTheUnboundedMap) {
+  const std::vector<VoxelList> lists = test::shoot_real_scans("3dtk_dat/3dtk_3scans.graph", 3);
+  ASSERT_FALSE(lists.empty());
+  OctreeStage stage(OctreeUpdateOptions{OctreeUpdateMode::kBatched, 2});
+  octomap::OcTree unbounded(0.1), bounded(0.1);
+  for (const VoxelList& l : lists) stage.apply(unbounded, l);
+  MemorySpill spill;
+  const RegionGrid sweep_grid = region_grid(10);
+  RegionResidency residency(region_grid(11), spill, unbounded.memoryUsage() / 3);
+  residency.start_background_writes(1u << 16);
+  unbounded.clear();
+  // One step of each sweep on both maps; the bounded one in slices, never restoring.
+  auto decay = [&](const DecayRule& rule) {
+    decay_tree(unbounded, sweep_grid, rule);
+    DecaySweep sweep(bounded, sweep_grid, rule);
+    sweep.regions().set_spill(residency.sweep_hooks(sweep_grid));
+    while (!sweep.run_slice(bounded, 20'000)) {}
+  };
+  auto clear = [&](const octomap::point3d& centre, double radius) {
+    clear_beyond(unbounded, sweep_grid, {centre}, radius);
+    DistanceClearingSweep sweep(bounded, sweep_grid, {centre}, radius);
+    sweep.regions().set_spill(residency.sweep_hooks(sweep_grid));
+    while (!sweep.run_slice(bounded, 20'000)) {}
+  };
+  size_t k = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const VoxelList& l : lists) {
+      stage.apply(unbounded, l);
+      residency.touch_voxels(bounded, l);
+      stage.apply(bounded, l);
+      residency.enforce(bounded);
+      const uint64_t restores = residency.stats().restores;
+      decay(DecayRule{0.6f, 0.45f});
+      // Inner nodes too: OctoMap's file holds every node's value.
+      ASSERT_EQ(ot_bytes(unbounded), ot_bytes(whole_copy(bounded, residency))) << "decayed, scan " << k;
+      if (++k % 2 == 0) clear(octomap::point3d(2, 1, 0), 14);
+      ASSERT_EQ(ot_bytes(unbounded), ot_bytes(whole_copy(bounded, residency))) << "cleared, scan " << k;
+      ASSERT_EQ(residency.stats().restores, restores) << "a sweep brought a region back";
+      if (k == 3) {  // a query's touch of half of what is spilled
+        const std::vector<RegionId> ids = residency.spilled_ids();
+        residency.touch(bounded, std::span<const RegionId>(ids).first(ids.size() / 2));
+      }
+    }
+  }
+  ResidencyStats st = residency.stats();
+  EXPECT_GT(st.steps_owed, 50u);
+  EXPECT_GT(st.owed_now, 0u);
+  EXPECT_GT(st.dropped, 0u) << "regions beyond the radius deleted unread";
+  // More steps than a region may owe: the sweeps bring the oldest back, and nothing is lost.
+  const uint64_t restores = st.restores;
+  for (size_t i = 0; i <= RegionResidency::kMaxOwed; ++i) decay(DecayRule{0.999f, 0.05f});
+  st = residency.stats();
+  EXPECT_GT(st.restores, restores) << "regions owing the most came back";
+  EXPECT_LE(st.owed_now, st.evicted_regions * RegionResidency::kMaxOwed);
+  EXPECT_EQ(ot_bytes(unbounded), ot_bytes(whole_copy(bounded, residency)));
+  residency.flush();
+  residency.restore_all(bounded);
+  EXPECT_EQ(residency.stats().owed_now, 0u);
+  ASSERT_TRUE(test::same_tree(unbounded, bounded));
+  EXPECT_EQ(ot_bytes(unbounded), ot_bytes(bounded));
 }
 
 TEST(Eviction, BoundedBuildOfRealScansIsTheUnboundedMap) {

@@ -329,9 +329,9 @@ TEST(MemoryBound, KillDuringEvictionKeepsTheSavedMap) {
   EXPECT_GT(server.residency_stats().evicted_regions, 0u);
 }
 
-// Decay sweeps over a map with evicted regions: each comes back as the sweep reaches it, so
-// the map is the rule's map of OctoMap's scans (octree/decay.h, checked against OctoMap's own
-// tree in forgetting_test).
+// Decay sweeps over a map with evicted regions leave them in the store: each owes the steps
+// (applied when a scan brings it back, or a copy is taken), and the map is the rule's map of
+// OctoMap's scans (octree/decay.h, checked against OctoMap's own tree in forgetting_test).
 TEST(MemoryBound, DecayOverEvictedRegionsIsTheRulesMap) {
   const ScanSet& set = real_scans();
   ASSERT_GE(set.scans.size(), 3u);
@@ -357,7 +357,8 @@ TEST(MemoryBound, DecayOverEvictedRegionsIsTheRulesMap) {
   }
   const daemon::MapResidencyStats st = server.residency_stats();
   EXPECT_GT(st.evictions, 0u);
-  EXPECT_GT(st.restores, 0u) << "the sweeps brought evicted regions back";
+  EXPECT_GT(st.restores, 0u) << "scans brought evicted regions back";
+  EXPECT_GT(st.steps_owed, 0u) << "the sweeps left evicted regions in the store";
   const auto whole = server.whole_map();
   expect_octomaps(*whole, reference, "decayed with evicted regions");
   EXPECT_EQ(compare_structure(*whole, reference), "");

@@ -57,7 +57,7 @@ octomap_rt_add_test(memory_bound_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/memory_b
 octomap_rt_lcm_handler_sources(memory_bound_test ${CMAKE_CURRENT_LIST_DIR}/memory_bound_test.cpp)
 # The memory bound's edges: the map's memory right after a scan's restores, a .bt prior past the bound.
 octomap_rt_add_test(map_residency_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_residency_test.cpp ${SERVER_TEST_FIXTURES}
-                    LIBS octomap_rt_daemon TIMEOUT 120)
+                    $<TARGET_OBJECTS:octomap_rt_octree_test_helpers> LIBS octomap_rt_daemon TIMEOUT 120)
 # Issue 21: every numeric field of scan_t at its degenerate values, on every back end.
 octomap_rt_add_test(server_scan_fields_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/scan_fields_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)

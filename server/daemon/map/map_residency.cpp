@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <stdexcept>
+#include <type_traits>
 
 #include "daemon/map/map_identity.h"
 #include "daemon/map/map_state.h"
@@ -47,6 +48,9 @@ void MapResidency::publish_stats(const octomap::OcTree& tree) {
   stats_.evicted_bytes = r.evicted_bytes;
   stats_.evictions = r.evictions;
   stats_.restores = r.restores;
+  stats_.steps_owed = r.steps_owed;
+  stats_.dropped = r.dropped;
+  stats_.owed_now = r.owed_now;
   stats_.costs = r.costs;
   stats_.regions_recounted = residency_.tally().regions_recounted();
   stats_.regions_reused = residency_.tally().regions_reused();
@@ -80,19 +84,21 @@ void MapResidency::note_costs(double touch_ms, double enforce_ms, double walk_ms
 std::string residency_cost_line(const MapResidencyStats& a, const MapResidencyStats& b) {
   const ResidencyCosts &x = a.costs, &y = b.costs;
   char line[1024];
-  std::snprintf(line, sizeof line,
-                "memory bound costs: %llu passes evicted %llu regions in %.1f ms (most %.1f ms a pass; walks %.1f, "
-                "list %.1f, encode %.1f, store write %.1f, strip %.1f); %llu restores in %.1f ms (most %.1f ms a "
-                "scan; store read %.1f, rebuild %.1f); exact counts recounted %llu regions, reused %llu; off stage: "
-                "sizing %.1f ms, waits for the writer %.1f ms, %llu restores from kept nodes",
-                (unsigned long long)(b.enforce_passes - a.enforce_passes),
-                (unsigned long long)(b.evictions - a.evictions), b.enforce_ms - a.enforce_ms, b.max_enforce_ms,
-                b.walk_ms - a.walk_ms, y.list_ms - x.list_ms, y.encode_ms - x.encode_ms, y.put_ms - x.put_ms,
-                y.strip_ms - x.strip_ms, (unsigned long long)(b.restores - a.restores), b.touch_ms - a.touch_ms,
-                b.max_touch_ms, y.get_ms - x.get_ms, y.rebuild_ms - x.rebuild_ms,
-                (unsigned long long)(b.regions_recounted - a.regions_recounted),
-                (unsigned long long)(b.regions_reused - a.regions_reused), y.size_ms - x.size_ms,
-                y.write_wait_ms - x.write_wait_ms, (unsigned long long)(y.reattached - x.reattached));
+  std::snprintf(
+      line, sizeof line,
+      "memory bound costs: %llu passes evicted %llu regions in %.1f ms (most %.1f ms a pass; walks %.1f, "
+      "list %.1f, encode %.1f, store write %.1f, strip %.1f); %llu restores in %.1f ms (most %.1f ms a "
+      "scan; store read %.1f, rebuild %.1f); exact counts recounted %llu regions, reused %llu; off stage: "
+      "sizing %.1f ms, waits for the writer %.1f ms, %llu restores from kept nodes; sweeps over the store: %llu "
+      "steps owed, %llu regions deleted unread",
+      (unsigned long long)(b.enforce_passes - a.enforce_passes), (unsigned long long)(b.evictions - a.evictions),
+      b.enforce_ms - a.enforce_ms, b.max_enforce_ms, b.walk_ms - a.walk_ms, y.list_ms - x.list_ms,
+      y.encode_ms - x.encode_ms, y.put_ms - x.put_ms, y.strip_ms - x.strip_ms,
+      (unsigned long long)(b.restores - a.restores), b.touch_ms - a.touch_ms, b.max_touch_ms, y.get_ms - x.get_ms,
+      y.rebuild_ms - x.rebuild_ms, (unsigned long long)(b.regions_recounted - a.regions_recounted),
+      (unsigned long long)(b.regions_reused - a.regions_reused), y.size_ms - x.size_ms,
+      y.write_wait_ms - x.write_wait_ms, (unsigned long long)(y.reattached - x.reattached),
+      (unsigned long long)(b.steps_owed - a.steps_owed), (unsigned long long)(b.dropped - a.dropped));
   return line;
 }
 
@@ -145,16 +151,28 @@ bool MapResidency::touch_scan(octomap::OcTree& tree, std::span<const VoxelUpdate
 
 void MapResidency::touch_boxes(octomap::OcTree& tree, std::span<const query::KeyBox> boxes) {
   std::lock_guard lock(mutex_);
-  std::vector<RegionId> ids;
-  for (const query::KeyBox& b : boxes) {
-    const std::vector<RegionId> in = residency_.spilled_in(b.min, b.max);
-    ids.insert(ids.end(), in.begin(), in.end());
-  }
-  std::sort(ids.begin(), ids.end());
-  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  auto spilled_in_boxes = [&] {
+    std::vector<RegionId> ids;
+    for (const query::KeyBox& b : boxes) {
+      const std::vector<RegionId> in = residency_.spilled_in(b.min, b.max);
+      ids.insert(ids.end(), in.begin(), in.end());
+    }
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    return ids;
+  };
+  std::vector<RegionId> ids = spilled_in_boxes();
   if (ids.empty()) return;
+  const auto t0 = SteadyClock::now();
   try {
     residency_.touch(tree, ids);
+    // As a scan's (touch_scan): room is made before the query reads, the regions just
+    // touched going last; whatever of the boxes that pass took comes back.
+    if (estimate(tree) > static_cast<uint64_t>(kSoftStart * static_cast<double>(max_bytes_))) {
+      enforce_locked(tree, /*exact=*/true);
+      ids = spilled_in_boxes();
+      if (!ids.empty()) residency_.touch(tree, ids);
+    }
   } catch (const std::exception& e) {
     count_residency_change();
     publish_stats(tree);
@@ -165,6 +183,7 @@ void MapResidency::touch_boxes(octomap::OcTree& tree, std::span<const query::Key
   }
   count_residency_change();
   publish_stats(tree);
+  note_costs(ms_since(t0), 0, 0);
 }
 
 void MapResidency::will_change(std::span<const query::KeyBox> boxes) {
@@ -205,7 +224,7 @@ void MapResidency::enforce_locked(octomap::OcTree& tree, bool exact) {
     const uint64_t before = residency_.stats().evictions;
     EnforceResult r;
     try {
-      r = residency_.enforce(tree, bytes, groups == 1 ? soft : target, groups, kSliceMs);
+      r = residency_.enforce(tree, bytes, groups == 1 ? soft : target, groups, kSliceMs, groups == 1 ? kSoftIdle : 0);
     } catch (const std::exception& e) {  // the store refused a put: that region stays here
       std::lock_guard s(stats_mutex_);
       if (stats_.evict_failures++ == 0 || stats_.evict_failures % 1000 == 0)
@@ -221,24 +240,27 @@ void MapResidency::enforce_locked(octomap::OcTree& tree, bool exact) {
 }
 
 SweepSpill MapResidency::sweep_hooks(const RegionGrid& sweep) {
-  SweepSpill s;
-  s.bring_back = [this, sweep](octomap::OcTree& tree, RegionId id) {
-    std::lock_guard lock(mutex_);
-    const std::vector<RegionId> inside = residency_.spilled_in(region_min_key(sweep, id), region_max_key(sweep, id));
-    if (inside.empty()) return;
-    for (RegionId r : inside) residency_.bring_back(tree, r);  // throws when the store refuses: the sweep stops
-    count_residency_change();
+  // The residency's hooks, each under mutex_; restores and deletions count as map changes.
+  SweepSpill s = residency_.sweep_hooks(sweep);
+  auto locked = [this](auto f, bool change) {
+    return [this, f = std::move(f), change](auto&&... args) {
+      std::lock_guard lock(mutex_);
+      const uint64_t before = residency_.stats().restores;
+      if constexpr (std::is_same_v<decltype(f(args...)), void>) {
+        f(args...);
+        if (change || residency_.stats().restores != before) count_residency_change();
+      } else {
+        return f(args...);
+      }
+    };
   };
-  s.reshaped = [this](const octomap::OcTreeKey& min_key, unsigned depth) {
-    std::lock_guard lock(mutex_);
-    const auto last = static_cast<uint16_t>((1u << (16 - depth)) - 1);
-    residency_.changed_box(min_key, octomap::OcTreeKey(uint16_t(min_key[0] | last), uint16_t(min_key[1] | last),
-                                                       uint16_t(min_key[2] | last)));
-  };
-  s.spilled = [this, sweep](RegionId id) {
-    std::lock_guard lock(mutex_);
-    return !residency_.spilled_in(region_min_key(sweep, id), region_max_key(sweep, id)).empty();
-  };
+  s.bring_back = locked(std::move(s.bring_back), false);
+  s.reshaped = locked(std::move(s.reshaped), false);
+  s.spilled = locked(std::move(s.spilled), false);
+  s.can_owe = locked(std::move(s.can_owe), false);
+  s.stand_in = locked(std::move(s.stand_in), false);
+  s.owe = locked(std::move(s.owe), false);
+  s.drop = locked(std::move(s.drop), true);
   return s;
 }
 
@@ -261,12 +283,16 @@ void MapResidency::forget_all() {
 MapResidency::SpilledRegions MapResidency::spilled_regions() const {
   std::lock_guard lock(mutex_);
   SpilledRegions out;
-  for (RegionId id : residency_.spilled_ids()) out.emplace_back(id, residency_.spilled_bytes(id));
+  for (RegionId id : residency_.spilled_ids())
+    out.push_back(SpilledRegion{id, residency_.spilled_bytes(id), residency_.owed_steps(id)});
   return out;
 }
 
 void MapResidency::fill_copy(octomap::OcTree& copy, const RegionGrid& grid, const SpilledRegions& regions) {
-  for (const auto& [id, bytes] : regions) restore_region(copy, grid, id, bytes);
+  for (const SpilledRegion& r : regions) restore_region(copy, grid, r.id, r.bytes);
+  // Every region is back: none is a stand-in when the owed steps settle the nodes above.
+  for (const SpilledRegion& r : regions)
+    if (!r.owed.empty()) apply_owed_steps(copy, grid, r.id, r.owed, nullptr);
 }
 
 MapResidencyStats MapResidency::stats() const {

@@ -6,7 +6,8 @@
 // - edits touch their box (a reset drops every spilled region);
 // - queries touch what they may read (daemon/queries/query_footprint.h), under the
 //   exclusive lock when something must come back;
-// - the upkeep's sweeps bring each spilled region back before they visit it;
+// - the upkeep's sweeps leave spilled regions on disk: each owes the sweep's step, applied
+//   when it comes back, or goes unread when the step deletes all of it (region_sweep.h);
 // - whole-map readers (snapshots, saves, the OCTOMAP map) fill their copy's stand-ins from
 //   the store (fill_copy), so every snapshot and save is the whole map.
 // Every batch of evictions or restores counts as one map change (count_residency_change).
@@ -15,11 +16,12 @@
 // the nodes above the region depth and the regions changed since the last count are walked)
 // when the running estimate (nodes times the bytes a node took at the last count) passes the bound;
 // eviction then goes down to kLowWater of the bound. Between kSoftStart and the bound each
-// change spills one sibling group by the estimate alone (no walk), so the map rarely gets
+// change spills one idle sibling group (kSoftIdle) by the estimate alone (no walk), so the map rarely gets
 // there: the cost is spread over the scans (docs/BENCHMARKS.md "The memory bound").
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <span>
 #include <string>
@@ -46,6 +48,8 @@ struct MapResidencyStats {
   uint64_t resident_regions = 0;                    // regions holding a subtree at the last eviction pass
   uint64_t evicted_regions = 0, evicted_bytes = 0;  // now, in the store
   uint64_t evictions = 0, restores = 0;             // over the run
+  uint64_t steps_owed = 0, dropped = 0;             // over the run: sweeps' steps kept, regions deleted unread
+  uint64_t owed_now = 0;                            // steps kept now
   uint64_t evict_failures = 0, restore_failures = 0;
   std::string last_error;  // the store's last refusal ("" if none)
   // Where the time goes, over the run (ms): the passes that evict, the exact memory walks
@@ -74,6 +78,10 @@ class MapResidency {
   // back to the bound itself is never cut. Eviction only counts and detaches nodes (the
   // writer thread encodes and stores them).
   static constexpr double kSliceMs = 3;
+  // Between kSoftStart and the bound only regions no change touched in the last kSoftIdle
+  // changes go: spilling what the robots are mapping only to bring it back a scan later is
+  // all cost and no room (the bound itself is enforced whatever the regions' age).
+  static constexpr uint64_t kSoftIdle = 64;
   // How often the cost breakdown is logged while regions move.
   static constexpr double kCostReportS = 10;
 
@@ -95,8 +103,10 @@ class MapResidency {
   // that refuses keeps the regions in memory (counted, logged).
   void enforce(octomap::OcTree& tree);
   // A sweep's hooks (octree/region_sweep.h) for a sweep over `sweep` regions, as coarse as the
-  // bound's or coarser: a sweep region comes back whole (every spilled region inside it) and
-  // counts as spilled while any region inside it is. Call under the exclusive map lock.
+  // bound's or coarser: spilled regions owe the sweep's step or go unread; one that owes
+  // too many comes back (with the rest of its sweep region) before the sweep visits it. A
+  // sweep region counts as spilled while any region inside it is. Call under the exclusive
+  // map lock.
   SweepSpill sweep_hooks(const RegionGrid& sweep);
   // While the map is loaded, before anything reads it: region `id` of the map file goes to the
   // store as `bytes` and is a stand-in in the tree being built (daemon/persistence/map_store.h
@@ -108,7 +118,14 @@ class MapResidency {
   // store, which put into a copy of the map's tree taken under the same lock (fill_copy, after
   // the lock is let go: the rebuild costs no one a wait) make it the whole map. Throws when
   // the store cannot give one back.
-  using SpilledRegions = std::vector<std::pair<RegionId, std::vector<uint8_t>>>;
+  // With each region the sweeps' steps it owes (octree/region_residency.h owe), which the copy
+  // applies once its bytes are in.
+  struct SpilledRegion {
+    RegionId id = 0;
+    std::vector<uint8_t> bytes;
+    std::vector<std::shared_ptr<const RegionStep>> owed;
+  };
+  using SpilledRegions = std::vector<SpilledRegion>;
   SpilledRegions spilled_regions() const;
   static void fill_copy(octomap::OcTree& copy, const RegionGrid& grid, const SpilledRegions& regions);
 

@@ -67,8 +67,8 @@ void MapUpkeep::apply_slice(const MapStep& slice) { apply_map_step(map_, slice);
 template <class Sweep>
 void MapUpkeep::run_sweep(std::function<std::unique_ptr<Sweep>(const octomap::OcTree&)> make,
                           uint64_t& deleted_counter) {
-  // With a memory bound, spilled regions come back as the map of record's sweep reaches them
-  // and the bound holds after every slice (daemon/map/map_residency.h).
+  // With a memory bound, spilled regions stay in the store, owing the sweep's step, and the
+  // bound holds after every slice (daemon/map/map_residency.h).
   const octomap::OcTree* record = map_.tree.get();
   auto make_here = [residency = map_.residency, record, grid = grid_,
                     make = std::move(make)](const octomap::OcTree& t) {
