@@ -7,10 +7,11 @@ COST = re.compile(r"memory bound costs: (\d+) passes evicted (\d+) regions in ([
                   r"pass; walks ([0-9.]+), list ([0-9.]+), encode ([0-9.]+), store write ([0-9.]+), strip "
                   r"([0-9.]+)\); (\d+) restores in ([0-9.]+) ms \(most ([0-9.]+) ms a scan; store read ([0-9.]+), "
                   r"rebuild ([0-9.]+)\)(?:; exact counts recounted (\d+) regions, reused (\d+))?"
-                  r"(?:; off stage: sizing ([0-9.]+) ms, waits for the writer ([0-9.]+) ms, (\d+) restores from kept nodes)?")
+                  r"(?:; off stage: sizing ([0-9.]+) ms, waits for the writer ([0-9.]+) ms, (\d+) restores from kept nodes)?"
+                  r"(?:; sweeps over the store: (\d+) steps owed, (\d+) regions deleted unread)?")
 NAMES = ["passes", "evicted", "evict ms", "most a pass", "walks", "list", "encode", "store write", "strip",
          "restores", "restore ms", "most a scan", "store read", "rebuild", "regions recounted", "reused",
-         "sizing (stage 2)", "writer waits", "restores from kept nodes"]
+         "sizing (stage 2)", "writer waits", "restores from kept nodes", "steps owed", "deleted unread"]
 
 
 def bound_costs(lines):

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The soak's figures (issue 25) from a run's folder: series.csv (every status) and server.log.
 
-    docs/bench/dev/issue25-soak/figures.py RUN_DIR [BOUND_MIB]
+    docs/bench/dev/issue25-soak/figures.py RUN_DIR [BOUND_MIB [SKIP_S]]
 
 Prints the server's RSS and map memory per quarter of the run (flat: the last quarters within
 +-5 % of the second), how often the map memory was above the bound and above 1.1 x the bound
@@ -18,6 +18,7 @@ from bound_costs import bound_costs, costs_text  # noqa: E402 (docs/bench/dev/bo
 
 run = Path(sys.argv[1])
 bound = float(sys.argv[2]) if len(sys.argv) > 2 else None
+skip = float(sys.argv[3]) if len(sys.argv) > 3 else 60  # seconds left out at the start (the map's build-up)
 rows = list(csv.DictReader((run / "series.csv").open()))
 t = [float(r["t_s"]) for r in rows]
 end = t[-1]
@@ -37,8 +38,8 @@ for name, xs in (("server RSS", col("rss_mib")), ("map memory", col("map_memory_
           f"; 4th vs 2nd quarter {100 * (quarters[3] / quarters[1] - 1):+.1f} %, "
           f"4th vs 1st {100 * (quarters[3] / quarters[0] - 1):+.1f} %")
 if bound:
-    after = between(60, end + 1, col("map_memory_mib"))
-    print(f"map memory after the first minute: median {statistics.median(after):.2f} MiB, max {max(after):.2f}; "
+    after = between(skip, end + 1, col("map_memory_mib"))
+    print(f"map memory after the first {skip:.0f} s: median {statistics.median(after):.2f} MiB, max {max(after):.2f}; "
           f"above the bound {sum(m > bound for m in after)} of {len(after)} statuses, "
           f"above 1.1 x the bound {sum(m > 1.1 * bound for m in after)}")
 for i in range(10):
