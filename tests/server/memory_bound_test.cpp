@@ -16,6 +16,7 @@
 
 #include "core/clock.h"
 #include "daemon/map/applied_order.h"
+#include "daemon/persistence/map_identity_file.h"
 #include "daemon/persistence/region_store.h"
 #include "octomap_rt/box_reply_t.hpp"
 #include "octomap_rt/distance_points_reply_t.hpp"
@@ -298,11 +299,13 @@ TEST(MemoryBound, KillDuringEvictionKeepsTheSavedMap) {
       lc.publish(kChannel, &msg);
       if (!wait_until_done(server, ++sent)) ::_exit(2);
     }
-    // Wait for a save holding every scan of the first pass, then go on and die mid-pass.
+    // Wait for a save holding every scan of the first pass (its identity file says how many:
+    // the order file may hold scans applied after the save's copy), then go on and die mid-pass.
     const auto deadline = SteadyClock::now() + std::chrono::seconds(60);
     while (SteadyClock::now() < deadline) {
       try {
-        if (daemon::read_applied_order(cfg.map_path + ".order").entries.size() == n) break;
+        const auto saved = daemon::read_map_identity(cfg.map_path);
+        if (saved && saved->order_entries >= n) break;
       } catch (const std::exception&) {}
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
