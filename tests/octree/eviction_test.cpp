@@ -3,6 +3,7 @@
 // touches them is, once everything is back, the map built without the bound, node for node
 // and log-odds for log-odds (and OctoMap's own file bytes).
 #include <chrono>
+#include <functional>
 #include <map>
 #include <memory>
 #include <span>
@@ -56,6 +57,26 @@ std::string ot_bytes(const octomap::OcTree& t) {
   return os.str();
 }
 
+// The map of `passes` passes over `lists` without a bound.
+octomap::OcTree unbounded_map(OctreeStage& stage, const std::vector<VoxelList>& lists, int passes) {
+  octomap::OcTree tree(0.1);
+  for (int pass = 0; pass < passes; ++pass)
+    for (const VoxelList& l : lists) stage.apply(tree, l);
+  return tree;
+}
+
+// Stage 2's order over `passes` passes of `lists` under the bound: a scan's regions touched
+// (brought back), the scan, then `after` (the bound's enforce and what the case checks).
+void bounded_passes(OctreeStage& stage, RegionResidency& residency, octomap::OcTree& tree,
+                    const std::vector<VoxelList>& lists, int passes, const std::function<void()>& after) {
+  for (int pass = 0; pass < passes; ++pass)
+    for (const VoxelList& l : lists) {
+      residency.touch_voxels(tree, l);
+      stage.apply(tree, l);
+      after();
+    }
+}
+
 TEST(Eviction, RegionBytesRoundTripAndRefuseDamage) {
   const std::vector<VoxelList> lists = test::shoot_real_scans("3dtk_dat/3dtk_3scans.graph", 1);
   ASSERT_FALSE(lists.empty());
@@ -88,24 +109,18 @@ TEST(Eviction, RegionBytesRoundTripAndRefuseDamage) {
 void check_bounded_build(const std::string& graph, size_t scans) {
   const std::vector<VoxelList> lists = test::shoot_real_scans(graph, scans);
   ASSERT_FALSE(lists.empty());
-  octomap::OcTree unbounded(0.1);
   OctreeStage stage(OctreeUpdateOptions{OctreeUpdateMode::kBatched, 2});
-  for (int pass = 0; pass < 2; ++pass)
-    for (const VoxelList& l : lists) stage.apply(unbounded, l);
+  const octomap::OcTree unbounded = unbounded_map(stage, lists, 2);
   const uint64_t bound = unbounded.memoryUsage() / 3;
 
   octomap::OcTree bounded(0.1);
   MemorySpill spill;
   RegionResidency residency(region_grid(10), spill, bound);
   uint64_t most = 0;
-  for (int pass = 0; pass < 2; ++pass) {
-    for (const VoxelList& l : lists) {
-      residency.touch_voxels(bounded, l);
-      stage.apply(bounded, l);
-      residency.enforce(bounded);
-      most = std::max<uint64_t>(most, bounded.memoryUsage());
-    }
-  }
+  bounded_passes(stage, residency, bounded, lists, 2, [&] {
+    residency.enforce(bounded);
+    most = std::max<uint64_t>(most, bounded.memoryUsage());
+  });
   const ResidencyStats st = residency.stats();
   EXPECT_GT(st.evictions, 5u) << graph;
   EXPECT_GT(st.restores, 0u) << graph;
@@ -199,10 +214,8 @@ TEST(Eviction, ExactMemoryCountEqualsTheWalkAfterEveryChange) {
 TEST(Eviction, BackgroundWritesKeepTheMapAndLoseNothingARefusedWriteHeld) {
   const std::vector<VoxelList> lists = test::shoot_real_scans("3dtk_dat/3dtk_3scans.graph", 2);
   ASSERT_FALSE(lists.empty());
-  octomap::OcTree unbounded(0.1);
   OctreeStage stage(OctreeUpdateOptions{OctreeUpdateMode::kBatched, 2});
-  for (int pass = 0; pass < 2; ++pass)
-    for (const VoxelList& l : lists) stage.apply(unbounded, l);
+  const octomap::OcTree unbounded = unbounded_map(stage, lists, 2);
   const uint64_t bound = unbounded.memoryUsage() / 3;
 
   octomap::OcTree bounded(0.1);
@@ -210,23 +223,20 @@ TEST(Eviction, BackgroundWritesKeepTheMapAndLoseNothingARefusedWriteHeld) {
   const RegionGrid grid = region_grid(10);
   RegionResidency residency(grid, spill, bound);
   residency.start_background_writes(20'000);  // small: enforce also waits for room
-  size_t refusals = 0, copies = 0;
-  for (int pass = 0; pass < 2; ++pass) {
-    for (const VoxelList& l : lists) {
-      residency.touch_voxels(bounded, l);
-      stage.apply(bounded, l);
-      try {
-        residency.enforce(bounded, residency.memory(bounded), bound * 9 / 10);
-      } catch (const std::runtime_error&) {
-        ++refusals;
-      }
-      ASSERT_EQ(residency.memory(bounded), bounded.memoryUsage()) << "the exact count with regions pending";
-      // A whole-map copy while regions are pending or written (as map_snapshot.cpp takes it).
-      octomap::OcTree copy(bounded);
-      for (RegionId id : residency.spilled_ids()) restore_region(copy, grid, id, residency.spilled_bytes(id));
-      ++copies;
+  size_t refusals = 0, copies = 0, miscounts = 0;
+  bounded_passes(stage, residency, bounded, lists, 2, [&] {
+    try {
+      residency.enforce(bounded, residency.memory(bounded), bound * 9 / 10);
+    } catch (const std::runtime_error&) {
+      ++refusals;
     }
-  }
+    miscounts += residency.memory(bounded) != bounded.memoryUsage();
+    // A whole-map copy while regions are pending or written (as map_snapshot.cpp takes it).
+    octomap::OcTree copy(bounded);
+    for (RegionId id : residency.spilled_ids()) restore_region(copy, grid, id, residency.spilled_bytes(id));
+    ++copies;
+  });
+  EXPECT_EQ(miscounts, 0u) << "the exact count with regions pending";
   octomap::OcTree last_copy(bounded);
   for (RegionId id : residency.spilled_ids()) restore_region(last_copy, grid, id, residency.spilled_bytes(id));
   EXPECT_TRUE(test::same_tree(unbounded, last_copy)) << "a copy with regions pending is the whole map";
@@ -260,13 +270,11 @@ TEST(Eviction, SweepsOwedBySpilledRegionsGiveTheUnboundedMap) {
   const std::vector<VoxelList> lists = test::shoot_real_scans("3dtk_dat/3dtk_3scans.graph", 3);
   ASSERT_FALSE(lists.empty());
   OctreeStage stage(OctreeUpdateOptions{OctreeUpdateMode::kBatched, 2});
-  octomap::OcTree unbounded(0.1), bounded(0.1);
-  for (const VoxelList& l : lists) stage.apply(unbounded, l);
   MemorySpill spill;
   const RegionGrid sweep_grid = region_grid(10);
-  RegionResidency residency(region_grid(11), spill, unbounded.memoryUsage() / 3);
+  RegionResidency residency(region_grid(11), spill, unbounded_map(stage, lists, 1).memoryUsage() / 3);
   residency.start_background_writes(1u << 16);
-  unbounded.clear();
+  octomap::OcTree unbounded(0.1), bounded(0.1);
   // One step of each sweep on both maps; the bounded one in slices, never restoring.
   auto decay = [&](const DecayRule& rule) {
     decay_tree(unbounded, sweep_grid, rule);
