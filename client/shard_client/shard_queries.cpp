@@ -142,9 +142,9 @@ Routed<octomap_rt::ray_reply_t> ShardQueries::rays(const std::vector<float>& ori
                                                    const std::vector<float>& directions, float max_range,
                                                    bool ignore_unknown, const ShardWait& w) {
   Routed<octomap_rt::ray_reply_t> out;
-  const auto got = ask_each<octomap_rt::ray_reply_t>(every_shard(set_.count), set_.count, out.shards, [&](uint32_t i) {
-    return clients_[i]->rays(origins, directions, max_range, ignore_unknown, w.on_shard(i));
-  });
+  const auto got = ask_each<octomap_rt::ray_reply_t>(
+      shards_for_rays(set_, origins, directions, max_range, resolution_), set_.count, out.shards,
+      [&](uint32_t i) { return clients_[i]->rays(origins, directions, max_range, ignore_unknown, w.on_shard(i)); });
   merged_header(out.reply, got);
   merge_shard_rays(out.reply, got, origins, set_, resolution_);
   return out;

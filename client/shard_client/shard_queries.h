@@ -1,9 +1,10 @@
 // Queries across a shard set (docs/PROTOCOL.md, "Shards"): each shard answers for its own
 // regions, so a point goes to the shard owning its region (a coarse depth above the region
 // depth asks every shard and takes the largest value, as OctoMap's inner nodes do), a box is
-// counted on every shard and summed, and a ray is cast on every shard, each stopping in its own
-// regions, and gets the stop the ray meets first (shard_rays.h); a distance is the smallest of the shards' within reach (shard_distance.h). A
-// shard that does not answer leaves its part unknown, and the answer says so.
+// counted on every shard and summed, and a ray is cast on every shard it may reach
+// (shards_for_rays), each stopping in its own regions, and gets the stop the ray meets first
+// (shard_rays.h); a distance is the smallest of the shards' within reach (shard_distance.h).
+// A shard that does not answer leaves its part unknown, and the answer says so.
 #pragma once
 
 #include <chrono>

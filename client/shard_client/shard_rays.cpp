@@ -1,8 +1,11 @@
 #include "shard_client/shard_rays.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <numeric>
 
 #include "octomap_rt/occupancy_reply_t.hpp"
 #include "shard_client/shard_distance.h"
@@ -60,6 +63,35 @@ void merge_shard_rays(octomap_rt::ray_reply_t& out, const std::vector<std::optio
     out.hit[j] = g.hit[j], out.end_state[j] = g.end_state[j];
     std::copy(&g.end_xyz[3 * j], &g.end_xyz[3 * j] + 3, &out.end_xyz[3 * j]);
   }
+}
+
+std::vector<uint32_t> shards_for_rays(const protocol::ShardSet& set, std::span<const float> origins,
+                                      std::span<const float> directions, float max_range, double resolution) {
+  std::vector<uint32_t> every(set.count);
+  std::iota(every.begin(), every.end(), 0u);
+  if (set.rule != protocol::ShardRule::kBoxes || !(max_range > 0) || !std::isfinite(max_range)) return every;
+  constexpr int64_t kKeyTop = 65535;
+  std::vector<bool> asked(set.count, false);
+  for (size_t j = 0; j + 2 < origins.size() && j + 2 < directions.size(); j += 3) {
+    const double d[3] = {directions[j], directions[j + 1], directions[j + 2]};
+    const double norm = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (!(norm > 0) || !std::isfinite(norm)) return every;
+    std::array<int64_t, 3> lo{}, hi{};
+    for (int a = 0; a < 3; ++a) {
+      int64_t k0 = 0, k1 = 0;
+      if (!voxel_key(origins[j + a], resolution, k0)) return every;
+      // castRay stops at the first key whose centre lies past max_range: within a voxel's diagonal.
+      const double end = double(origins[j + a]) + d[a] / norm * (double(max_range) + 2 * resolution);
+      if (!std::isfinite(end)) return every;
+      if (!voxel_key(end, resolution, k1)) k1 = end < 0 ? 0 : kKeyTop;
+      lo[a] = std::min(k0, k1) - 2, hi[a] = std::max(k0, k1) + 2;
+    }
+    for (uint32_t i : shards_meeting(set, lo, hi)) asked[i] = true;
+  }
+  std::vector<uint32_t> out;
+  for (uint32_t i = 0; i < set.count; ++i)
+    if (asked[i]) out.push_back(i);
+  return out.empty() ? std::vector<uint32_t>{0} : out;  // no ray: one shard answers the empty batch
 }
 
 }  // namespace ort::client

@@ -8,6 +8,7 @@
 // own an earlier stop: the answer is then partial (the ray may stop short of its first hit there).
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <vector>
@@ -23,5 +24,14 @@ namespace ort::client {
 // earliest cut's).
 void merge_shard_rays(octomap_rt::ray_reply_t& out, const std::vector<std::optional<octomap_rt::ray_reply_t>>& got,
                       std::span<const float> origins, const protocol::ShardSet& set, double resolution);
+
+// The shards a batch of rays must be asked (in index order): for the boxes rule with a finite
+// max_range, those whose box meets a ray's key box (its origin's key and the key past its range,
+// widened by 2 keys: a superset of the keys castRay walks); a shard no ray reaches would only
+// answer "no stop", which every asked shard's answer already covers. Every shard otherwise
+// (the hash rule's regions meet nearly every ray), and for a ray outside the key range or
+// without a usable direction (every shard answers or refuses those alike).
+std::vector<uint32_t> shards_for_rays(const protocol::ShardSet& set, std::span<const float> origins,
+                                      std::span<const float> directions, float max_range, double resolution);
 
 }  // namespace ort::client
