@@ -72,6 +72,10 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
         cfg_.replica_versions ? std::optional(region_grid(evict_region_depth(cfg_))) : std::nullopt);
     map_.replica = replica_.get();
   }
+  if (cfg_.queries.distance.field_cache && cfg_.queries.distance.change_lists) {
+    journal_ = std::make_unique<ChangeJournal>();
+    map_.journal = journal_.get();
+  }
   engine_ = std::make_unique<MapEngine>(cfg_.engine, log_);
   if (!cfg_.applied_log.empty()) map_.order.open_live_log(cfg_.applied_log);
 

@@ -22,6 +22,7 @@
 #include "daemon/intake/producer_registry.h"
 #include "daemon/intake/scan_intake.h"
 #include "daemon/intake/scan_queue.h"
+#include "daemon/map/change_journal.h"
 #include "daemon/map/map_replica.h"
 #include "daemon/map/map_residency.h"
 #include "daemon/map/map_state.h"
@@ -72,6 +73,13 @@ class MappingServer {
   std::vector<ProducerStats> producer_stats() const { return producers_.snapshot(); }
   std::vector<QueryClientStats> query_stats() const {
     return queries_ ? queries_->stats() : std::vector<QueryClientStats>{};
+  }
+  // How the distance field cache's entry was kept up to date (distance/field_cache.h).
+  distance::FieldCacheStats distance_cache_stats() const {
+    return queries_ ? queries_->service_stats().field_cache : distance::FieldCacheStats{};
+  }
+  std::optional<ChangeJournalStats> change_journal_stats() const {
+    return journal_ ? std::optional(journal_->stats()) : std::nullopt;
   }
   // The applied order as the order file beside the map has it (synced first); without --map
   // the newest AppliedOrder::kRecent entries of this run.
@@ -162,7 +170,8 @@ class MappingServer {
   std::unique_ptr<RegionStore> region_store_;  // --max-map-memory's evicted regions
   std::unique_ptr<MapResidency> residency_;
   std::optional<MapLoadBound> load_bound_;
-  std::unique_ptr<MapReplica> replica_;  // what whole-map readers read (cfg_.read_replica)
+  std::unique_ptr<MapReplica> replica_;     // what whole-map readers read (cfg_.read_replica)
+  std::unique_ptr<ChangeJournal> journal_;  // the scans' class changes, for the distance field cache
   ProducerRegistry producers_;
   ScanQueue queue_;
   PipelineMetrics metrics_;

@@ -61,7 +61,7 @@ PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, 
 }
 
 PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, const DistanceOptions& opt,
-                       const DistanceLimits& lim, const std::function<std::optional<CellBox>(const CellBox&)>& cover) {
+                       const DistanceLimits& lim, const CoverFn& cover) {
   PointsRead r;
   r.opt = opt;
   r.resolution = tree.getResolution();
@@ -80,9 +80,10 @@ PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, 
   }
   r.cells.resize(n);
   const CellBox all = cell_box_around(lo, hi, m, pad);
-  if (const std::optional<CellBox> c = cover ? cover(all) : std::nullopt; c && c->dims.cells() <= lim.max_grid_cells) {
-    r.grids.push_back(read_occupancy(tree, *c, opt.unknown, opt.ownership));
-    for (size_t p = 0; p < n; ++p) r.cells[p] = {0, cell_index(keys[p], *c)};
+  if (const std::optional<GridCover> c = cover ? cover(all) : std::nullopt; c) {
+    check_cells(c->box.dims.cells(), lim);
+    r.grids.push_back(c->read ? read_occupancy(tree, c->box, opt.unknown, opt.ownership) : OccupancyGrid{c->box, {}});
+    for (size_t p = 0; p < n; ++p) r.cells[p] = {0, cell_index(keys[p], c->box)};
     return r;
   }
   if (all.dims.cells() <= std::min(lim.single_grid_cells, lim.max_grid_cells)) {
@@ -140,6 +141,13 @@ std::vector<PointDistance> answer_points(const PointsRead& r, std::span<const Di
 
 BoxRead read_box(const octomap::OcTree& tree, const double lo[3], const double hi[3], const DistanceOptions& opt,
                  const DistanceLimits& lim) {
+  BoxRead r = plan_box(tree, lo, hi, opt, lim);
+  r.grid = read_occupancy(tree, r.grid.box, opt.unknown, opt.ownership);
+  return r;
+}
+
+BoxRead plan_box(const octomap::OcTree& tree, const double lo[3], const double hi[3], const DistanceOptions& opt,
+                 const DistanceLimits& lim) {
   BoxRead r;
   r.opt = opt;
   r.resolution = tree.getResolution();
@@ -157,8 +165,14 @@ BoxRead read_box(const octomap::OcTree& tree, const double lo[3], const double h
                         std::to_string(lim.max_box_cells) + "): ask for a smaller box or a coarser cell");
   const CellBox padded = cell_box_around(klo, khi, opt.cell_voxels, r.pad);
   check_cells(padded.dims.cells(), lim);
-  r.grid = read_occupancy(tree, padded, opt.unknown, opt.ownership);
+  r.grid.box = padded;
   return r;
+}
+
+std::array<double, 3> box_origin(const BoxRead& r) {
+  std::array<double, 3> o{};
+  for (int a = 0; a < 3; ++a) o[a] = double(r.cells.key_lo[a] - kKeyOrigin) * r.resolution;
+  return o;
 }
 
 BoxDistances answer_box(const BoxRead& r, const SquaredEdt& edt, bool with_gradient) {
@@ -173,7 +187,7 @@ BoxDistances answer_box(const BoxRead& r, const DistanceField& f, bool with_grad
   b.cells = r.cells;
   b.cell_size = f.cell_size;
   b.max_distance = f.max_distance;
-  for (int a = 0; a < 3; ++a) b.origin[a] = double(r.cells.key_lo[a] - kKeyOrigin) * r.resolution;
+  b.origin = box_origin(r);
   const GridDims d = r.cells.dims;
   b.squared.resize(size_t(d.cells()));
   if (with_gradient) b.gradient.resize(3 * size_t(d.cells()));
@@ -192,7 +206,7 @@ BoxDistances answer_box(const BoxRead& r, const DistanceField& f, bool with_grad
 }
 
 PathRead read_path(const octomap::OcTree& tree, std::span<const double> v, const DistanceOptions& opt,
-                   const DistanceLimits& lim, const std::function<std::optional<CellBox>(const CellBox&)>& cover) {
+                   const DistanceLimits& lim, const CoverFn& cover) {
   const size_t n = v.size() / 3;
   if (n == 0) throw DistanceError("a path needs at least one vertex");
   for (double x : v)

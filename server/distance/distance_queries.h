@@ -47,13 +47,20 @@ struct PointsRead {
   };
   std::vector<Cell> cells;  // per point
 };
+// A box (field_cache.h's covering) to take as the points' one grid when it holds their padded
+// cells; it answers the same (its extra obstacles are at least a padding away). `read`: read it
+// from the map; else the caller brings its grid (the grid is left empty: the field cache's,
+// brought up to date from the map's change lists).
+struct GridCover {
+  CellBox box;
+  bool read = true;
+};
+using CoverFn = std::function<std::optional<GridCover>(const CellBox& want)>;
 // xyz: 3 floats a point. Throws DistanceError (a point outside the key range, too many cells).
-// `cover`: a box (field_cache.h's covering) to read as the one grid when it holds the points'
-// padded cells; it answers the same (its extra obstacles are at least a padding away).
 PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, const DistanceOptions& opt,
                        const DistanceLimits& lim);
 PointsRead read_points(const octomap::OcTree& tree, std::span<const float> xyz, const DistanceOptions& opt,
-                       const DistanceLimits& lim, const std::function<std::optional<CellBox>(const CellBox&)>& cover);
+                       const DistanceLimits& lim, const CoverFn& cover);
 std::vector<PointDistance> answer_points(const PointsRead& read, const SquaredEdt& edt);
 // The same from fields already computed, one per grid of `read` (in order).
 std::vector<PointDistance> answer_points(const PointsRead& read, std::span<const DistanceField* const> fields);
@@ -68,6 +75,9 @@ struct BoxRead {
 };
 BoxRead read_box(const octomap::OcTree& tree, const double lo[3], const double hi[3], const DistanceOptions& opt,
                  const DistanceLimits& lim);
+// The same checked and sized, its grid not read (grid.box set, grid.occupied empty).
+BoxRead plan_box(const octomap::OcTree& tree, const double lo[3], const double hi[3], const DistanceOptions& opt,
+                 const DistanceLimits& lim);
 struct BoxDistances {
   CellBox cells;
   double cell_size = 0, max_distance = 0;
@@ -77,6 +87,8 @@ struct BoxDistances {
   std::vector<uint32_t> squared;
   std::vector<float> gradient;  // 3 per cell when asked for, else empty
 };
+// [m] the min corner of the box's cell (0, 0, 0) (BoxDistances::origin).
+std::array<double, 3> box_origin(const BoxRead& read);
 BoxDistances answer_box(const BoxRead& read, const SquaredEdt& edt, bool with_gradient);
 // The same from the field of read.grid already computed (field_cache.h).
 BoxDistances answer_box(const BoxRead& read, const DistanceField& field, bool with_gradient);
@@ -89,7 +101,7 @@ struct PathRead {
 };
 // vertices: 3 doubles a vertex (>= 1 vertex); samples every resolution along each segment.
 PathRead read_path(const octomap::OcTree& tree, std::span<const double> vertices, const DistanceOptions& opt,
-                   const DistanceLimits& lim, const std::function<std::optional<CellBox>(const CellBox&)>& cover = {});
+                   const DistanceLimits& lim, const CoverFn& cover = {});
 struct PathClearance {
   float min_distance = 0;
   int64_t min_sample = 0;

@@ -12,6 +12,15 @@ namespace {
 struct IndexBox {
   std::array<int64_t, 3> lo{}, hi{};
   int64_t cells() const { return (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1); }
+  void add(int64_t i, int64_t j, int64_t k, bool& any) {
+    if (!any) {
+      lo = {i, j, k}, hi = {i, j, k};
+      any = true;
+      return;
+    }
+    lo = {std::min(lo[0], i), std::min(lo[1], j), std::min(lo[2], k)};
+    hi = {std::max(hi[0], i), std::max(hi[1], j), std::max(hi[2], k)};
+  }
 };
 
 // The bounding box of the cells where `a` and `b` differ; false where they are equal.
@@ -27,14 +36,8 @@ bool changed_box(const OccupancyGrid& a, const OccupancyGrid& b, IndexBox& out) 
       int64_t first = 0, last = d.nx - 1;
       while (x[first] == y[first]) ++first;
       while (x[last] == y[last]) --last;
-      if (!any) {
-        out.lo = {first, j, k}, out.hi = {last, j, k};
-        any = true;
-        continue;
-      }
-      out.lo[0] = std::min(out.lo[0], first), out.hi[0] = std::max(out.hi[0], last);
-      out.lo[1] = std::min(out.lo[1], j), out.hi[1] = std::max(out.hi[1], j);
-      out.hi[2] = k;
+      out.add(first, j, k, any);
+      out.add(last, j, k, any);
     }
   return any;
 }
@@ -56,66 +59,143 @@ bool inside(const CellBox& want, const CellBox& have) {
   return true;
 }
 
-bool same_box(const CellBox& a, const CellBox& b) {
-  return a.key_lo == b.key_lo && a.cell_voxels == b.cell_voxels && a.dims.nx == b.dims.nx && a.dims.ny == b.dims.ny &&
-         a.dims.nz == b.dims.nz;
+// The field of `grid` after its cells in `changed` changed (`field` was the field before):
+// the changed cells' reach (grown by pad) from the EDT of their reach's obstacles (by 2 pad).
+void transform_part(const OccupancyGrid& grid, const IndexBox& changed, int pad, const SquaredEdt& edt,
+                    DistanceField& field, FieldCacheStats& stats) {
+  const IndexBox src = grown(changed, 2 * int64_t(pad), grid.box.dims);
+  const IndexBox dst = grown(changed, pad, grid.box.dims);
+  const GridDims sd{int(src.hi[0] - src.lo[0] + 1), int(src.hi[1] - src.lo[1] + 1), int(src.hi[2] - src.lo[2] + 1)};
+  const GridDims d = grid.box.dims;
+  std::vector<uint8_t> occ(size_t(sd.cells()));
+  for (int64_t k = 0; k < sd.nz; ++k)
+    for (int64_t j = 0; j < sd.ny; ++j)
+      std::memcpy(occ.data() + size_t((k * sd.ny + j) * sd.nx),
+                  grid.occupied.data() + size_t(((src.lo[2] + k) * d.ny + src.lo[1] + j) * d.nx + src.lo[0]),
+                  size_t(sd.nx));
+  std::vector<uint32_t> sq(occ.size());
+  edt(occ, sd, sq);
+  for (int64_t k = dst.lo[2]; k <= dst.hi[2]; ++k)
+    for (int64_t j = dst.lo[1]; j <= dst.hi[1]; ++j)
+      std::memcpy(field.squared.data() + size_t((k * d.ny + j) * d.nx + dst.lo[0]),
+                  sq.data() + size_t(((k - src.lo[2]) * sd.ny + j - src.lo[1]) * sd.nx + dst.lo[0] - src.lo[0]),
+                  size_t(dst.hi[0] - dst.lo[0] + 1) * sizeof(uint32_t));
+  ++stats.partial;
+  stats.partial_cells += sd.cells();
+}
+
+// Whether the changed cells' reach is small enough for a partial transform to pay.
+bool partial_pays(const IndexBox& changed, int pad, const GridDims& d) {
+  return grown(changed, 2 * int64_t(pad), d).cells() * 2 < d.cells();
 }
 
 }  // namespace
 
-bool FieldCache::same_key(const CellBox& box, const DistanceOptions& opt, double resolution) const {
-  return valid_ && box.cell_voxels == grid_.box.cell_voxels && opt.unknown == unknown_ && resolution == resolution_ &&
-         padding_cells(opt, resolution) == pad_;
+FieldCache::Key FieldCache::key_of(const CellBox& box, const DistanceOptions& opt, double resolution) {
+  return Key{box, padding_cells(opt, resolution), opt.unknown, resolution};
 }
 
-std::optional<CellBox> FieldCache::covering(const CellBox& want, const DistanceOptions& opt) const {
-  if (!same_key(want, opt, resolution_) || !inside(want, grid_.box)) return std::nullopt;
-  // Reading the cached box costs its cells: for far fewer, their own grid's EDT is the cheaper.
-  if (want.dims.cells() * 4 < grid_.box.dims.cells()) return std::nullopt;
-  return grid_.box;
+bool FieldCache::same_key(const Key& a, const Key& b, bool with_box) {
+  return a.box.cell_voxels == b.box.cell_voxels && a.pad == b.pad && a.unknown == b.unknown &&
+         a.resolution == b.resolution && (!with_box || same_cells(a.box, b.box));
 }
 
-bool FieldCache::holds(const CellBox& box, const DistanceOptions& opt) const {
-  return same_key(box, opt, resolution_) && same_box(box, grid_.box);
+std::optional<FieldCache::Pending> FieldCache::pending(const DistanceOptions& opt, double resolution) const {
+  CellBox probe;
+  probe.cell_voxels = opt.cell_voxels;
+  if (!pending_valid_ || !same_key(pending_key_, key_of(probe, opt, resolution), false)) return std::nullopt;
+  return Pending{pending_key_.box, pending_version_};
 }
+
+std::optional<CellBox> FieldCache::covering(const CellBox& want, const DistanceOptions& opt, double resolution,
+                                            bool cheap) const {
+  const auto p = pending(opt, resolution);
+  if (!p || want.cell_voxels != p->box.cell_voxels || !inside(want, p->box)) return std::nullopt;
+  // Reading the cached box from the map costs its cells: for far fewer, their own grid is cheaper.
+  if (!cheap && want.dims.cells() * 4 < p->box.dims.cells()) return std::nullopt;
+  return p->box;
+}
+
+void FieldCache::will_hold(const CellBox& box, const DistanceOptions& opt, double resolution, uint64_t version) {
+  pending_key_ = key_of(box, opt, resolution);
+  pending_version_ = version;
+  pending_valid_ = true;
+}
+
+void FieldCache::will_advance(uint64_t version) { pending_version_ = version; }
 
 const DistanceField& FieldCache::update(OccupancyGrid grid, const SquaredEdt& edt, double resolution,
-                                        const DistanceOptions& opt) {
-  const int pad = padding_cells(opt, resolution);
-  IndexBox changed;
-  const bool reuse = same_key(grid.box, opt, resolution) && same_box(grid.box, grid_.box);
-  if (reuse && !changed_box(grid_, grid, changed)) {
-    ++stats_.unchanged;
-  } else if (reuse && grown(changed, 2 * int64_t(pad), grid.box.dims).cells() * 2 < grid.box.dims.cells()) {
-    // The changed cells' reach (grown by pad) from the EDT of their reach's obstacles (by 2 pad).
-    const IndexBox src = grown(changed, 2 * int64_t(pad), grid.box.dims);
-    const IndexBox dst = grown(changed, pad, grid.box.dims);
-    const GridDims sd{int(src.hi[0] - src.lo[0] + 1), int(src.hi[1] - src.lo[1] + 1), int(src.hi[2] - src.lo[2] + 1)};
-    const GridDims d = grid.box.dims;
-    std::vector<uint8_t> occ(size_t(sd.cells()));
-    for (int64_t k = 0; k < sd.nz; ++k)
-      for (int64_t j = 0; j < sd.ny; ++j)
-        std::memcpy(occ.data() + size_t((k * sd.ny + j) * sd.nx),
-                    grid.occupied.data() + size_t(((src.lo[2] + k) * d.ny + src.lo[1] + j) * d.nx + src.lo[0]),
-                    size_t(sd.nx));
-    std::vector<uint32_t> sq(occ.size());
-    edt(occ, sd, sq);
-    for (int64_t k = dst.lo[2]; k <= dst.hi[2]; ++k)
-      for (int64_t j = dst.lo[1]; j <= dst.hi[1]; ++j)
-        std::memcpy(field_.squared.data() + size_t((k * d.ny + j) * d.nx + dst.lo[0]),
-                    sq.data() + size_t(((k - src.lo[2]) * sd.ny + j - src.lo[1]) * sd.nx + dst.lo[0] - src.lo[0]),
-                    size_t(dst.hi[0] - dst.lo[0] + 1) * sizeof(uint32_t));
-    ++stats_.partial;
-    stats_.partial_cells += sd.cells();
-  } else {
-    field_ = compute_field(grid, edt, resolution, opt);
-    ++stats_.full;
+                                        const DistanceOptions& opt, uint64_t version) {
+  const Key key = key_of(grid.box, opt, resolution);
+  try {
+    IndexBox changed;
+    const bool reuse = valid_ && same_key(key, key_, true);
+    valid_ = false;  // until the field is the grid's
+    ++stats_.reread;
+    if (reuse && !changed_box(grid_, grid, changed)) {
+      ++stats_.unchanged;
+      grid_ = std::move(grid);
+    } else if (reuse && partial_pays(changed, key.pad, grid.box.dims)) {
+      memo_.reset();
+      grid_ = std::move(grid);
+      transform_part(grid_, changed, key.pad, edt, field_, stats_);
+    } else {
+      memo_.reset();
+      field_ = compute_field(grid, edt, resolution, opt);
+      grid_ = std::move(grid);
+      ++stats_.full;
+    }
+  } catch (...) {
+    pending_valid_ = false;
+    memo_.reset();
+    throw;
   }
-  grid_ = std::move(grid);
   field_.box = grid_.box;
   field_.cell_size = resolution * grid_.box.cell_voxels;
   field_.max_distance = opt.max_distance;
-  pad_ = pad, unknown_ = opt.unknown, resolution_ = resolution, valid_ = true;
+  key_ = key, version_ = version, valid_ = true;
+  return field_;
+}
+
+const DistanceField& FieldCache::update(const GridPatch& patch, const SquaredEdt& edt, const DistanceOptions& opt) {
+  if (!valid_ || !same_cells(patch.box, key_.box) || version_ != patch.from ||
+      !same_key(key_of(patch.box, opt, key_.resolution), key_, true)) {
+    pending_valid_ = false;
+    throw DistanceError("the distance field cache lost its entry (an update before this one failed): ask again");
+  }
+  try {
+    valid_ = false;
+    const GridDims d = grid_.box.dims;
+    IndexBox changed;
+    bool any = false;
+    for (const CellChange& c : patch.cells) {
+      uint8_t& cell = grid_.occupied.at(c.index);
+      if (cell == c.occupied) continue;
+      cell = c.occupied;
+      const int64_t i = c.index % d.nx, j = (c.index / d.nx) % d.ny, k = c.index / (int64_t(d.nx) * d.ny);
+      changed.add(i, j, k, any);
+    }
+    ++stats_.patched;
+    stats_.patch_changes += int64_t(patch.cells.size());
+    if (!any)
+      ++stats_.unchanged;
+    else if (partial_pays(changed, key_.pad, d)) {
+      memo_.reset();
+      transform_part(grid_, changed, key_.pad, edt, field_, stats_);
+    } else {
+      memo_.reset();
+      field_ = compute_field(grid_, edt, key_.resolution, opt);
+      ++stats_.full;
+    }
+  } catch (...) {
+    pending_valid_ = false;
+    memo_.reset();
+    throw;
+  }
+  field_.box = grid_.box;
+  field_.cell_size = key_.resolution * grid_.box.cell_voxels;
+  field_.max_distance = opt.max_distance;
+  version_ = patch.to, valid_ = true;
   return field_;
 }
 

@@ -22,6 +22,12 @@ struct CellBox {
   int cell_voxels = 1;
 };
 
+// Whether two boxes are the same cells.
+inline bool same_cells(const CellBox& a, const CellBox& b) {
+  return a.key_lo == b.key_lo && a.cell_voxels == b.cell_voxels && a.dims.nx == b.dims.nx && a.dims.ny == b.dims.ny &&
+         a.dims.nz == b.dims.nz;
+}
+
 struct OccupancyGrid {
   CellBox box;
   std::vector<uint8_t> occupied;  // dims.cells(), 1 = obstacle

@@ -98,6 +98,54 @@ TEST(FieldCache, UpdatedFieldsAnswerAsFreshOnesOnARealMap) {
     }
 }
 
+// The same changes handed over as patches (the cells that changed, as the map's change lists
+// say, with cells set to what they already were among them): the field equals a fresh one
+// after every step; a patch from another state than the entry's is refused.
+TEST(FieldCache, PatchedFieldsAnswerAsFreshOnesOnARealMap) {
+  const octomap::OcTree& t = *query_test_maps()[0].tree;
+  const auto edt = distance::cpu_edt(2);
+  std::mt19937 rng(41);
+  distance::DistanceOptions opt;
+  opt.max_distance = 6.45 * t.getResolution();
+  double lo[3], hi[3];
+  box_around_obstacle(t, 1, lo, hi);
+  const distance::BoxRead read = distance::read_box(t, lo, hi, opt, {});
+  distance::FieldCache cache;
+  distance::OccupancyGrid grid = read.grid;
+  cache.update(grid, edt, read.resolution, opt, 7);
+  const distance::GridDims d = grid.box.dims;
+  std::uniform_int_distribution<uint32_t> any_cell(0, uint32_t(d.cells() - 1));
+  distance::BoxDistances before =
+      distance::answer_box(read, distance::compute_field(grid, edt, read.resolution, opt), true);
+  int wrong = 0, visible = 0;
+  uint64_t version = 7;
+  for (int step = 0; step < 16; ++step) {
+    distance::GridPatch patch;
+    patch.box = grid.box, patch.from = version, patch.to = ++version;
+    const uint32_t at = any_cell(rng);
+    for (int c = 0; c < (step % 3 == 0 ? 1 : 12); ++c) {  // one cell, or a run of 12 along x
+      const uint32_t index = std::min<uint32_t>(uint32_t(d.cells() - 1), at + uint32_t(c));
+      grid.occupied[index] ^= 1;
+      patch.cells.push_back({index, grid.occupied[index]});
+    }
+    patch.cells.push_back({any_cell(rng), 0});  // a change back and forth within the patch
+    patch.cells.back().occupied = grid.occupied[patch.cells.back().index];
+    const distance::BoxDistances got = distance::answer_box(read, cache.update(patch, edt, opt), true);
+    const distance::BoxDistances want =
+        distance::answer_box(read, distance::compute_field(grid, edt, read.resolution, opt), true);
+    expect_same_box(got, want, wrong);
+    if (want.squared != before.squared) ++visible;
+    before = want;
+  }
+  EXPECT_EQ(wrong, 0);
+  EXPECT_GE(visible, 6);
+  EXPECT_EQ(cache.stats().patched, 16);
+  EXPECT_GE(cache.stats().partial, 12);
+  distance::GridPatch stale;
+  stale.box = grid.box, stale.from = version - 1, stale.to = version + 1;
+  EXPECT_THROW(cache.update(stale, edt, opt), distance::DistanceError);
+}
+
 TEST(FieldCache, PointsReadThroughTheCachedBoxAnswerAsFromTheirOwnGrid) {
   const octomap::OcTree& t = *query_test_maps()[0].tree;
   const auto edt = distance::cpu_edt(2);
@@ -113,11 +161,14 @@ TEST(FieldCache, PointsReadThroughTheCachedBoxAnswerAsFromTheirOwnGrid) {
   std::vector<float> xyz;
   for (int p = 0; p < 300; ++p)
     for (int a = 0; a < 3; ++a) xyz.push_back(float(std::uniform_real_distribution<double>(lo[a], hi[a])(rng)));
-  auto cover = [&](const distance::CellBox& want) { return cache.covering(want, opt); };
+  cache.will_hold(cached, opt, box.resolution, 0);
+  auto cover = [&](const distance::CellBox& want) -> std::optional<distance::GridCover> {
+    const auto c = cache.covering(want, opt, box.resolution, false);
+    return c ? std::optional(distance::GridCover{*c, true}) : std::nullopt;
+  };
   distance::PointsRead through = distance::read_points(t, xyz, opt, {}, cover);
   ASSERT_EQ(through.grids.size(), 1u);
-  ASSERT_TRUE(cache.holds(through.grids[0].box, opt));
-  EXPECT_EQ(through.grids[0].box.key_lo, cached.key_lo);
+  ASSERT_TRUE(distance::same_cells(through.grids[0].box, cached));
   const distance::DistanceField* f = &cache.update(std::move(through.grids[0]), edt, box.resolution, opt);
   const auto got = distance::answer_points(through, std::span<const distance::DistanceField* const>(&f, 1));
   const auto want = distance::answer_points(distance::read_points(t, xyz, opt, {}), edt);
@@ -132,17 +183,19 @@ TEST(FieldCache, PointsReadThroughTheCachedBoxAnswerAsFromTheirOwnGrid) {
   EXPECT_GT(near, 30);  // not all at the clamp
   // A point outside the cached box: its own grid.
   xyz.insert(xyz.end(), {float(hi[0] + 3), float(hi[1]), float(hi[2])});
-  EXPECT_FALSE(cache.holds(distance::read_points(t, xyz, opt, {}, cover).grids[0].box, opt));
-  // A few cells inside it: their own grid is the cheaper read.
+  EXPECT_FALSE(distance::same_cells(distance::read_points(t, xyz, opt, {}, cover).grids[0].box, cached));
+  // A few cells inside it: their own grid is the cheaper read, unless the cache's grid can be
+  // brought up to date without reading it (the change lists).
   distance::CellBox small = cached;
   small.dims = {8, 8, 8};
   for (int a = 0; a < 3; ++a) small.key_lo[a] += 10;
-  EXPECT_FALSE(cache.covering(small, opt).has_value());
-  EXPECT_TRUE(cache.covering(cached, opt).has_value());
+  EXPECT_FALSE(cache.covering(small, opt, box.resolution, false).has_value());
+  EXPECT_TRUE(cache.covering(small, opt, box.resolution, true).has_value());
+  EXPECT_TRUE(cache.covering(cached, opt, box.resolution, false).has_value());
   // Other options (unknown as occupied): not covered.
   distance::DistanceOptions other = opt;
   other.unknown = UnknownAs::kOccupied;
-  EXPECT_FALSE(cache.covering(cached, other).has_value());
+  EXPECT_FALSE(cache.covering(cached, other, box.resolution, true).has_value());
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -119,11 +120,31 @@ int main(int argc, char** argv) {
   ort::bench::DistanceReplies replies(server, kReply);
   server.start();
   const int64_t utime0 = ort::now_utime();
-  auto publish_scan = [&](const std::string& robot, size_t i, int64_t s) {
+  // `shift` [m] moves the scan's pose (x, y): the exploring phase's robot maps space new to the box.
+  auto publish_scan = [&](const std::string& robot, size_t i, int64_t s, double shift_x = 0, double shift_y = 0) {
     ort::cli::ScanMessageFields f;
     f.robot_id = robot, f.seq = s, f.utime = utime0 + s * 100'000;
-    const auto msg = ort::cli::make_scan_message(scans.scans[i % scans.scans.size()], f);
+    ort::PosedScan scan = scans.scans[i % scans.scans.size()];
+    scan.pose.trans() += octomap::point3d(float(shift_x), float(shift_y), 0);
+    const auto msg = ort::cli::make_scan_message(scan, f);
     lc.publish(ort::cli::scan_channel(ort::protocol::kScanChannelPrefix, robot), &msg);
+  };
+  // The field cache's counters since the last call (distance/field_cache.h): how its entry was
+  // brought up to date (from the change lists or by reading the box again) and what that cost.
+  ort::distance::FieldCacheStats cache_before;
+  auto cache_line = [&](const char* phase) {
+    const ort::distance::FieldCacheStats c = server.distance_cache_stats();
+    std::printf(
+        "  field cache (%s): %lld from change lists (%lld cell changes), %lld box reads; %lld unchanged, %lld partial "
+        "(%.0f cells each), %lld whole; %lld replies' bytes kept\n",
+        phase, (long long)(c.patched - cache_before.patched), (long long)(c.patch_changes - cache_before.patch_changes),
+        (long long)(c.reread - cache_before.reread), (long long)(c.unchanged - cache_before.unchanged),
+        (long long)(c.partial - cache_before.partial),
+        c.partial > cache_before.partial
+            ? double(c.partial_cells - cache_before.partial_cells) / double(c.partial - cache_before.partial)
+            : 0.0,
+        (long long)(c.full - cache_before.full), (long long)(c.replies_kept - cache_before.replies_kept));
+    cache_before = c;
   };
 
   // Preload: at most 2 scans in flight; then wait until every scan ended (applied, refused or
@@ -196,8 +217,8 @@ int main(int argc, char** argv) {
     });
     std::printf(
         "box reply stages (CPU EDT, %d threads, zstd %d): read %.1f ms; finish %.1f ms with the field computed "
-        "whole, %.1f ms from the cache with the grid unchanged (of it: box cut and clamped %.1f ms, bytes + zstd "
-        "%.1f ms); blob %lld of %lld bytes in %lld chunks\n",
+        "whole, %.1f ms from the cache with the grid unchanged (the last reply's bytes kept; made again: box cut and "
+        "clamped %.1f ms, bytes + zstd %.1f ms); blob %lld of %lld bytes in %lld chunks\n",
         cfg.queries.distance.threads, cfg.queries.distance.zstd_level, rt.read_ms, rt.whole_ms, rt.cached_ms,
         rt.clamp_ms, rt.zstd_ms, (long long)rt.blob_bytes, (long long)rt.raw_bytes, (long long)rt.chunks);
     std::printf("  zstd levels on the box's bytes:%s\n", rt.levels.c_str());
@@ -249,15 +270,19 @@ int main(int argc, char** argv) {
     idle_box.add(replies.wait(id, t, answer_timeout_s));
   }
   report("box idle", idle_box, 0);
+  cache_line("box idle");
   for (int i = 0; i < point_queries; ++i) {
     const auto [id, t] = point_query();
     idle_points.add(replies.wait(id, t, answer_timeout_s));
   }
   report("points idle", idle_points, 0);
+  cache_line("points idle");
 
   // Streaming: producers keep 2 scans in flight each (as fast as the server maps), each going
   // round the scans in its own order; the phase lasts --phase-s whatever the queries do.
-  auto stream = [&](const std::function<void(const std::atomic<bool>&)>& queries) {
+  // exploring: each scan's pose moved by a shift that grows with its seq (0.4 m, 0.25 m a scan,
+  // wrapping within +-6 m): the map keeps growing into space the box had not seen.
+  auto stream = [&](const std::function<void(const std::atomic<bool>&)>& queries, bool exploring = false) {
     std::atomic<bool> stop{false};
     std::vector<std::thread> threads;
     for (int p = 0; p < producers; ++p)
@@ -267,7 +292,9 @@ int main(int argc, char** argv) {
         for (size_t i = size_t(p); !stop; i += size_t(producers)) {
           while (!stop && tally(server, robot).in_flight >= 2)
             std::this_thread::sleep_for(std::chrono::microseconds(500));
-          publish_scan(robot, i, s++);
+          const double sx = exploring ? std::fmod(0.4 * double(s), 12.0) - 6.0 : 0;
+          const double sy = exploring ? std::fmod(0.25 * double(s) + 4.0 * p, 12.0) - 6.0 : 0;
+          publish_scan(robot, i, s++, sx, sy);
         }
       });
     const int64_t before = applied_total(server);
@@ -296,6 +323,7 @@ int main(int argc, char** argv) {
     for (const auto& [id, t] : sent) loaded_box.add(replies.wait(id, t, answer_timeout_s));
   });
   report("mapping + boxes", loaded_box, with_boxes);
+  cache_line("mapping + boxes");
   LatencyStats loaded_points;
   const double with_points = stream([&](const std::atomic<bool>&) {
     for (int i = 0; i < point_queries; ++i) {
@@ -304,6 +332,28 @@ int main(int argc, char** argv) {
     }
   });
   report("mapping + points", loaded_points, with_points);
+  cache_line("mapping + points");
+  // A robot exploring: the producers' scans shifted into new space, boxes at --box-rate.
+  auto boxes_at_rate = [&](LatencyStats& stats) {
+    const auto t0 = SteadyClock::now();
+    std::vector<std::pair<int64_t, SteadyClock::time_point>> sent;
+    for (int i = 0; since(t0) < phase_s; ++i) {
+      sent.push_back(box_query());
+      std::this_thread::sleep_until(
+          t0 + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>((i + 1) / box_rate)));
+    }
+    for (const auto& [id, t] : sent) stats.add(replies.wait(id, t, answer_timeout_s));
+  };
+  LatencyStats exploring_box;
+  const double exploring = stream([&](const std::atomic<bool>&) { boxes_at_rate(exploring_box); }, true);
+  report("exploring + boxes", exploring_box, exploring);
+  cache_line("exploring + boxes");
+  if (const auto j = server.change_journal_stats())
+    std::printf(
+        "  change journal: %llu scans, %llu class changes recorded, %zu held, %llu trimmed; %llu asked, "
+        "%llu could not say\n",
+        (unsigned long long)j->scans, (unsigned long long)j->changes, j->held_changes, (unsigned long long)j->trimmed,
+        (unsigned long long)j->answered, (unsigned long long)j->refused);
   server.stop();
   return 0;
 }

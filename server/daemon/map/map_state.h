@@ -39,6 +39,7 @@ class MapChangeObserver {
   virtual void replaced(const octomap::OcTree& tree, uint64_t version, uint64_t epoch) = 0;
 };
 
+class ChangeJournal;
 class MapReplica;
 class MapResidency;
 
@@ -89,6 +90,9 @@ struct MapState {
   // The read replica whole-map readers read (daemon/map/map_replica.h); null: they read this
   // map. Set before the pipeline starts; stage 2 feeds it every change.
   MapReplica* replica = nullptr;
+  // The scans' occupancy class changes by state id (daemon/map/change_journal.h), for the
+  // distance field cache's grid; null: none kept. Set before the pipeline starts.
+  ChangeJournal* journal = nullptr;
   // Each robot's newest applied scan, by lower-case id: its seq (queries that wait for their
   // own scan), its id as sent and how many scans the map had applied with it (snapshots list
   // the producers with the most recent scans first).

@@ -7,6 +7,7 @@
 
 #include "core/clock.h"
 #include "daemon/intake/scan_to_map.h"
+#include "daemon/map/change_journal.h"
 #include "daemon/map/map_identity.h"
 #include "daemon/map/map_replica.h"
 #include "daemon/map/map_residency.h"
@@ -235,7 +236,8 @@ void ScanPipeline::apply(ShotJob& job) {
     if (std::string why; map_.residency && !map_.residency->touch_scan(*map_.tree, job.shot.voxels, why))
       throw std::runtime_error(why);
     const auto nodes_before = static_cast<int64_t>(map_.tree->size());
-    const std::optional<int64_t> leaf_change = engine_.apply(job.shot, *map_.tree, map_.observer ? &changes_ : nullptr);
+    const bool log_changes = map_.observer || (map_.journal && map_.journal->armed());
+    const std::optional<int64_t> leaf_change = engine_.apply(job.shot, *map_.tree, log_changes ? &changes_ : nullptr);
     new_nodes = static_cast<int64_t>(map_.tree->size()) - nodes_before;
     // A scan stamped in the far future must not pin the map's time there: its utime in the
     // map (order, snapshots, replies) is bounded by the daemon's clock plus the clock skew
@@ -247,6 +249,8 @@ void ScanPipeline::apply(ShotJob& job) {
     map_.last_scan_utime = std::max(map_.last_scan_utime, utime);
     map_.last_scan_origin = job.origin;
     const auto updated = SteadyClock::now();
+    // The journal reads the log before the observer takes it over.
+    if (log_changes && map_.journal) map_.journal->applied(changes_, map_.tree->getOccupancyThresLog(), map_.version);
     if (map_.observer) map_.observer->applied(changes_, *map_.tree, map_.version);
     const std::string robot = robot_key(job.robot_id);
     map_.newest_scan[robot] = MapState::NewestScan{job.robot_id, job.seq, map_.scans};

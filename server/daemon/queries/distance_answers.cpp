@@ -5,6 +5,7 @@
 #include <memory>
 #include <string_view>
 
+#include "daemon/queries/field_patch.h"
 #include "octomap_rt/distance_box_chunk_t.hpp"
 #include "octomap_rt/distance_path_reply_t.hpp"
 #include "octomap_rt/distance_points_reply_t.hpp"
@@ -41,18 +42,46 @@ distance::DistanceOptions options_of(const Query& q, const DistanceServiceConfig
   return o;
 }
 
+// How a read uses the field cache: not at all, with a grid read whole, or with a patch.
+struct CacheUse {
+  enum Kind { kNone, kWhole, kPatch } kind = kNone;
+  distance::GridPatch patch;
+  uint64_t version = 0;  // the map state read
+};
+
+// Under the lock: the patch that brings the cache's pending entry (when it is `box`) to `version`.
+std::optional<distance::GridPatch> patch_for(const octomap::OcTree& tree, const distance::CellBox& box,
+                                             const distance::DistanceOptions& opt, uint64_t version,
+                                             distance::FieldCache& cache, ChangeJournal* journal) {
+  if (!journal) return std::nullopt;
+  journal->arm();
+  const auto p = cache.pending(opt, tree.getResolution());
+  if (!p || !distance::same_cells(p->box, box)) return std::nullopt;
+  return patch_from_journal(*journal, tree, box, opt, p->version, version);
+}
+
+// The field of a grid read `use` says how to take: from the cache (updated), else computed.
+const distance::DistanceField* cached_field(distance::OccupancyGrid& grid, const CacheUse& use, double resolution,
+                                            const distance::DistanceOptions& opt, const distance::SquaredEdt& edt,
+                                            distance::FieldCache* cache) {
+  if (!cache || use.kind == CacheUse::kNone) return nullptr;
+  if (use.kind == CacheUse::kPatch) return &cache->update(use.patch, edt, opt);
+  return &cache->update(std::move(grid), edt, resolution, opt, use.version);
+}
+
 // The points' field: from the cache when the read took its box (read_points' cover), else computed.
 std::vector<distance::PointDistance> answer_points(distance::PointsRead& read, const distance::SquaredEdt& edt,
-                                                   distance::FieldCache* cache) {
-  if (!cache || read.grids.size() != 1 || !cache->holds(read.grids[0].box, read.opt))
-    return distance::answer_points(read, edt);
-  const distance::DistanceField* f = &cache->update(std::move(read.grids[0]), edt, read.resolution, read.opt);
+                                                   distance::FieldCache* cache, const CacheUse& use) {
+  const distance::DistanceField* f =
+      read.grids.size() == 1 ? cached_field(read.grids[0], use, read.resolution, read.opt, edt, cache) : nullptr;
+  if (!f) return distance::answer_points(read, edt);
   return distance::answer_points(read, std::span<const distance::DistanceField* const>(&f, 1));
 }
 
 void points_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id,
-                  distance::PointsRead& read, const distance::SquaredEdt& edt, distance::FieldCache* cache) {
-  const auto d = answer_points(read, edt, cache);
+                  distance::PointsRead& read, const distance::SquaredEdt& edt, distance::FieldCache* cache,
+                  const CacheUse& use) {
+  const auto d = answer_points(read, edt, cache, use);
   octomap_rt::distance_points_reply_t r{};
   stamp(r, q, s, id, Reply::REPLY_OK, "");
   r.cell_size = read.resolution * read.opt.cell_voxels;
@@ -66,8 +95,8 @@ void points_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const 
 }
 
 void path_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id, distance::PathRead& read,
-                const distance::SquaredEdt& edt, distance::FieldCache* cache) {
-  const auto c = distance::path_clearance(read, answer_points(read.points, edt, cache));
+                const distance::SquaredEdt& edt, distance::FieldCache* cache, const CacheUse& use) {
+  const auto c = distance::path_clearance(read, answer_points(read.points, edt, cache, use));
   octomap_rt::distance_path_reply_t r{};
   stamp(r, q, s, id, Reply::REPLY_OK, "");
   r.min_distance = c.min_distance;
@@ -78,14 +107,14 @@ void path_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const st
   out.messages.push_back(encode_message(r));
 }
 
-void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id, distance::BoxRead& read,
-               const distance::SquaredEdt& edt, const DistanceServiceConfig& cfg, distance::FieldCache* cache) {
-  // A box the cache can hold is transformed where its grid changed only (field_cache.h).
-  const bool cached = cache && read.grid.box.dims.cells() <= cfg.limits.single_grid_cells;
-  const auto b = cached
-                     ? distance::answer_box(read, cache->update(std::move(read.grid), edt, read.resolution, read.opt),
-                                            q.with_gradient != 0)
-                     : distance::answer_box(read, edt, q.with_gradient != 0);
+// A box's reply bytes: the field cut to the box and clamped, then compressed.
+struct BoxBlob {
+  std::string bytes;
+  int64_t raw_size = 0;
+};
+BoxBlob box_blob(const distance::BoxRead& read, const distance::DistanceField* f, const distance::SquaredEdt& edt,
+                 bool with_gradient, int zstd_level) {
+  const auto b = f ? distance::answer_box(read, *f, with_gradient) : distance::answer_box(read, edt, with_gradient);
   // Little-endian hosts only (x86-64, arm64). Without the gradient the distances are the blob's
   // bytes as they are (no copy); an empty part is not copied: memcpy from an empty vector's null
   // data() is undefined even for 0 bytes.
@@ -98,7 +127,33 @@ void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std
   const std::string_view raw =
       b.gradient.empty() ? std::string_view(reinterpret_cast<const char*>(b.squared.data()), b.squared.size() * 4)
                          : std::string_view(joined);
-  const std::string blob = cfg.zstd_level != 0 ? protocol::zstd_compress(raw, cfg.zstd_level) : std::string(raw);
+  return BoxBlob{zstd_level != 0 ? protocol::zstd_compress(raw, zstd_level) : std::string(raw),
+                 static_cast<int64_t>(raw.size())};
+}
+
+void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id, distance::BoxRead& read,
+               const distance::SquaredEdt& edt, const DistanceServiceConfig& cfg, distance::FieldCache* cache,
+               const CacheUse& use) {
+  // A box the cache holds is transformed where its grid changed only (field_cache.h), and
+  // asked again over a field that did not change, it is sent the same bytes (kept, not made again).
+  const distance::DistanceField* f = cached_field(read.grid, use, read.resolution, read.opt, edt, cache);
+  const bool gradient = q.with_gradient != 0;
+  std::string key;
+  if (f) {
+    key = std::to_string(read.cells.key_lo[0]) + "," + std::to_string(read.cells.key_lo[1]) + "," +
+          std::to_string(read.cells.key_lo[2]) + "/" + std::to_string(read.cells.dims.nx) + "x" +
+          std::to_string(read.cells.dims.ny) + "x" + std::to_string(read.cells.dims.nz) + "/" +
+          std::to_string(read.pad) + (gradient ? "g" : "") + "/z" + std::to_string(cfg.zstd_level) + "/" +
+          std::to_string(read.opt.max_distance);
+  }
+  BoxBlob made;
+  const distance::FieldCache::Memo* kept = f ? cache->memo(key) : nullptr;
+  if (!kept) {
+    made = box_blob(read, f, edt, gradient, cfg.zstd_level);
+    if (f) kept = &cache->keep_memo(distance::FieldCache::Memo{key, std::move(made.bytes), made.raw_size});
+  }
+  const std::string& blob = kept ? kept->bytes : made.bytes;
+  const int64_t raw_size = kept ? kept->raw_size : made.raw_size;
   if (int64_t(blob.size()) > cfg.max_reply_bytes) {
     const std::string why = "the box's field is " + std::to_string(blob.size()) + " bytes compressed (at most " +
                             std::to_string(cfg.max_reply_bytes) +
@@ -107,18 +162,20 @@ void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std
     out.refused = why;
     return;
   }
+  const double cell_size = read.resolution * read.opt.cell_voxels;
+  const std::array<double, 3> origin = distance::box_origin(read);
   const size_t chunk = protocol::kChunkDataBytes;
   const int32_t chunks = static_cast<int32_t>(std::max<size_t>(1, (blob.size() + chunk - 1) / chunk));
   const int64_t hash = protocol::blob_hash(blob.data(), blob.size());
   for (int32_t c = 0; c < chunks; ++c) {
     octomap_rt::distance_box_chunk_t m{};
     stamp(m, q, s, id, Reply::REPLY_OK, "");
-    m.cell_size = b.cell_size;
-    for (int a = 0; a < 3; ++a) m.origin[a] = b.origin[a];
-    m.size[0] = b.cells.dims.nx, m.size[1] = b.cells.dims.ny, m.size[2] = b.cells.dims.nz;
+    m.cell_size = cell_size;
+    for (int a = 0; a < 3; ++a) m.origin[a] = origin[a];
+    m.size[0] = read.cells.dims.nx, m.size[1] = read.cells.dims.ny, m.size[2] = read.cells.dims.nz;
     m.with_gradient = q.with_gradient ? 1 : 0;
     m.compression = cfg.zstd_level != 0 ? m.COMPRESSION_ZSTD : m.COMPRESSION_NONE;
-    m.uncompressed_size = static_cast<int64_t>(raw.size());
+    m.uncompressed_size = raw_size;
     m.total_size = static_cast<int64_t>(blob.size());
     m.blob_hash = hash;
     m.num_chunks = chunks, m.chunk_index = c;
@@ -166,28 +223,56 @@ std::string validate_distance(const Query& q, double resolution, const DistanceS
 
 EncodedReplies read_distance(const octomap::OcTree& tree, const Query& q, const MapStamp& s,
                              const std::string& server_id, const DistanceServiceConfig& cfg,
-                             const distance::SquaredEdt& edt, distance::FieldCache* cache) {
+                             const distance::SquaredEdt& edt, distance::FieldCache* cache, ChangeJournal* journal) {
   EncodedReplies out;
   out.channel = q.reply_channel;
   out.client_id = q.client_id;
   const distance::DistanceOptions opt = options_of(q, cfg);
+  const double res = tree.getResolution();
+  const auto version = static_cast<uint64_t>(s.snapshot_id);
   auto query = std::make_shared<const Query>(q);
-  // Points and paths read the cached field's box where it holds theirs (their answer is the same).
-  std::function<std::optional<distance::CellBox>(const distance::CellBox&)> cover;
-  if (cache) cover = [cache, &opt](const distance::CellBox& want) { return cache->covering(want, opt); };
+  auto use = std::make_shared<CacheUse>();
+  use->version = version;
+  // Points and paths read the cached field's box where it holds theirs (their answer is the
+  // same): brought up to date from the change lists where the journal can, else read again.
+  distance::CoverFn cover;
+  if (cache)
+    cover = [&, cache, use](const distance::CellBox& want) -> std::optional<distance::GridCover> {
+      const auto box = cache->covering(want, opt, res, journal != nullptr);
+      if (!box || box->dims.cells() > cfg.limits.max_grid_cells) return std::nullopt;
+      if (auto patch = patch_for(tree, *box, opt, version, *cache, journal)) {
+        use->kind = CacheUse::kPatch, use->patch = std::move(*patch);
+        cache->will_advance(version);
+        return distance::GridCover{*box, false};
+      }
+      if (!cache->covering(want, opt, res, false)) return std::nullopt;
+      use->kind = CacheUse::kWhole;
+      cache->will_hold(*box, opt, res, version);
+      return distance::GridCover{*box, true};
+    };
   if (q.mode == Query::MODE_POINTS) {
     auto read = std::make_shared<distance::PointsRead>(distance::read_points(tree, q.xyz, opt, cfg.limits, cover));
     out.finish = guarded(query, s, server_id,
-                         [=](EncodedReplies& r) { points_reply(r, *query, s, server_id, *read, edt, cache); });
+                         [=](EncodedReplies& r) { points_reply(r, *query, s, server_id, *read, edt, cache, *use); });
   } else if (q.mode == Query::MODE_PATH) {
     const std::vector<double> v(q.xyz.begin(), q.xyz.end());
     auto read = std::make_shared<distance::PathRead>(distance::read_path(tree, v, opt, cfg.limits, cover));
     out.finish = guarded(query, s, server_id,
-                         [=](EncodedReplies& r) { path_reply(r, *query, s, server_id, *read, edt, cache); });
+                         [=](EncodedReplies& r) { path_reply(r, *query, s, server_id, *read, edt, cache, *use); });
   } else {
-    auto read = std::make_shared<distance::BoxRead>(distance::read_box(tree, q.box_min, q.box_max, opt, cfg.limits));
-    out.finish = guarded(query, s, server_id,
-                         [=, &cfg](EncodedReplies& r) { box_reply(r, *query, s, server_id, *read, edt, cfg, cache); });
+    auto read = std::make_shared<distance::BoxRead>(distance::plan_box(tree, q.box_min, q.box_max, opt, cfg.limits));
+    // A box the cache can hold: from the change lists when it is the cached box, else read whole.
+    const bool cacheable = cache && read->grid.box.dims.cells() <= cfg.limits.single_grid_cells;
+    if (auto patch = cacheable ? patch_for(tree, read->grid.box, opt, version, *cache, journal) : std::nullopt) {
+      use->kind = CacheUse::kPatch, use->patch = std::move(*patch);
+      cache->will_advance(version);
+    } else {
+      read->grid = distance::read_occupancy(tree, read->grid.box, opt.unknown, opt.ownership);
+      if (cacheable) use->kind = CacheUse::kWhole, cache->will_hold(read->grid.box, opt, res, version);
+    }
+    out.finish = guarded(query, s, server_id, [=, &cfg](EncodedReplies& r) {
+      box_reply(r, *query, s, server_id, *read, edt, cfg, cache, *use);
+    });
   }
   return out;
 }

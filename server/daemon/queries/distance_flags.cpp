@@ -19,6 +19,10 @@ void add_distance_flags(CLI::App& app, DistanceServiceConfig& d) {
   app.add_option("--distance-field-cache", d.field_cache,
                  "keep the last distance field and transform again only where its grid changed (the same answer)")
       ->capture_default_str();
+  app.add_option("--distance-change-lists", d.change_lists,
+                 "bring the cached field's grid up to date from the scans' change lists instead of reading its box "
+                 "from the map again (the same answer; a small cost per scan once distance queries came)")
+      ->capture_default_str();
   app.add_option("--distance-device", d.device,
                  "Vulkan device of distance queries (index or name substring; default automatic)");
 }

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/clock.h"
+#include "distance/field_cache.h"
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/distance_query_t.hpp"
 #include "octomap_rt/grid_query_t.hpp"
@@ -50,6 +51,7 @@ struct QueryServiceStats {
   // so that "depth 17 ..." and "depth 20 ..." count as one reason; at most kMaxReasons.
   std::vector<std::pair<std::string, int64_t>> refusal_reasons;
   int64_t grids_published = 0;
+  distance::FieldCacheStats field_cache;  // the distance field cache's updates (distance/field_cache.h)
 };
 
 class QueryClients {

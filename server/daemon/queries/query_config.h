@@ -44,6 +44,9 @@ struct DistanceServiceConfig {
   int64_t max_reply_bytes = 16 << 20;  // compressed box blob; larger is refused as too large
   int zstd_level = 1;                  // 1..19; negative: zstd's fast levels (same frames); 0: none
   bool field_cache = true;             // keep the last field for the next query (distance/field_cache.h)
+  // Bring the cached field's grid up to date from the scans' change lists
+  // (daemon/map/change_journal.h) instead of reading its box from the map again.
+  bool change_lists = true;
   // The server's shard set (ServerConfig::shard, set where the query service is made): a
   // shard answers for the obstacles of its own regions (distance_types.h's RegionOwnership).
   protocol::ShardSet shard;

@@ -113,6 +113,8 @@ QueryServiceStats QueryService::service_stats() const {
   s.clients = clients_.snapshot();
   s.refusal_reasons = clients_.refusal_reasons();
   s.grids_published = grids_.published();
+  std::lock_guard lock(field_cache_stats_mutex_);
+  s.field_cache = field_cache_stats_;
   return s;
 }
 
@@ -279,7 +281,7 @@ bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& o
     if (const auto* d = std::get_if<octomap_rt::distance_query_t>(&q.msg)) {
       // Only the grid is read here (bounded in cells); the EDT runs after the lock, counted there.
       out.push_back(read_distance(*map.tree, *d, stamp, server_id_, cfg_.distance, edt_,
-                                  cfg_.distance.field_cache ? &field_cache_ : nullptr));
+                                  cfg_.distance.field_cache ? &field_cache_ : nullptr, map_.journal));
       return true;
     }
     out.push_back(answer_query(*map.tree, q.msg, stamp, server_id_, cfg_.bounds, budget, cfg_.shard));
@@ -366,6 +368,8 @@ void QueryService::run() {
       if (r.finish) {
         r.finish(r);
         clients_.count(r.client_id, r.refused.empty() ? Count::kAnswered : Count::kBad, r.refused);
+        std::lock_guard lock(field_cache_stats_mutex_);
+        field_cache_stats_ = field_cache_.stats();
       }
       publish(r);
     }

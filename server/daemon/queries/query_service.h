@@ -100,6 +100,8 @@ class QueryService {
   GridPublisher grids_;
   distance::SquaredEdt edt_;          // CPU threads or the device; used by the worker thread only
   distance::FieldCache field_cache_;  // the last distance field (distance/field_cache.h); the worker's
+  mutable std::mutex field_cache_stats_mutex_;
+  distance::FieldCacheStats field_cache_stats_;  // a copy of field_cache_'s, for the status
   std::string distance_backend_;
   std::mutex wake_mutex_;
   std::condition_variable wake_;
