@@ -20,7 +20,8 @@ for g in "${sets[@]}"; do
   /usr/bin/time -f "$n,octomap-rt build,%M,%e" -a -o "$o/rss.csv" "$b/client/octomap-rt" build "$g" -o "$o/ort.bt" \
     -r 0.1 --backend cpu-grid -q > "$o/build-$n.txt" 2>&1
 done
+# The octree stage both ways: `octomap-rt build` (above) runs the batched one by default.
 "$b/client/octomap-rt" bench --preset none --graph "$(IFS=,; echo "${sets[*]}")" --resolutions 0.1 \
-  --backends cpu-grid --csv "$o/bench.csv" > "$o/bench.txt" 2>&1
+  --backends cpu-grid --traversals octomap --octree sequential,batched --csv "$o/bench.csv" > "$o/bench.txt" 2>&1
 { date -u; uptime; } >> "$o/machine.txt"
 cat "$o/rss.csv"
