@@ -44,7 +44,7 @@ void MapSaver::save_periodically() {
   last_error_ = error;  // the status is DEGRADED while it is set
 }
 
-void MapSaver::save(bool force, bool clean) {
+void MapSaver::save(bool force, bool clean, bool from_record) {
   if (path_.empty()) return;
   std::lock_guard save_lock(save_mutex_);
   const auto t0 = SteadyClock::now();
@@ -54,13 +54,16 @@ void MapSaver::save(bool force, bool clean) {
   uint64_t version = 0, epoch = 0;
   size_t scans = 0;
   double lock_ms = 0;
-  if (auto v = readable_version(map_)) {
+  // The final save reads the map of record (the stages have stopped): a read replica still
+  // behind it would make the stop wait for the replica's backlog.
+  if (auto v = from_record ? nullptr : readable_version(map_)) {
     if (!force && v->version == saved_version_) return;
     bytes = v->map->ot_bytes();
     version = v->version, epoch = v->epoch, scans = v->scans;
   } else {
-    std::optional<MapCopy> copy = force ? std::optional<MapCopy>(copy_map(readable_map(map_)))
-                                        : copy_map_if_changed(readable_map(map_), saved_version_);
+    MapState& source = from_record ? map_ : readable_map(map_);
+    std::optional<MapCopy> copy =
+        force ? std::optional<MapCopy>(copy_map(source)) : copy_map_if_changed(source, saved_version_);
     if (!copy) return;
     bytes = serialize_map(*copy->tree);
     version = copy->version, epoch = copy->epoch, scans = copy->scans, lock_ms = copy->lock_ms;
@@ -80,7 +83,7 @@ std::string MapSaver::save_final() {
   if (path_.empty()) return "";
   // A failed final save is reported (log, summary, status, exit status), not thrown.
   try {
-    save(/*force=*/true, /*clean=*/true);
+    save(/*force=*/true, /*clean=*/true, /*from_record=*/true);
     return "";
   } catch (const std::exception& e) {
     log_.error(text("the final save failed (the previous map file is intact): ", e.what()));

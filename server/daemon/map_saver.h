@@ -50,9 +50,10 @@ class MapSaver {
 
   // Saves now if the map changed since the last save (or `force`); `clean`: the last save of
   // an orderly stop (the identity says so). Throws MapStoreError or std::runtime_error (the
-  // previous map file is intact).
-  void save(bool force = false, bool clean = false);
-  // The forced, clean save of an orderly stop. Never throws: "" or why it failed (logged).
+  // previous map file is intact). `from_record`: the map of record, never the read replica.
+  void save(bool force = false, bool clean = false, bool from_record = false);
+  // The forced, clean save of an orderly stop, of the map of record (the stages have
+  // stopped; the replica may be behind). Never throws: "" or why it failed (logged).
   std::string save_final();
 
   SaveFigures figures() const;

@@ -201,11 +201,20 @@ void MappingServer::open_map_serving() {
 bool MappingServer::stop() {
   if (!started_ || stopped_) return final_save_error_.empty();
   stopped_ = true;
+  // The drain bound counts from the stop, not from the drain's start: closing the intake
+  // waits for the LCM thread's handler in progress.
+  const auto deadline = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
+                                                 std::chrono::duration<double>(std::max(0.0, cfg_.drain_timeout_s)));
   status_->set_state(Status::STATE_STOPPING, "stopping: intake closed, draining queued scans");
   if (queries_) queries_->cut_running();  // no query holds the map past the drain bound
   intake_->close();
   queue_.close();
-  drain_until_deadline();
+  drain_until_deadline(deadline);
+  // The read replica stops here, its backlog left unapplied: stage 2 no longer waits for room
+  // in it, the final save reads the map of record, and so do readers from now on (its
+  // thread, at low priority, took minutes on a loaded machine to apply a backlog of big
+  // scans that nothing would read).
+  if (replica_) replica_->stop();
   pipeline_->join();
   pipeline_drained_ = true;
   if (upkeep_) upkeep_->stop();  // ends a sweep at its current slice (the map stays whole)
@@ -232,9 +241,7 @@ bool MappingServer::stop() {
 // The bounded drain: queued scans go through the pipeline until the queue is empty or the
 // deadline passes; what is still queued then is dropped, counted ("left at shutdown").
 // Scans already in the pipeline (at most two) are finished either way.
-void MappingServer::drain_until_deadline() {
-  const auto deadline = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
-                                                 std::chrono::duration<double>(std::max(0.0, cfg_.drain_timeout_s)));
+void MappingServer::drain_until_deadline(SteadyClock::time_point deadline) {
   while (queue_.depth() > 0 && SteadyClock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   const std::vector<QueuedScan> left = queue_.take_all();
   size_t scans_left = 0;

@@ -153,7 +153,7 @@ class MappingServer {
   void open_map_serving();
   // The engine's warm-up scan (ServerConfig::warm_up_points), logged.
   void warm_up_engine();
-  void drain_until_deadline();
+  void drain_until_deadline(SteadyClock::time_point deadline);
   LoadedMapFile load_checked_map();  // tree nullptr: moved aside, start anew
   // The status' figures of now, gathered from every part (any thread).
   StatusInputs gather_status();

@@ -169,7 +169,11 @@ void MapReplica::run() {
         next_version_at = t1 + 2 * (t1 - t0);
         continue;
       }
-      if (queue_.empty()) {  // stopped with nothing left
+      if (stop_) {
+        // What is still queued is left: the server stops the replica once its drain deadline
+        // passed, and applying a backlog of big scans at this thread's low priority took
+        // minutes on a loaded machine. From here readers read the map of record
+        // (readable_map, read_version) unless the replica had caught up.
         exited_ = true;
         progress_.notify_all();
         return;
@@ -242,7 +246,8 @@ std::shared_ptr<const ReplicaVersion> MapReplica::read_version(uint64_t min_vers
   versions_on_ = true;
   for (;;) {
     if (latest_ && latest_->version >= min_version) return latest_;
-    if (exited_) {  // nothing changes the tree any more: the reader makes the version itself
+    if (exited_) {                       // nothing changes the tree any more: the reader makes the version itself
+      if (!caught_up()) return nullptr;  // it stopped behind the map of record
       lock.unlock();
       make_version();
       lock.lock();
@@ -261,6 +266,11 @@ bool MapReplica::wait_for(uint64_t version, double timeout_s) {
                             [&] { return stop_ || stats_.version >= version; });
 }
 
+bool MapReplica::stopped_behind() const {
+  std::lock_guard lock(mutex_);
+  return stop_ && !caught_up();
+}
+
 ReplicaStats MapReplica::stats() const {
   std::lock_guard lock(mutex_);
   return stats_;
@@ -270,7 +280,7 @@ MapState& readable_map(MapState& map) {
   if (!map.replica) return map;
   // The map of record's id without its lock: a reader never holds the octree stage up.
   map.replica->wait_for(map.replica->record_version(), 1e9);
-  return map.replica->state();
+  return map.replica->stopped_behind() ? map : map.replica->state();
 }
 
 std::shared_ptr<const ReplicaVersion> readable_version(MapState& map) {

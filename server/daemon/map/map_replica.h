@@ -129,10 +129,15 @@ class MapReplica {
   // (between two batches, from its own tree: no lock a reader or the octree stage waits for).
   // The first call turns versions on (the replica's thread then notes the regions each batch
   // touches). The caller may hold it as long as it likes: the replica goes on.
+  // After stop(), nullptr when the replica stopped behind the map of record.
   std::shared_ptr<const ReplicaVersion> read_version(uint64_t min_version);
   bool has_versions() const { return has_versions_; }
   ReplicaStats stats() const;
+  // Ends its thread after the batch it is on; what is still queued is not applied (nothing
+  // waits for a backlog at shutdown). Stage 2's waits for room end too.
   void stop();
+  // Stopped with changes of the map of record not applied: readers read the map of record.
+  bool stopped_behind() const;
 
  private:
   struct Item {
