@@ -35,7 +35,8 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
     : cfg_(cfg),
       log_(std::move(log)),
       producers_(literal_prefix(cfg.scan_channels), producer_policy(cfg)),
-      queue_(queue_budget(cfg), 8 * queue_budget(cfg), cfg.scan_costs.producer_share) {
+      queue_(queue_budget(cfg), 8 * queue_budget(cfg), cfg.scan_costs.producer_share,
+             cfg.scan_costs.shared_class_share) {
   start_ = SteadyClock::now();
   start_utime_ = now_utime();
   host_ = host_name();
@@ -115,6 +116,7 @@ void MappingServer::start() {
   ScanLimits limits;
   limits.max_points = cfg_.max_points;
   limits.resolution = cfg_.engine.resolution;
+  limits.max_range = cfg_.engine.max_range;
   open_map_serving();  // the delta observer is in place before the first scan is applied
   warm_up_engine();    // before the pipeline's threads use the engine and before the intake opens
   pipeline_ = std::make_unique<ScanPipeline>(*engine_, map_, queue_, producers_, metrics_, log_, cfg_.pipeline,

@@ -69,6 +69,18 @@ void add_scan_cost_flags(CLI::App& app, ScanCostBounds& c) {
   app.add_option("--share-history", c.share_history_s, "see --share-history-scans [s]")
       ->capture_default_str()
       ->check(number_in(0.0, 1e9));
+  app.add_option("--shared-class-share", c.shared_class_share,
+                 "the share of the stages all robot ids without history get together, against 1 for each robot "
+                 "with history")
+      ->capture_default_str()
+      ->check(number_in(1e-3, 1e3));
+  app.add_option(
+         "--max-scan-time", c.max_scan_stage_s,
+         "most of the stages' time one scan of a robot without history (--share-history-scans) may be predicted to take (its rays' voxels times what a voxel "
+         "of scans of its shape took before) while other robots stream; more: rejected as 'predicted "
+         "too slow' before any ray is shot; 0: no limit [s]")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e6));
 }
 
 }  // namespace ort::daemon

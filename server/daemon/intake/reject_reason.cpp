@@ -35,6 +35,7 @@ const char* to_string(Reject r) {
     case Reject::kNewNodeRate: return "new-node rate";
     case Reject::kMapNewNodeRate: return "map new-node rate";
     case Reject::kDuplicateSeq: return "duplicate seq";
+    case Reject::kPredictedTooSlow: return "predicted too slow";
     case Reject::kQueueFull: return "queue full";
     case Reject::kOverLatencyBound: return "over latency bound";
     case Reject::kOverShare: return "over its share";

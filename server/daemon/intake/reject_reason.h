@@ -44,6 +44,7 @@ enum class Reject {
   kNewNodeRate,       // the robot's new nodes passed --max-new-nodes-per-s (its allowance is spent)
   kMapNewNodeRate,    // all robots' new nodes passed --max-map-new-nodes-per-s (the map's allowance is spent)
   kDuplicateSeq,      // the seq and utime of the robot's previous scan again: a copy, not applied twice
+  kPredictedTooSlow,  // predicted to take more of the stages than --max-scan-time while others stream
   // Why a valid scan was dropped (counted as dropped, not rejected).
   kQueueFull,         // the producer's queue budget was full on arrival
   kOverLatencyBound,  // waited in the queue longer than --max-queue-age (overload shedding)

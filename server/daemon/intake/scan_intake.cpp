@@ -1,6 +1,7 @@
 #include "daemon/intake/scan_intake.h"
 
 #include "core/clock.h"
+#include "daemon/intake/scan_to_map.h"
 
 namespace ort::daemon {
 
@@ -53,6 +54,11 @@ void ScanIntake::on_message(const lcm::ReceiveBuffer& rbuf, const std::string& c
   item.received = received;
   item.decoded = SteadyClock::now();
   item.bytes = queued_bytes(item.msg);
+  // Its walk, for the queue's prediction of what it will cost the stages (intake/stage_cost_model.h).
+  const RayLengths rays =
+      ray_lengths(item.msg, effective_max_range(item.msg.max_range, limits_.max_range), limits_.resolution);
+  item.walk_voxels = rays.total_voxels;
+  item.mean_ray_voxels = rays.mean_voxels();
   const int64_t seq = item.msg.seq, utime = item.msg.utime;
   producers_.admit(producer, seq, utime, [&] { return queue_.try_push(std::move(item)); });
 }

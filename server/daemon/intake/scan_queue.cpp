@@ -12,8 +12,18 @@ size_t queued_bytes(const octomap_rt::scan_t& msg) {
   return sizeof(QueuedScan) + msg.xyz.capacity() * sizeof(float) + msg.robot_id.size() + msg.map_frame.size();
 }
 
-ScanQueue::ScanQueue(uint64_t per_producer_budget, uint64_t total_budget, bool fair)
-    : per_producer_budget_(per_producer_budget), total_budget_(total_budget), fair_(fair) {}
+ScanQueue::ScanQueue(uint64_t per_producer_budget, uint64_t total_budget, bool fair, double shared_class_share)
+    : per_producer_budget_(per_producer_budget),
+      total_budget_(total_budget),
+      fair_(fair),
+      // A share of nothing would never be served; NaN would compare false everywhere.
+      shared_class_share_(shared_class_share >= 1e-3 && shared_class_share <= 1e3 ? shared_class_share : 1.0) {}
+
+ScanQueue::ShareClass& ScanQueue::class_named(size_t key) {
+  auto [it, made] = classes_.try_emplace(key);
+  if (made) it->second.share = key == kNewProducersClass ? shared_class_share_ : 1.0;
+  return it->second;
+}
 
 size_t ScanQueue::class_for(const QueuedScan& s) const {
   return fair_ && s.established ? s.producer : kNewProducersClass;
@@ -23,8 +33,8 @@ void ScanQueue::move_to_own_class(size_t producer) {
   // Its scans still waiting in the shared class come along, in their order, so that its
   // scans leave in its order. Waiting for them to leave the shared class first kept a robot
   // there for as long as a flood of fresh ids kept that class's backlog (it never emptied).
-  ShareClass& shared = classes_[kNewProducersClass];
-  ShareClass& own = classes_[producer];
+  ShareClass& shared = class_named(kNewProducersClass);
+  ShareClass& own = class_named(producer);
   if (own.scans.empty()) own.used_ms = std::max(own.used_ms, virtual_ms_);
   for (auto it = shared.scans.begin(); it != shared.scans.end();) {
     if (it->producer != producer) {
@@ -49,12 +59,13 @@ bool ScanQueue::try_push(QueuedScan&& s) {
       bytes_by_producer_.resize(s.producer + 1, 0);
       depth_by_producer_.resize(s.producer + 1, 0);
       new_class_depth_.resize(s.producer + 1, 0);
+      served_by_producer_.resize(s.producer + 1);
     }
     if (bytes_by_producer_[s.producer] + s.bytes > per_producer_budget_) return false;
     if (total_bytes_ + s.bytes > total_budget_) return false;
     const size_t cls = class_for(s);
     if (cls != kNewProducersClass && new_class_depth_[s.producer] > 0) move_to_own_class(s.producer);
-    ShareClass& c = classes_[cls];
+    ShareClass& c = class_named(cls);
     // Fresh ids are free to make: together they hold what one producer may.
     if (fair_ && cls == kNewProducersClass && c.bytes + s.bytes > per_producer_budget_) return false;
     if (c.scans.empty()) c.used_ms = std::max(c.used_ms, virtual_ms_);  // no credit saved while idle
@@ -88,6 +99,16 @@ bool ScanQueue::push_edit(std::shared_ptr<MapEditItem> edit) {
 }
 
 bool ScanQueue::empty_locked() const { return depth_ == 0 && edits_.empty(); }
+
+bool ScanQueue::others_stream(size_t producer, SteadyClock::time_point now) const {
+  for (size_t p = 0; p < depth_by_producer_.size(); ++p)
+    if (p != producer && (depth_by_producer_[p] > 0 || (served_by_producer_[p] != SteadyClock::time_point{} &&
+                                                        now - served_by_producer_[p] < kStreamingWindow)))
+      return true;
+  for (const auto& [arrival, t] : in_stages_)
+    if (t.producer != producer) return true;
+  return false;
+}
 
 bool ScanQueue::streams(const ShareClass& c, SteadyClock::time_point now) const {
   return !c.scans.empty() || c.in_stages > 0 ||
@@ -151,20 +172,42 @@ std::optional<QueuedScan> ScanQueue::pop() {
   c->bytes -= s.bytes;
   s.passed_over = c->deferrals != s.deferrals_at_push;
   forget(s);
+  // Its turn is paid now, as predicted; charge() and leave() settle it with what it took.
+  s.predicted = costs_.predict(s.walk_voxels, s.mean_ray_voxels);
+  c->used_ms += s.predicted.ms / c->share;
+  in_stages_[s.arrival] = InStages{s.share_class, s.producer, s.predicted.ms, 0, s.walk_voxels, s.mean_ray_voxels};
+  const auto now = SteadyClock::now();
+  s.others_stream = others_stream(s.producer, now);
+  served_by_producer_[s.producer] = now;
   return s;
 }
 
-void ScanQueue::charge(size_t share_class, double ms) {
+void ScanQueue::charge(uint64_t arrival, double ms) {
   if (!(ms > 0)) return;
   std::lock_guard lock(mutex_);
-  if (auto it = classes_.find(share_class); it != classes_.end()) it->second.used_ms += ms;
+  auto it = in_stages_.find(arrival);
+  if (it == in_stages_.end()) return;  // an edit, or it left
+  InStages& t = it->second;
+  const double over_before = std::max(0.0, t.spent_ms - t.predicted_ms);
+  t.spent_ms += ms;
+  const double over = std::max(0.0, t.spent_ms - t.predicted_ms);
+  if (auto c = classes_.find(t.share_class); c != classes_.end())
+    c->second.used_ms += (over - over_before) / c->second.share;
 }
 
-void ScanQueue::leave(size_t share_class, bool edit) {
-  if (edit) return;
+void ScanQueue::leave(uint64_t arrival, bool applied) {
   {
     std::lock_guard lock(mutex_);
-    if (auto it = classes_.find(share_class); it != classes_.end() && it->second.in_stages > 0) it->second.in_stages--;
+    auto it = in_stages_.find(arrival);
+    if (it == in_stages_.end()) return;  // an edit: it is in no class
+    const InStages t = it->second;
+    in_stages_.erase(it);
+    if (applied) costs_.learn(t.walk_voxels, t.mean_ray_voxels, t.spent_ms);
+    if (auto c = classes_.find(t.share_class); c != classes_.end()) {
+      ShareClass& cls = c->second;
+      cls.used_ms -= std::max(0.0, t.predicted_ms - t.spent_ms) / cls.share;  // what it did not use
+      if (cls.in_stages > 0) cls.in_stages--;
+    }
   }
   ready_.notify_all();
 }
@@ -233,9 +276,9 @@ std::string ScanQueue::policy() const {
                              " MiB); when full the newest scan is dropped "
                              "(counted as dropped: queue full); queued scans are never evicted; ";
   if (!fair_) return budget + "one FIFO: scans are applied in arrival order";
-  return budget +
-         "each producer with history has its share of the stages' time, producers without share one (and one "
-         "byte budget): scans are applied in arrival order per producer, by share across producers; a scan that "
+  return budget + "each producer with history has its share of the stages' time, producers without share one of " +
+         std::to_string(shared_class_share_).substr(0, 4) +
+         " of a producer's (and one byte budget), each scan charged as predicted when it is served: scans are applied in arrival order per producer, by share across producers; a scan that "
          "waited past the latency bound while others were served in its turn is dropped as 'over its share'";
 }
 

@@ -3,8 +3,13 @@
 //
 // Share of the stages (docs/RELIABILITY.md, "Bounded cost"): scans wait in one queue per
 // share class, and the stages serve the class that has used the least of their time
-// (start-time fair queuing on measured stage time: the pipeline charges each scan's shoot and
-// apply time to its class). A producer with history (ScanCostBounds' share_history_*) is a
+// (start-time fair queuing on stage time). A scan's time is charged to its class when it is
+// served, as predicted (intake/stage_cost_model.h: its walk times what a voxel of that shape
+// took before), so that a class's turn is spent before its scan runs, not seconds later
+// when a stage finishes it; the pipeline's measured shoot and apply times then settle it
+// (what passes the prediction is charged as it is measured, what it did not use is given
+// back when the scan leaves). A class's time counts divided by its share: 1 for a
+// producer with history, shared_class_share (less) for the shared class. A producer with history (ScanCostBounds' share_history_*) is a
 // class of its own; every producer without (a robot id never seen, or seen only briefly) is
 // in ONE class together, so fresh ids cost nothing to make but share one turn. While a known
 // robot streams, one class, however expensive its scans, takes at most its share of the
@@ -36,6 +41,7 @@
 #include <vector>
 
 #include "core/clock.h"
+#include "daemon/intake/stage_cost_model.h"
 #include "octomap_rt/scan_t.hpp"
 
 namespace ort::daemon {
@@ -48,6 +54,9 @@ struct MapEditItem;
 inline constexpr size_t kNewProducersClass = SIZE_MAX;
 // A class served this recently still streams (a robot at 1 Hz or faster).
 inline constexpr std::chrono::seconds kStreamingWindow{2};
+// The shared class's share of the stages, against 1 for each producer with history: fresh
+// ids are free to make, so together they get less than one robot.
+inline constexpr double kSharedClassShare = 0.25;
 
 struct QueuedScan {
   size_t producer = 0;
@@ -56,9 +65,14 @@ struct QueuedScan {
   size_t share_class = 0;            // set by the queue: whose turn it waits for
   uint64_t deferrals_at_push = 0;    // set by the queue: its class's deferrals when it arrived
   bool passed_over = false;          // set by pop(): other classes were served in its class's turn
+  bool others_stream = false;        // set by pop(): another producer's scans wait, are in the stages,
+                                     // or one was served within kStreamingWindow
   SteadyClock::time_point received;  // when the LCM thread got it
   SteadyClock::time_point decoded;   // when the LCM thread had decoded and checked it (unset: = received)
   size_t bytes = 0;                  // what it holds against the budget
+  double walk_voxels = 0;            // set by the intake: its rays' voxels (rays x mean length)
+  double mean_ray_voxels = 0;        // set by the intake
+  StageCostPrediction predicted;     // set by pop(): what it will cost the stages
   octomap_rt::scan_t msg;
   std::shared_ptr<MapEditItem> edit;  // set: a map edit, not a scan (msg is empty)
 };
@@ -68,7 +82,8 @@ size_t queued_bytes(const octomap_rt::scan_t& msg);
 
 class ScanQueue {
  public:
-  ScanQueue(uint64_t per_producer_budget, uint64_t total_budget, bool fair = true);
+  ScanQueue(uint64_t per_producer_budget, uint64_t total_budget, bool fair = true,
+            double shared_class_share = kSharedClassShare);
 
   // False when the producer's (or the total) budget would be exceeded, or after close().
   bool try_push(QueuedScan&& s);
@@ -77,11 +92,12 @@ class ScanQueue {
   bool push_edit(std::shared_ptr<MapEditItem> edit);
   // Blocks until a scan may be served; nullopt once closed and empty.
   std::optional<QueuedScan> pop();
-  // What serving a scan of `share_class` took of a stage (the pipeline's measured time).
-  void charge(size_t share_class, double ms);
-  // A scan pop() returned has left the stages (applied, refused or dropped): once for each.
-  void leave(const QueuedScan& s) { leave(s.share_class, s.edit != nullptr); }
-  void leave(size_t share_class, bool edit = false);
+  // What the scan pop() returned as `arrival` took of a stage (the pipeline's measured time).
+  void charge(uint64_t arrival, double ms);
+  // A scan pop() returned has left the stages, once for each: `applied` when both stages ran
+  // it whole (its time then teaches the cost model), false when it was refused or dropped.
+  void leave(uint64_t arrival, bool applied);
+  void leave(const QueuedScan& s) { leave(s.arrival, false); }
   // No more pushes; pop() drains what is left, then returns nullopt.
   void close();
   // Removes and returns every queued scan (the drain deadline passed: the caller counts
@@ -106,29 +122,42 @@ class ScanQueue {
     uint64_t bytes = 0;
     int in_stages = 0;  // popped, not yet left
     SteadyClock::time_point served;
+    double share = 1;
+  };
+  // A scan in the stages: what its class was charged for it so far.
+  struct InStages {
+    size_t share_class = 0, producer = 0;
+    double predicted_ms = 0, spent_ms = 0;
+    double walk_voxels = 0, mean_ray_voxels = 0;
   };
   size_t class_for(const QueuedScan& s) const;  // under mutex_
   // A producer that earned its history: its scans waiting in the shared class join its own.
   void move_to_own_class(size_t producer);  // under mutex_
   // The class to serve next (least used; ties: oldest head), or nullptr when no scan may be.
   ShareClass* next_class(SteadyClock::time_point now);  // under mutex_
+  ShareClass& class_named(size_t key);                  // under mutex_; made with its share
   bool streams(const ShareClass& c, SteadyClock::time_point now) const;
   bool empty_locked() const;
+  bool others_stream(size_t producer, SteadyClock::time_point now) const;
   void forget(const QueuedScan& s);  // its bytes and depth, once it left the queue
 
   mutable std::mutex mutex_;
   std::condition_variable ready_;
   std::map<size_t, ShareClass> classes_;
-  std::deque<QueuedScan> edits_;  // arrival order
+  std::deque<QueuedScan> edits_;            // arrival order
+  std::map<uint64_t, InStages> in_stages_;  // by arrival
+  StageCostModel costs_;
   std::vector<uint64_t> bytes_by_producer_;
   std::vector<size_t> depth_by_producer_;
-  std::vector<size_t> new_class_depth_;  // by producer: its scans waiting in kNewProducersClass
+  std::vector<size_t> new_class_depth_;                      // by producer: its scans waiting in kNewProducersClass
+  std::vector<SteadyClock::time_point> served_by_producer_;  // its last scan's pop()
   size_t depth_ = 0;
   uint64_t total_bytes_ = 0;
   uint64_t next_arrival_ = 0;
   double virtual_ms_ = 0;  // the used time of the class served last, when it was served
   uint64_t per_producer_budget_, total_budget_;
   bool fair_;
+  double shared_class_share_;
   bool closed_ = false;
 };
 

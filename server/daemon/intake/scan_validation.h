@@ -19,6 +19,7 @@ namespace ort::daemon {
 struct ScanLimits {
   uint64_t max_points = ort::protocol::kDefaultMaxScanPoints;  // per scan; bounds num_xyz before any allocation
   double resolution = 0.1;                                     // map resolution: the origin must have a key
+  double max_range = -1;  // the server's (< 0: none): what the intake's cost prediction cuts rays at
 };
 
 // Robot ids: protocol/ids.h (valid_robot_id, same_robot_id).

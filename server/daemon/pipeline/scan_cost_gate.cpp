@@ -87,6 +87,16 @@ Reject ScanCostGate::admit_rays(double mean_ray_voxels, std::string& detail) con
   return Reject::kMeanRayTooLong;
 }
 
+Reject ScanCostGate::admit_stage_time(const StageCostPrediction& predicted, bool others_stream,
+                                      std::string& detail) const {
+  const double bound_ms = bounds_.max_scan_stage_s * 1e3;
+  if (!(bound_ms > 0) || !others_stream || !predicted.learned || !(predicted.ms > bound_ms)) return Reject::kNone;
+  detail = "the scan is predicted to take " + std::to_string(static_cast<int64_t>(std::min(predicted.ms, 1e15))) +
+           " ms of the stages while other robots stream, above " + std::to_string(static_cast<int64_t>(bound_ms)) +
+           " ms (--max-scan-time)";
+  return Reject::kPredictedTooSlow;
+}
+
 Reject ScanCostGate::admit_voxels(uint64_t voxels, std::string& detail) const {
   if (bounds_.max_scan_voxels == 0 || voxels <= bounds_.max_scan_voxels) return Reject::kNone;
   detail = "the scan updates " + std::to_string(voxels) + " voxels, above " + std::to_string(bounds_.max_scan_voxels) +

@@ -8,6 +8,11 @@
 //    walks, so a few points far out cost what a real scan's ten thousand do (100 points 1 km
 //    out at 0.1 m add ~2-3 M nodes), from the first scan of a robot id without history on.
 //    Decided from the message before any ray is shot;
+//  - (a producer without history) it is predicted to take more of the stages than
+//    max_scan_stage_s (its walk times what a voxel of its shape took in the scans applied
+//    before: intake/stage_cost_model.h) while another producer streams (scans waiting, in the stages, or served within the queue's
+//    kStreamingWindow): a scan is applied whole, so what the others wait for is its whole
+//    time; alone it delays no one. Decided from a learned prediction only;
 //  - the producer's new-node allowance is spent: each applied scan's new nodes are taken
 //    from a bucket refilled at max_new_nodes_per_s up to new_node_burst, and while the
 //    bucket is below zero the producer's scans are refused;
@@ -27,6 +32,7 @@
 
 #include "core/clock.h"
 #include "daemon/intake/reject_reason.h"
+#include "daemon/intake/stage_cost_model.h"
 
 namespace ort::daemon {
 
@@ -52,6 +58,12 @@ struct ScanCostBounds {
   bool producer_share = true;
   int64_t share_history_scans = 10;
   double share_history_s = 5;
+  // The shared class's share against 1 for each producer with history (intake/scan_queue.h).
+  double shared_class_share = 0.25;
+  // The most of the stages' time (both together) one scan of a producer without history may
+  // be predicted to take while another producer streams; two fifths of the default latency
+  // bound. 0: no limit.
+  double max_scan_stage_s = 2.0;
 };
 
 class ScanCostGate {
@@ -76,6 +88,9 @@ class ScanCostGate {
   // kNone, or kMeanRayTooLong when the scan's rays are longer on average (in voxels, cut at
   // its max range: intake/scan_to_map.h's ray_lengths) than the bound.
   Reject admit_rays(double mean_ray_voxels, std::string& detail) const;
+  // kNone, or kPredictedTooSlow when the scan is predicted (learned, not guessed) to take more
+  // of the stages than the bound while `others_stream`.
+  Reject admit_stage_time(const StageCostPrediction& predicted, bool others_stream, std::string& detail) const;
   // kNone, or kTooManyVoxels when the shot scan updates more voxels than the bound.
   Reject admit_voxels(uint64_t voxels, std::string& detail) const;
   // Stage 2 applied the producer's scan: its new nodes are taken from its allowance and the map's.

@@ -90,6 +90,7 @@ void ScanPipeline::reject(size_t producer, Reject why, const char* what) {
 }
 
 bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
+  job.arrival = item.arrival;
   if (item.edit) {  // edits pass stage 1 untouched
     job.edit = std::move(item.edit);
     return true;
@@ -106,15 +107,21 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
     job.origin = scan_pose(item.msg).trans();
     const double max_range = effective_max_range(item.msg.max_range, engine_.options().max_range);
     // What the scan may cost is decided before any ray is shot: per point first (the rays'
-    // mean length), then where the robot has been and its allowance.
+    // mean length), then the stages' time it is predicted to take (while others wait), then
+    // where the robot has been and its allowance.
     Reject refusal =
         gate_.admit_rays(ray_lengths(item.msg, max_range, engine_.options().resolution).mean_voxels(), detail);
+    // The per-scan time bound is for producers without history (fresh ids are free to make);
+    // an established robot's scans are bounded by its share, and a slow machine's overload
+    // drops them over their share, never refuses them for their cost.
+    if (refusal == Reject::kNone && item.share_class == kNewProducersClass)
+      refusal = gate_.admit_stage_time(item.predicted, item.others_stream, detail);
     if (refusal == Reject::kNone) refusal = gate_.admit_origin(item.producer, job.origin, t0, detail);
     if (refusal != Reject::kNone) {
       refuse_cost(item.producer, refusal, detail);
       metrics_.overlap().end(0, token);
       set_busy(0, false);
-      queue_.charge(item.share_class, ms_since(t0));
+      queue_.charge(item.arrival, ms_since(t0));
       return false;
     }
     if (filters_.active()) {
@@ -167,7 +174,7 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
   job.received = item.received;
   job.shot_at = SteadyClock::now();
   job.shoot_ms = ms_between(t0, job.shot_at);
-  queue_.charge(item.share_class, job.shoot_ms);
+  queue_.charge(item.arrival, job.shoot_ms);
   return ok;
 }
 
@@ -209,8 +216,11 @@ PointDropCounts point_drops(const PrepareReport& r, const FilterCounts& f) {
 
 }  // namespace
 
-void ScanPipeline::apply(ShotJob& job) {
-  if (job.edit) return apply_edit(*job.edit);
+bool ScanPipeline::apply(ShotJob& job) {
+  if (job.edit) {
+    apply_edit(*job.edit);
+    return false;
+  }
   const double token = metrics_.overlap().begin(1);
   const auto t0 = SteadyClock::now();
   job.waits.handoff_ms = ms_between(job.shot_at, t0);
@@ -219,7 +229,8 @@ void ScanPipeline::apply(ShotJob& job) {
   if (const Reject why = gate_.admit_allowance(job.producer, t0, detail); why != Reject::kNone) {
     set_busy(1, false);
     metrics_.overlap().end(1, token);
-    return refuse_cost(job.producer, why, detail);
+    refuse_cost(job.producer, why, detail);
+    return false;
   }
   Stage2Parts parts;
   int64_t new_nodes = 0;
@@ -261,14 +272,14 @@ void ScanPipeline::apply(ShotJob& job) {
   } catch (const std::exception& e) {
     set_busy(1, false);
     metrics_.overlap().end(1, token);
-    queue_.charge(job.share_class, ms_since(t0));
+    queue_.charge(job.arrival, ms_since(t0));
     reject(job.producer, Reject::kEngineError, e.what());
-    return;
+    return false;
   }
   set_busy(1, false);
   map_.changed.notify_all();
   const auto t1 = SteadyClock::now();
-  queue_.charge(job.share_class, ms_between(t0, t1));
+  queue_.charge(job.arrival, ms_between(t0, t1));
   const double overlap_s = metrics_.overlap().end(1, token);
   AppliedTiming t;
   t.shoot_ms = job.shoot_ms;
@@ -290,6 +301,7 @@ void ScanPipeline::apply(ShotJob& job) {
   producers_.count_applied(job.producer, static_cast<int64_t>(job.shot.prepare.rays), t.end_to_end_ms,
                            point_drops(job.shot.prepare, job.filtered),
                            static_cast<int64_t>(job.shot.prepare.read_as_zero));
+  return true;
 }
 
 // Every scan the queue hands out leaves it again exactly once (ScanQueue::leave), when it has
@@ -308,8 +320,8 @@ void ScanPipeline::run_stage1() {
 
 void ScanPipeline::run_stage2() {
   while (auto job = handoff_.pop()) {
-    apply(*job);
-    queue_.leave(job->share_class, job->edit != nullptr);
+    const bool applied = apply(*job);
+    queue_.leave(job->arrival, applied);
   }
 }
 
@@ -317,8 +329,8 @@ void ScanPipeline::run_sequential() {
   while (auto item = queue_.pop()) {
     ShotJob job;
     if (!shed_if_stale(*item) && shoot(*item, job)) {
-      apply(job);
-      queue_.leave(job.share_class, job.edit != nullptr);
+      const bool applied = apply(job);
+      queue_.leave(job.arrival, applied);
     } else {
       queue_.leave(*item);
     }

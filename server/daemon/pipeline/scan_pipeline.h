@@ -27,6 +27,7 @@ namespace ort::daemon {
 struct ShotJob {
   size_t producer = 0;
   size_t share_class = 0;  // whose share of the stages its time is charged to (intake/scan_queue.h)
+  uint64_t arrival = 0;    // its number in the queue (what its time is charged as)
   std::string robot_id;
   int64_t seq = 0, utime = 0, points = 0;
   SteadyClock::time_point received;
@@ -71,7 +72,8 @@ class ScanPipeline {
  private:
   // Stage 1 on one scan; false when it ended as a rejection.
   bool shoot(QueuedScan& item, ShotJob& job);
-  void apply(ShotJob& job);
+  // Stage 2 on one scan; true when it was applied (whole: a scan is never half-applied).
+  bool apply(ShotJob& job);
   void apply_edit(MapEditItem& edit);
   void reject(size_t producer, Reject why, const char* what);
   // A scan refused by the cost gate: counted, the first few logged with the detail.
