@@ -67,10 +67,11 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
     // take what the octree stage leaves idle and yield to it (daemon/map/map_replica.h).
     o.threads = cfg_.replica_threads;
     o.helper_nice = 19;
-    // Whole-map readers read versions of it kept per region of the eviction's grid.
+    // Whole-map readers read versions of it kept per region (ServerConfig::replica_version_depth).
     replica_ = std::make_unique<MapReplica>(
         map_, o, cfg_.replica_pending_bytes, cfg_.replica_batch_voxels, cfg_.replica_nice,
-        cfg_.replica_versions ? std::optional(region_grid(evict_region_depth(cfg_))) : std::nullopt);
+        cfg_.replica_versions ? std::optional(region_grid(replica_version_depth(cfg_))) : std::nullopt,
+        cfg_.replica_version_cells);
     map_.replica = replica_.get();
   }
   if (cfg_.queries.distance.field_cache && cfg_.queries.distance.change_lists) {

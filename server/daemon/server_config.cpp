@@ -36,6 +36,10 @@ unsigned evict_region_depth(const ServerConfig& c) {
   return c.evict_depth != 0 ? c.evict_depth : std::min(16u, c.upkeep.region_depth + 1);
 }
 
+unsigned replica_version_depth(const ServerConfig& c) {
+  return c.replica_version_depth != 0 ? std::min(16u, c.replica_version_depth) : evict_region_depth(c);
+}
+
 ProducerPolicy producer_policy(const ServerConfig& c) {
   ProducerPolicy p;
   p.max_producers = c.max_producers;

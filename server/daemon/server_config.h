@@ -102,6 +102,14 @@ struct ServerConfig {
   // held (daemon/map/map_replica.h); false: they copy the replica under its lock, the design
   // before (octomap-rt-bigmap-bench --replica-versions off compares).
   bool replica_versions = true;
+  // The depth of the regions those versions are kept in (each written again whole where a scan
+  // changed a leaf): finer regions rewrite less of the map per version and cost more entries
+  // (docs/ARCHITECTURE.md "Readers and the read replica"); 0: the eviction's depth.
+  unsigned replica_version_depth = 0;
+  // A version writes only the cells of a region where the replica's octree stage changed a
+  // leaf, the rest copied from the region's old records; false: it rewrites every region the
+  // scans' keys touched, whole (the design before; octomap-rt-bigmap-bench compares).
+  bool replica_version_cells = true;
 };
 
 // "" when the memory bound's flags fit together; else why not (a bound or a store bound
@@ -110,6 +118,8 @@ struct ServerConfig {
 std::string memory_bound_problem(const ServerConfig& c);
 // The depth the memory bound evicts at (ServerConfig::evict_depth, 0 resolved).
 unsigned evict_region_depth(const ServerConfig& c);
+// The depth of the read replica's version regions (ServerConfig::replica_version_depth, 0 resolved).
+unsigned replica_version_depth(const ServerConfig& c);
 
 struct ProducerPolicy;
 // The producer admission policy (slots, idle release, allow-list) of `c`.

@@ -79,6 +79,8 @@ struct Args {
   uint64_t replica_pending_bytes = daemon::ServerConfig{}.replica_pending_bytes;
   int replica_nice = 10;
   std::string replica_versions = "on";
+  unsigned replica_version_depth = 0;
+  std::string replica_version_writes = "cells";
   unsigned replica_threads = 0;
   double snapshot_period = 1, save_interval = 10, raw_rate = 1, query_rate = 100;
   cli::EngineFlags engine;
@@ -96,6 +98,8 @@ daemon::ServerConfig server_config(const Args& a) {
   cfg.replica_pending_bytes = a.replica_pending_bytes;
   cfg.replica_nice = a.replica_nice;
   cfg.replica_versions = a.replica_versions == "on";
+  cfg.replica_version_depth = a.replica_version_depth;
+  cfg.replica_version_cells = a.replica_version_writes == "cells";
   cfg.replica_threads = a.replica_threads;
   // The producers go round the preset's scans (origins far apart, many new nodes a second at
   // the GPU machine's rates): the per-producer cost gates would refuse the scans it measures.
@@ -243,9 +247,16 @@ int run(const Args& a) {
   if (replica && replica->versions_built > 0)
     std::printf(
         "  versions for whole-map readers: %llu made on the replica's thread, %.1f s in all, at most %.1f ms; the "
-        "last wrote %llu of its %llu regions\n",
+        "last wrote %llu of its %llu regions (depth %u, %s), %.1f of %.1f MB; those after the first: %.1f s, "
+        "%.1f s of CPU, %.1f MB written (%.0f %% of its nodes copied from old records)\n",
         (unsigned long long)replica->versions_built, replica->version_ms_total / 1e3, replica->version_ms_max,
-        (unsigned long long)replica->version_regions_written, (unsigned long long)replica->version_regions);
+        (unsigned long long)replica->version_regions_written, (unsigned long long)replica->version_regions,
+        replica->version_depth, a.replica_version_writes.c_str(), double(replica->version_bytes_written) / 1e6,
+        double(replica->version_bytes) / 1e6, replica->version_ms_later / 1e3, replica->version_cpu_ms_later / 1e3,
+        double(replica->version_bytes_written_later) / 1e6,
+        replica->version_nodes_written_later
+            ? 100.0 * double(replica->version_nodes_copied_later) / double(replica->version_nodes_written_later)
+            : 0.0);
   std::printf("  memory: RSS %.0f MiB before the map, %.0f MiB loaded, %.0f MiB at the end, peak %.0f MiB\n",
               rss_before, rss_loaded, rss_end, hwm);
   // readers, replica, nodes, scans, s, stall max, stall p99, e2e p50, e2e p99, query p50, query p99, snapshots,
@@ -303,6 +314,15 @@ int main(int argc, char** argv) {
                 "on: snapshots, saves and the viewer map read versions of the read replica (no lock); off: they "
                 "copy it under its lock")
       ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  r->add_option("--replica-version-depth", a.replica_version_depth,
+                "the depth of the regions the read replica's versions are kept in (0: the eviction's)")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  r->add_option("--replica-version-writes", a.replica_version_writes,
+                "cells: a version writes the cells where the replica changed a leaf; regions: it rewrites every "
+                "region the scans' keys touched, whole (the design before)")
+      ->check(CLI::IsMember({"cells", "regions"}))
       ->capture_default_str();
   r->add_option("--snapshot-period", a.snapshot_period, "a fresh snapshot pulled this often [s]")
       ->capture_default_str();

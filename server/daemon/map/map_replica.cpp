@@ -13,12 +13,14 @@
 namespace ort::daemon {
 
 MapReplica::MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
-                       uint64_t max_batch_voxels, int nice, std::optional<RegionGrid> version_grid)
+                       uint64_t max_batch_voxels, int nice, std::optional<RegionGrid> version_grid, bool version_cells)
     : stage_(octree),
       max_pending_bytes_(max_pending_bytes),
       max_batch_voxels_(max_batch_voxels),
       has_versions_(version_grid.has_value()),
-      builder_(version_grid.value_or(region_grid(11))) {
+      version_cells_(version_cells),
+      builder_(version_grid.value_or(region_grid(11)), version_cells),
+      version_threads_(octree.threads != 0 ? octree.threads : std::max(1u, std::thread::hardware_concurrency())) {
   state_.mutex.prefer_writers();  // readers overlap one another: the writer must get in between
   state_.tree = std::make_unique<octomap::OcTree>(*map.tree);
   state_.version = map.version;
@@ -28,6 +30,7 @@ MapReplica::MapReplica(const MapState& map, const OctreeUpdateOptions& octree, u
   state_.newest_scan = map.newest_scan;
   state_.leaves.store(map.leaves.load(std::memory_order_relaxed), std::memory_order_relaxed);
   stats_.version = map.version;
+  stats_.version_depth = has_versions_ ? version_grid->depth : 0;
   record_version_ = applied_version_ = map.version;
   thread_ = std::thread([this, nice] {
     lower_this_thread_priority(nice);
@@ -108,7 +111,7 @@ void MapReplica::take_batch(std::deque<Item>& batch) {
   }
 }
 
-double MapReplica::apply_batch(std::deque<Item>& batch) {
+double MapReplica::apply_batch(std::deque<Item>& batch, bool log_changes) {
   std::span<const VoxelUpdate> voxels = batch.front().voxels;
   if (batch.size() > 1) {
     joined_.clear();
@@ -125,7 +128,7 @@ double MapReplica::apply_batch(std::deque<Item>& batch) {
   if (batch.front().step)
     batch.front().step(*state_.tree);
   else
-    leaf_change = stage_.apply(*state_.tree, voxels);
+    leaf_change = stage_.apply(*state_.tree, voxels, log_changes ? &changes_ : nullptr);
   const int64_t leaves = state_.leaves.load(std::memory_order_relaxed);
   state_.leaves.store(!state_.tree->getRoot()      ? 0
                       : leaves >= 0 && leaf_change ? leaves + *leaf_change
@@ -182,15 +185,16 @@ void MapReplica::run() {
       note_regions = versions_on_;
     }
     const auto t0 = SteadyClock::now();
-    const double waited = apply_batch(batch);
+    const double waited = apply_batch(batch, note_regions && version_cells_);
     const double applied_ms = ms_since(t0);
-    if (note_regions) {  // what the next version writes again
+    if (note_regions) {  // what the next version writes again: the regions of the leaves that changed
       std::lock_guard build(build_mutex_);
-      for (const Item& it : batch)
-        if (it.step)
-          builder_.changed_all();
-        else
-          builder_.changed(it.voxels);
+      if (batch.front().step)
+        builder_.changed_all();
+      else if (version_cells_)
+        builder_.changed(changes_);
+      else
+        for (const Item& it : batch) builder_.changed(it.voxels);
     }
     uint64_t bytes = 0;
     for (const Item& it : batch) bytes += it.bytes;
@@ -220,15 +224,20 @@ void MapReplica::make_version() {
   // read here without its lock, while query turns read it under theirs.
   std::lock_guard build(build_mutex_);
   const auto t0 = SteadyClock::now();
+  const int64_t cpu0 = thread_cpu_ns();
   auto v = std::make_shared<ReplicaVersion>();
-  v->map = builder_.build(*state_.tree);
+  // (Without cells, as before them: on this thread alone.)
+  if (!version_pool_ && version_threads_ > 1 && version_cells_)
+    version_pool_ = std::make_unique<WorkerPool>(version_threads_, false, 19);
+  v->map = builder_.build(*state_.tree, version_pool_.get());
   v->version = state_.version;
   v->epoch = state_.epoch;
   v->scans = state_.scans;
   v->last_scan_utime = state_.last_scan_utime;
   v->newest_scan = state_.newest_scan;
-  const double ms = ms_since(t0);
+  const double ms = ms_since(t0), cpu_ms = double(thread_cpu_ns() - cpu0) / 1e6;
   const auto figures = builder_.last_build();
+  const uint64_t v_bytes = v->map->data_bytes();
   {
     std::lock_guard lock(mutex_);
     if (!latest_ || latest_->version <= v->version) latest_ = std::move(v);
@@ -237,6 +246,15 @@ void MapReplica::make_version() {
     stats_.version_ms_max = std::max(stats_.version_ms_max, ms);
     stats_.version_regions = figures.regions;
     stats_.version_regions_written = figures.regions_written;
+    stats_.version_bytes = v_bytes;
+    stats_.version_bytes_written = figures.bytes_written;
+    if (stats_.versions_built > 1) {
+      stats_.version_bytes_written_later += figures.bytes_written;
+      stats_.version_nodes_written_later += figures.nodes_written;
+      stats_.version_nodes_copied_later += figures.nodes_copied;
+      stats_.version_ms_later += ms;
+      stats_.version_cpu_ms_later += cpu_ms;
+    }
   }
   progress_.notify_all();
 }

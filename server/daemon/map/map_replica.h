@@ -7,8 +7,9 @@
 // bytes). Short readers (query turns, the status' figures) lock the replica's MapState.
 // Whole-map readers (snapshots, saves, the viewer map) lock nothing: they take an immutable
 // version of it (read_version), kept per region (octree/versions/map_version.h), that the replica's
-// thread makes between two batches from its own tree, writing again only the regions the
-// batches since the last version touched; however long a reader holds or serializes its
+// thread makes between two batches from its own tree, writing again only the cells where the
+// batches since the last version changed a leaf (its octree stage's change log; the rest of a
+// changed region copied from its old records); however long a reader holds or serializes its
 // version, neither the octree stage nor the replica waits for it (docs/ARCHITECTURE.md
 // "Readers and the read replica").
 //
@@ -17,7 +18,9 @@
 // changed since each); plus the voxel lists and steps not applied yet, at most
 // `max_pending_bytes`; past that, stage 2 waits for the replica (only while a reader holds
 // the replica longer than it takes the producers to send that much); plus one buffer of at
-// most `max_batch_voxels` voxels (8 bytes each), kept from batch to batch.
+// most `max_batch_voxels` voxels (8 bytes each), kept from batch to batch, and while versions
+// are on the change log of a batch (16 bytes a changed leaf, at most one per voxel) and the
+// changed cells since the last version (a 64-byte set per changed region).
 //
 // Keeping up: scans waiting back to back (a reader held the replica, or it fell behind) are
 // applied as one list, their voxel lists one after the other. The batched octree stage applies
@@ -51,9 +54,11 @@
 #include "core/voxel_update.h"
 #include "daemon/map/map_identity.h"
 #include "daemon/map/map_state.h"
+#include "octree/leaf_changes.h"
 #include "octree/octree_update.h"
 #include "octree/region.h"
 #include "octree/versions/map_version.h"
+#include "octree/worker_pool.h"
 
 namespace ort::daemon {
 
@@ -75,12 +80,17 @@ struct ReplicaStats {
   double apply_ms_total = 0;      // the replica thread's own update time (its lock held)
   double lock_wait_ms_total = 0;  // the replica thread's wait for its lock (readers inside)
   double lock_wait_ms_max = 0;
-  uint64_t updates = 0;                             // tree updates it made: one per batch of scans or per step
-  uint64_t scans_in_batches = 0;                    // scans applied together with others
-  uint64_t largest_batch = 0;                       // most scans in one update
-  uint64_t versions_built = 0;                      // versions made for whole-map readers
-  double version_ms_total = 0, version_ms_max = 0;  // the replica thread's time making them
+  uint64_t updates = 0;                                   // tree updates it made: one per batch of scans or per step
+  uint64_t scans_in_batches = 0;                          // scans applied together with others
+  uint64_t largest_batch = 0;                             // most scans in one update
+  uint64_t versions_built = 0;                            // versions made for whole-map readers
+  double version_ms_total = 0, version_ms_max = 0;        // the replica thread's time making them
+  double version_ms_later = 0, version_cpu_ms_later = 0;  // of those after the first: wall, its CPU
   uint64_t version_regions = 0, version_regions_written = 0;  // of the last one
+  uint64_t version_bytes = 0, version_bytes_written = 0;      // of the last one: its records, those written
+  uint64_t version_bytes_written_later = 0;                   // by every version after the first
+  uint64_t version_nodes_written_later = 0, version_nodes_copied_later = 0;  // of those: copied from old records
+  unsigned version_depth = 0;                                                // of its regions
 };
 
 class MapReplica {
@@ -91,12 +101,14 @@ class MapReplica {
   // its priority below the server's (core/thread_priority.h; its octree stage's helpers:
   // octree.helper_nice).
   static constexpr uint64_t kDefaultBatchVoxels = uint64_t{1} << 23;
-  // `version_grid`: the regions versions for whole-map readers are kept in (the eviction's
-  // grid); none: no versions (whole-map readers copy the replica under its lock, the design
-  // before them: benchmarks compare).
+  // `version_grid`: the regions versions for whole-map readers are kept in; none: no versions
+  // (whole-map readers copy the replica under its lock, the design before them: benchmarks
+  // compare). `version_cells`: a version writes the cells the octree stage's change log names
+  // (octree/versions/region_records.h); false: it rewrites the regions the scans' keys touched
+  // whole (the design before, session 5).
   MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
              uint64_t max_batch_voxels = kDefaultBatchVoxels, int nice = 0,
-             std::optional<RegionGrid> version_grid = region_grid(11));
+             std::optional<RegionGrid> version_grid = region_grid(11), bool version_cells = true);
   ~MapReplica();
   MapReplica(const MapReplica&) = delete;
   MapReplica& operator=(const MapReplica&) = delete;
@@ -156,9 +168,9 @@ class MapReplica {
   void run();
   // Under mutex_: the front item, and the scans right behind a scan up to max_batch_voxels_.
   void take_batch(std::deque<Item>& batch);
-  // Applies a batch to the tree and takes its last item's state (under state_.mutex).
-  // Returns how long it waited for that lock (ms).
-  double apply_batch(std::deque<Item>& batch);
+  // Applies a batch to the tree and takes its last item's state (under state_.mutex), with
+  // `log_changes` the leaves it changed in changes_. Returns how long it waited for that lock (ms).
+  double apply_batch(std::deque<Item>& batch, bool log_changes);
   // Makes a version of the tree as the replica's thread left it (after its last batch, or
   // after it exited) and publishes it.
   void make_version();
@@ -168,6 +180,7 @@ class MapReplica {
   uint64_t max_pending_bytes_;
   uint64_t max_batch_voxels_;
   VoxelList joined_;          // a batch's voxel lists one after the other (capacity kept)
+  LeafChanges changes_;       // the leaves a batch changed, while versions are on (capacity kept)
   mutable std::mutex mutex_;  // the queue and the stats
   std::condition_variable work_, room_, progress_;
   std::deque<Item> queue_;
@@ -175,13 +188,17 @@ class MapReplica {
   ReplicaStats stats_;
   std::atomic<uint64_t> record_version_{0}, applied_version_{0};
   // Versions: on after the first read_version; the newest made; the version a reader waits for.
-  bool has_versions_;
+  bool has_versions_, version_cells_;
   bool versions_on_ = false, exited_ = false;
   uint64_t wanted_version_ = 0;
   bool wanted_ = false;
   std::shared_ptr<const ReplicaVersion> latest_;
   std::mutex build_mutex_;  // the builder: the replica's thread, or a reader after it exited
   MapVersionBuilder builder_;
+  // The threads that write a version's changed regions (made with the first version; its
+  // helpers at the lowest priority, as the replica's octree stage's).
+  unsigned version_threads_;
+  std::unique_ptr<WorkerPool> version_pool_;
   std::thread thread_;
 };
 

@@ -1,17 +1,16 @@
 #include "octree/versions/map_version.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <limits>
 #include <sstream>
 
 #include "core/memory_stream.h"
+#include "octree/versions/region_records.h"
 
 namespace ort {
 namespace {
-
-// OcTreeBaseImpl's tree_max_val at OctoMap's depth 16: the root's centre key.
-constexpr octomap::key_type kRootKey = 32768;
 
 // A tree whose sensor model is set as log-odds (OcTree's setters take probabilities and
 // would round them).
@@ -25,18 +24,6 @@ class TreeWithParams : public octomap::OcTree {
     clamping_thres_max = p.clamp_max_log;
   }
 };
-
-// One node's .ot record (OcTreeNode::writeData, then the child bits).
-void append_record(std::string& out, const octomap::OcTree& tree, const octomap::OcTreeNode* node) {
-  const float value = node->getValue();
-  char rec[sizeof(float) + 1];
-  std::memcpy(rec, &value, sizeof(float));
-  unsigned bits = 0;
-  for (unsigned i = 0; i < 8; ++i)
-    if (tree.nodeChildExists(node, i)) bits |= 1u << i;
-  rec[sizeof(float)] = static_cast<char>(bits);
-  out.append(rec, sizeof rec);
-}
 
 // The step for one leaf (its leaf iterator's key and depth) of the const getMetricMin/Max
 // that snapshots of a copied tree report (calcMinMax rounds the max another way).
@@ -52,34 +39,6 @@ void extend(const octomap::OcTree& tree, const octomap::OcTreeKey& key, unsigned
 void reset_extent(double* mn, double* mx) {
   for (unsigned a = 0; a < 3; ++a)
     mn[a] = std::numeric_limits<double>::max(), mx[a] = -std::numeric_limits<double>::max();
-}
-
-// Calls fn(child, child's key) for each existing child of `node` (at `depth`, key `key`), in
-// OctoMap's child order: the order writeNodesRecurs writes them.
-template <class Fn>
-void for_each_child(const octomap::OcTree& tree, const octomap::OcTreeNode* node, const octomap::OcTreeKey& key,
-                    unsigned depth, Fn&& fn) {
-  const octomap::key_type offset = kRootKey >> (depth + 1);
-  for (unsigned i = 0; i < 8; ++i)
-    if (tree.nodeChildExists(node, i)) {
-      octomap::OcTreeKey child;
-      octomap::computeChildKey(i, offset, key, child);
-      fn(tree.getNodeChild(node, i), child);
-    }
-}
-
-// writeNodesRecurs below `node` into `r`, with the keys OctoMap's leaf iterator gives.
-void write_subtree(const octomap::OcTree& tree, const octomap::OcTreeNode* node, const octomap::OcTreeKey& key,
-                   unsigned depth, RegionBytes& r) {
-  append_record(r.bytes, tree, node);
-  ++r.nodes;
-  if (!tree.nodeHasChildren(node)) {
-    extend(tree, key, depth, r.min, r.max);
-    return;
-  }
-  for_each_child(tree, node, key, depth, [&](const octomap::OcTreeNode* c, const octomap::OcTreeKey& k) {
-    write_subtree(tree, c, k, depth + 1, r);
-  });
 }
 
 }  // namespace
@@ -155,35 +114,39 @@ std::unique_ptr<octomap::OcTree> MapVersion::tree() const {
   return t;
 }
 
+void MapVersionBuilder::mark(const octomap::OcTreeKey& key) {
+  const RegionId id = region_of(grid_, key);
+  if (id != last_id_) last_cells_ = &dirty_[id], last_id_ = id;
+  last_cells_->set(cell_of(key, grid_.depth));
+}
+
 void MapVersionBuilder::changed(std::span<const VoxelUpdate> voxels) {
   if (all_) return;
-  RegionId last = ~RegionId{0};
-  for (const VoxelUpdate& v : voxels) {
-    const RegionId id = region_of(grid_, v.key());
-    if (id != last) dirty_.insert(id), last = id;
-  }
+  last_id_ = ~RegionId{0};
+  for (const VoxelUpdate& v : voxels) mark(v.key());
+}
+
+void MapVersionBuilder::changed(const LeafChanges& log) {
+  if (all_) return;
+  last_id_ = ~RegionId{0};
+  log.for_each([&](const LeafChange& c) { mark(c.key()); });
 }
 
 void MapVersionBuilder::walk(const octomap::OcTree& tree, const octomap::OcTreeNode* node,
                              const octomap::OcTreeKey& key, unsigned depth, MapVersion& v) {
   if (depth == grid_.depth) {
     const RegionId id = region_of(grid_, key);
-    std::shared_ptr<const RegionBytes> r;
-    if (!all_ && !dirty_.contains(id))
-      if (auto it = kept_.find(id); it != kept_.end()) r = it->second;
-    if (!r) {
-      auto fresh = std::make_shared<RegionBytes>();
-      reset_extent(fresh->min, fresh->max);
-      write_subtree(tree, node, key, depth, *fresh);
-      last_.regions_written++;
-      last_.bytes_written += fresh->bytes.size();
-      r = std::move(fresh);
+    const auto kept = all_ ? kept_.end() : kept_.find(id);
+    const auto cells = kept == kept_.end() ? dirty_.end() : dirty_.find(id);
+    ids_.push_back(id);
+    if (kept != kept_.end() && cells == dirty_.end()) {  // unchanged: the old one
+      v.regions_.emplace_back(v.top_.size(), kept->second);
+    } else {  // written after the walk: merged from its old records, or whole
+      const bool merge = kept != kept_.end() && cells_;
+      jobs_.push_back(Job{v.regions_.size(), node, key, depth, merge ? kept->second.get() : nullptr,
+                          merge ? &cells->second : nullptr});
+      v.regions_.emplace_back(v.top_.size(), nullptr);
     }
-    v.nodes_ += r->nodes;
-    for (unsigned a = 0; a < 3; ++a)
-      v.min_[a] = std::min(v.min_[a], r->min[a]), v.max_[a] = std::max(v.max_[a], r->max[a]);
-    v.regions_.emplace_back(v.top_.size(), r);
-    next_.emplace(id, std::move(r));
     return;
   }
   append_record(v.top_, tree, node);
@@ -196,15 +159,48 @@ void MapVersionBuilder::walk(const octomap::OcTree& tree, const octomap::OcTreeN
                  [&](const octomap::OcTreeNode* c, const octomap::OcTreeKey& k) { walk(tree, c, k, depth + 1, v); });
 }
 
-std::shared_ptr<const MapVersion> MapVersionBuilder::build(const octomap::OcTree& tree) {
+std::shared_ptr<const MapVersion> MapVersionBuilder::build(const octomap::OcTree& tree, WorkerPool* pool) {
   auto v = std::make_shared<MapVersion>();
   v->params_ = tree_params(tree);
   last_ = Figures{};
-  next_.clear();
-  next_.reserve(kept_.size() + 16);
+  jobs_.clear();
+  ids_.clear();
   if (const octomap::OcTreeNode* root = tree.getRoot()) {
     reset_extent(v->min_, v->max_);
     walk(tree, root, octomap::OcTreeKey(kRootKey, kRootKey, kRootKey), 0, *v);
+  }
+  // The regions to write, on the pool's threads where there is one (each its own bytes).
+  std::atomic<size_t> next_job{0};
+  auto write = [&](unsigned) {
+    for (size_t i; (i = next_job.fetch_add(1, std::memory_order_relaxed)) < jobs_.size();) {
+      Job& j = jobs_[i];
+      auto fresh = std::make_shared<RegionBytes>();
+      if (j.old)
+        j.copied = merge_region(tree, j.node, j.key, j.depth, *j.old, *j.cells, *fresh);
+      else
+        write_region(tree, j.node, j.key, j.depth, *fresh);
+      v->regions_[j.slot].second = std::move(fresh);
+    }
+  };
+  if (pool && jobs_.size() > 1)
+    pool->run_shared(write);
+  else
+    write(0);
+  for (const Job& j : jobs_) {
+    last_.regions_merged += j.old != nullptr;
+    last_.bytes_written += v->regions_[j.slot].second->bytes.size();
+    last_.nodes_written += v->regions_[j.slot].second->nodes;
+    last_.nodes_copied += j.copied;
+  }
+  last_.regions_written = jobs_.size();
+  next_.clear();
+  next_.reserve(v->regions_.size());
+  for (size_t k = 0; k < v->regions_.size(); ++k) {
+    const RegionBytes& r = *v->regions_[k].second;
+    v->nodes_ += r.nodes;
+    for (unsigned a = 0; a < 3; ++a)
+      v->min_[a] = std::min(v->min_[a], r.min[a]), v->max_[a] = std::max(v->max_[a], r.max[a]);
+    next_.emplace(ids_[k], v->regions_[k].second);
   }
   // Regions no longer in the tree are forgotten: one made again later is written anew.
   kept_.swap(next_);

@@ -9,16 +9,25 @@
 // bytes written in order: OctoMap's AbstractOcTree::write byte for byte.
 //
 // Building the next version (MapVersionBuilder::build) walks the nodes above the region depth
-// (O(regions)) and writes again only the regions a change touched since the last build (the
-// keys of the scans applied since, MapVersionBuilder::changed) or every region after a change
-// that does not list its keys (changed_all: an edit, a reset). Why the regions a scan did not
-// touch are unchanged: OctoMap's update (and the batched stage, which does what it does)
-// creates, expands, prunes and changes nodes only on the paths of the keys it updates; a
-// region pruned into a coarser leaf above it was a leaf itself first, and one made again by
-// expanding that coarse leaf has the coarse leaf's value, which is its own (the coarse leaf
-// cannot change without being expanded); the nodes above the region depth are written anew
-// at every build. tests/octree/map_version_test.cpp checks the bytes against OcTree::write
-// after every scan of real data.
+// (O(regions)) and writes again only the regions a change reached since the last build, and of
+// those only the cells (a region's nodes 3 levels below its root) where it changed: the rest of
+// the region is copied from its old records (octree/versions/region_records.h). The builder is
+// told the keys of the scans applied since, or better the leaves their updates changed (the
+// octree stage's change log; MapVersionBuilder::changed), or to write every region after a
+// change that does not list its keys (changed_all: an edit, a reset). So a version costs in
+// proportion to what changed, not to the nodes of the regions it reached.
+// Why a subtree no changed key lies in is unchanged: OctoMap's update (and the batched stage,
+// which does what it does) creates, expands, prunes and changes nodes only on the paths of the
+// keys it updates; a subtree pruned into a coarser leaf above it was a leaf itself first, and
+// one made again by expanding that coarse leaf has the coarse leaf's value, which is its own
+// (the coarse leaf cannot change without being expanded); the nodes above the region depth are
+// written anew at every build.
+// Why the change log is enough: an update of a key whose leaf (or the pruned node above it)
+// is at the clamping bound returns before it touches the tree (updateNode's early return);
+// every other update changes the leaf's value and is logged (octree/leaf_changes.h; a key
+// updated several times in one list is logged once, even where its value comes back to what
+// it was). tests/octree/map_version_test.cpp checks the bytes against OcTree::write after
+// every scan of real data, told either way.
 //
 // Memory: a region's bytes are 5 per node (a tree's node costs 16 to 80); the newest version
 // holds one such copy of the whole map, and an older version a reader still holds adds at most
@@ -31,24 +40,18 @@
 #include <span>
 #include <string>
 #include <unordered_map>
-#include <unordered_set>
 #include <utility>
 #include <vector>
 
 #include <octomap/OcTree.h>
 
 #include "core/voxel_update.h"
+#include "octree/leaf_changes.h"
 #include "octree/region.h"
+#include "octree/versions/region_records.h"
+#include "octree/worker_pool.h"
 
 namespace ort {
-
-// One region's subtree as .ot records, its node count and the extent of its leaves as
-// OctoMap's const getMetricMin/Max compute it.
-struct RegionBytes {
-  std::string bytes;
-  uint64_t nodes = 0;
-  double min[3], max[3];
-};
 
 // The tree's resolution and sensor model as log-odds (a tree made from a version gets them
 // bit for bit: the .bt's maximum likelihood depends on them).
@@ -88,25 +91,50 @@ class MapVersion {
 
 class MapVersionBuilder {
  public:
-  explicit MapVersionBuilder(RegionGrid grid) : grid_(grid) {}
+  // `cells` false: a changed region is written whole from the tree (the design before the
+  // changed cells; benchmarks compare).
+  explicit MapVersionBuilder(RegionGrid grid, bool cells = true) : grid_(grid), cells_(cells) {}
   // The tree changed at these keys (a scan's voxel list) since the last build.
   void changed(std::span<const VoxelUpdate> voxels);
+  // The same from the octree stage's log of the leaves an update changed: fewer regions where
+  // scans cross space they already made certain (its keys at the clamping bound).
+  void changed(const LeafChanges& log);
   // The tree changed in a way that does not list its keys: the next build writes every region.
   void changed_all() { all_ = true; }
   // The version of `tree` as it is now. The caller keeps the tree from changing meanwhile.
-  std::shared_ptr<const MapVersion> build(const octomap::OcTree& tree);
+  // With `pool`, its threads write the regions that changed (each region's bytes its own).
+  std::shared_ptr<const MapVersion> build(const octomap::OcTree& tree, WorkerPool* pool = nullptr);
 
   struct Figures {
     uint64_t regions = 0, regions_written = 0, bytes_written = 0;
+    uint64_t regions_merged = 0;                   // of those written: from their old records and the changed cells
+    uint64_t nodes_written = 0, nodes_copied = 0;  // of the regions written: all, copied from old records
   };
   Figures last_build() const { return last_; }
 
  private:
   void walk(const octomap::OcTree& tree, const octomap::OcTreeNode* node, const octomap::OcTreeKey& key, unsigned depth,
             MapVersion& v);
+  void mark(const octomap::OcTreeKey& key);
+  // A region the build writes after its walk: into the version's slot, from its old records
+  // and changed cells (old set) or whole.
+  struct Job {
+    size_t slot;
+    const octomap::OcTreeNode* node;
+    octomap::OcTreeKey key;
+    unsigned depth;
+    const RegionBytes* old;
+    const RegionCells* cells;
+    uint64_t copied = 0;  // nodes copied from `old`
+  };
+  std::vector<Job> jobs_;
+  std::vector<RegionId> ids_;  // the version's regions, in order
   RegionGrid grid_;
-  bool all_ = true;  // the first build writes everything
-  std::unordered_set<RegionId> dirty_;
+  bool cells_;
+  bool all_ = true;                                  // the first build writes everything
+  std::unordered_map<RegionId, RegionCells> dirty_;  // the cells changed since the last build
+  RegionId last_id_ = ~RegionId{0};
+  RegionCells* last_cells_ = nullptr;
   std::unordered_map<RegionId, std::shared_ptr<const RegionBytes>> kept_, next_;
   Figures last_;
 };
