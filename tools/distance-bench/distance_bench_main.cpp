@@ -311,8 +311,8 @@ int main(int argc, char** argv) {
     return scans_per_s;
   };
   report("mapping alone", LatencyStats{}, stream([](const std::atomic<bool>&) {}));
-  LatencyStats loaded_box;
-  const double with_boxes = stream([&](const std::atomic<bool>&) {
+  // Boxes at --box-rate for the phase, then every reply waited for.
+  auto boxes_at_rate = [&](LatencyStats& stats) {
     const auto t0 = SteadyClock::now();
     std::vector<std::pair<int64_t, SteadyClock::time_point>> sent;
     for (int i = 0; since(t0) < phase_s; ++i) {
@@ -320,8 +320,10 @@ int main(int argc, char** argv) {
       std::this_thread::sleep_until(
           t0 + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>((i + 1) / box_rate)));
     }
-    for (const auto& [id, t] : sent) loaded_box.add(replies.wait(id, t, answer_timeout_s));
-  });
+    for (const auto& [id, t] : sent) stats.add(replies.wait(id, t, answer_timeout_s));
+  };
+  LatencyStats loaded_box;
+  const double with_boxes = stream([&](const std::atomic<bool>&) { boxes_at_rate(loaded_box); });
   report("mapping + boxes", loaded_box, with_boxes);
   cache_line("mapping + boxes");
   LatencyStats loaded_points;
@@ -334,16 +336,6 @@ int main(int argc, char** argv) {
   report("mapping + points", loaded_points, with_points);
   cache_line("mapping + points");
   // A robot exploring: the producers' scans shifted into new space, boxes at --box-rate.
-  auto boxes_at_rate = [&](LatencyStats& stats) {
-    const auto t0 = SteadyClock::now();
-    std::vector<std::pair<int64_t, SteadyClock::time_point>> sent;
-    for (int i = 0; since(t0) < phase_s; ++i) {
-      sent.push_back(box_query());
-      std::this_thread::sleep_until(
-          t0 + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>((i + 1) / box_rate)));
-    }
-    for (const auto& [id, t] : sent) stats.add(replies.wait(id, t, answer_timeout_s));
-  };
   LatencyStats exploring_box;
   const double exploring = stream([&](const std::atomic<bool>&) { boxes_at_rate(exploring_box); }, true);
   report("exploring + boxes", exploring_box, exploring);
