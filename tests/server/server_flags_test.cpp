@@ -61,6 +61,14 @@ TEST(ServerFlags, AbsurdNumbersForTheWalkAndTheSensorModelAreRefusedAtStart) {
       {"-r 0.1 --max-map-new-nodes-per-s -1", "--max-map-new-nodes-per-s"},
       {"-r 0.1 --map-new-node-burst nan", "--map-new-node-burst"},
       {"-r 0.1 --max-origin-jump -5", "--max-origin-jump"},
+      // The shared class's share and the per-scan time bound: NaN, zero share, negative time.
+      {"-r 0.1 --shared-class-share nan", "--shared-class-share"},
+      {"-r 0.1 --shared-class-share 0", "--shared-class-share"},
+      {"-r 0.1 --max-scan-time -1", "--max-scan-time"},
+      {"-r 0.1 --max-scan-time nan", "--max-scan-time"},
+      // Shard regions: depth 0 and past the octree's 16 levels.
+      {"-r 0.1 --shard 0/2 --shard-region-depth 0", "--shard-region-depth"},
+      {"-r 0.1 --shard 0/2 --shard-region-depth 17", "--shard-region-depth"},
   };
   for (const auto& c : cases) {
     const ServerRun r = run_server(c.flags);
