@@ -29,10 +29,6 @@
 namespace ort::test {
 namespace {
 
-// The rt back end walks the exact traversal only (its map is compared with the cpu back
-// end's exact walk); the others OctoMap's (compared with OctoMap itself).
-Traversal traversal_of(BackendKind kind) { return kind == BackendKind::kRt ? Traversal::kExact : Traversal::kOctomap; }
-
 std::unique_ptr<MapEngine> make_engine(BackendKind kind, Traversal traversal) {
   EngineOptions o;
   o.resolution = 0.1;
@@ -115,7 +111,7 @@ class DegenerateRays : public ::testing::TestWithParam<BackendKind> {
  protected:
   void SetUp() override {
     try {
-      engine_ = make_engine(GetParam(), traversal_of(GetParam()));
+      engine_ = make_engine(GetParam(), reference_traversal(GetParam()));
     } catch (const Unsupported& e) {
       GTEST_SKIP() << "no device for " << to_string(GetParam()) << ": " << e.what();
     } catch (const std::runtime_error& e) {
@@ -151,7 +147,7 @@ TEST_P(DegenerateRays, TinyCoordinatesReadAsZeroAndTooShortRaysAreSkippedAsOctom
       EXPECT_EQ(shot.prepare.read_as_zero, s.read_as_zero);
       EXPECT_EQ(shot.prepare.rays, s.expected.size());
       EXPECT_EQ(shot.shoot.walk_overruns, 0u);
-      const auto ref = reference(traversal_of(GetParam()), octomap::point3d(0, 0, 0), s.expected, -1.0);
+      const auto ref = reference(reference_traversal(GetParam()), octomap::point3d(0, 0, 0), s.expected, -1.0);
       const TreeDiff d = compare_leaves(*tree, *ref);
       EXPECT_TRUE(d.maps_equal()) << d.differing_voxels << " voxels differ: " << d.first_difference;
     }
@@ -171,7 +167,7 @@ TEST_P(DegenerateRays, AtTheSmallestMaxRangeEveryRayIsCutAsOctomapCutsIt) {
     EXPECT_EQ(shot.prepare.degenerate + shot.prepare.rays, s.all.size());
     EXPECT_GT(shot.prepare.cut_at_max_range, 40u);
     EXPECT_EQ(shot.shoot.walk_overruns, 0u);
-    const auto ref = reference(traversal_of(GetParam()), octomap::point3d(0, 0, 0), s.expected, kMinMaxRange);
+    const auto ref = reference(reference_traversal(GetParam()), octomap::point3d(0, 0, 0), s.expected, kMinMaxRange);
     EXPECT_GT(ref->size(), 0u);
     const TreeDiff d = compare_leaves(*tree, *ref);
     EXPECT_TRUE(d.maps_equal()) << d.differing_voxels << " voxels differ: " << d.first_difference;

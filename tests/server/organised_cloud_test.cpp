@@ -47,8 +47,6 @@ std::vector<octomap::point3d> range_image(const octomap::Pointcloud& scan) {
   return image;
 }
 
-Traversal traversal_of(BackendKind kind) { return kind == BackendKind::kRt ? Traversal::kExact : Traversal::kOctomap; }
-
 class OrganisedCloud : public ::testing::TestWithParam<BackendKind> {};
 
 TEST_P(OrganisedCloud, NaNNoReturnsAreCountedEveryFinitePointAppliedAndTheMapIsOctoMaps) {
@@ -64,7 +62,7 @@ TEST_P(OrganisedCloud, NaNNoReturnsAreCountedEveryFinitePointAppliedAndTheMapIsO
   lcm::LCM lc("memq://");
   auto cfg = test_config(kResolution, true);
   cfg.engine.backend.kind = GetParam();
-  cfg.engine.traversal = traversal_of(GetParam());
+  cfg.engine.traversal = reference_traversal(GetParam());
   cfg.engine.backend.grid_budget_bytes = 64ull << 20;
   cfg.engine.backend.threads = 2;
   std::ostringstream log;

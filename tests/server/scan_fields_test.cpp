@@ -47,17 +47,13 @@ PosedScan scan_at_zero(std::vector<octomap::point3d>& expected) {
   return s;
 }
 
-// The rt back end walks the exact traversal only: its map is compared with the cpu back
-// end's exact walk of the same scans; the others with OctoMap itself.
-Traversal traversal_of(BackendKind kind) { return kind == BackendKind::kRt ? Traversal::kExact : Traversal::kOctomap; }
-
 class ScanFields : public ::testing::TestWithParam<BackendKind> {};
 
 TEST_P(ScanFields, EveryDegenerateFieldIsRefusedWithItsReasonOrWalkedSafely) {
   lcm::LCM lc("memq://");
   auto cfg = test_config(0.1, true);
   cfg.engine.backend.kind = GetParam();
-  cfg.engine.traversal = traversal_of(GetParam());
+  cfg.engine.traversal = reference_traversal(GetParam());
   cfg.engine.backend.grid_budget_bytes = 64ull << 20;
   cfg.engine.backend.threads = 2;
   std::ostringstream log;

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "core/backend_kind.h"
+#include "core/traversal.h"
 
 namespace ort::test {
 
@@ -20,6 +21,13 @@ inline std::string backend_param_name(const ::testing::TestParamInfo<BackendKind
   for (char& c : n)
     if (c == '-') c = '_';
   return n;
+}
+
+// The traversal a back end's map is compared under: the rt back end walks the exact traversal
+// only (its map is compared with the cpu back end's exact walk), the others OctoMap's own
+// (compared with OctoMap itself).
+inline Traversal reference_traversal(BackendKind kind) {
+  return kind == BackendKind::kRt ? Traversal::kExact : Traversal::kOctomap;
 }
 
 }  // namespace ort::test
