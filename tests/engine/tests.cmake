@@ -3,6 +3,7 @@ target_compile_definitions(engine_cli_parity_test PRIVATE OCTOMAP_RT_CLI="$<TARG
 add_dependencies(engine_cli_parity_test octomap-rt)
 
 octomap_rt_add_test(engine_prepare_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/prepare_scan_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/map_frame_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/exact_traversal_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/ground_helpers_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/periodic_thread_test.cpp)
