@@ -6,22 +6,18 @@
 #include <utility>
 
 namespace ort::distance {
-namespace {
 
-// The cells [lo, hi] (inclusive, per axis) of a grid, in its own index space.
-struct IndexBox {
-  std::array<int64_t, 3> lo{}, hi{};
-  int64_t cells() const { return (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1); }
-  void add(int64_t i, int64_t j, int64_t k, bool& any) {
-    if (!any) {
-      lo = {i, j, k}, hi = {i, j, k};
-      any = true;
-      return;
-    }
-    lo = {std::min(lo[0], i), std::min(lo[1], j), std::min(lo[2], k)};
-    hi = {std::max(hi[0], i), std::max(hi[1], j), std::max(hi[2], k)};
+void IndexBox::add(int64_t i, int64_t j, int64_t k, bool& any) {
+  if (!any) {
+    lo = {i, j, k}, hi = {i, j, k};
+    any = true;
+    return;
   }
-};
+  lo = {std::min(lo[0], i), std::min(lo[1], j), std::min(lo[2], k)};
+  hi = {std::max(hi[0], i), std::max(hi[1], j), std::max(hi[2], k)};
+}
+
+namespace {
 
 // The bounding box of the cells where `a` and `b` differ; false where they are equal.
 bool changed_box(const OccupancyGrid& a, const OccupancyGrid& b, IndexBox& out) {
@@ -124,26 +120,23 @@ void FieldCache::will_hold(const CellBox& box, const DistanceOptions& opt, doubl
 
 void FieldCache::will_advance(uint64_t version) { pending_version_ = version; }
 
-const DistanceField& FieldCache::update(OccupancyGrid grid, const SquaredEdt& edt, double resolution,
-                                        const DistanceOptions& opt, uint64_t version) {
-  const Key key = key_of(grid.box, opt, resolution);
+template <class BringGrid>
+const DistanceField& FieldCache::settle(const Key& key, uint64_t version, const SquaredEdt& edt,
+                                        const DistanceOptions& opt, BringGrid&& bring_grid) {
   try {
-    IndexBox changed;
-    const bool reuse = valid_ && same_key(key, key_, true);
-    valid_ = false;  // until the field is the grid's
-    ++stats_.reread;
-    if (reuse && !changed_box(grid_, grid, changed)) {
+    const bool was_valid = valid_;
+    valid_ = false;  // until the field is grid_'s
+    const Change c = bring_grid(was_valid);
+    if (c.reuse && !c.any) {
       ++stats_.unchanged;
-      grid_ = std::move(grid);
-    } else if (reuse && partial_pays(changed, key.pad, grid.box.dims)) {
-      memo_.reset();
-      grid_ = std::move(grid);
-      transform_part(grid_, changed, key.pad, edt, field_, stats_);
     } else {
       memo_.reset();
-      field_ = compute_field(grid, edt, resolution, opt);
-      grid_ = std::move(grid);
-      ++stats_.full;
+      if (c.reuse && partial_pays(c.box, key.pad, grid_.box.dims)) {
+        transform_part(grid_, c.box, key.pad, edt, field_, stats_);
+      } else {
+        field_ = compute_field(grid_, edt, key.resolution, opt);
+        ++stats_.full;
+      }
     }
   } catch (...) {
     pending_valid_ = false;
@@ -151,10 +144,23 @@ const DistanceField& FieldCache::update(OccupancyGrid grid, const SquaredEdt& ed
     throw;
   }
   field_.box = grid_.box;
-  field_.cell_size = resolution * grid_.box.cell_voxels;
+  field_.cell_size = key.resolution * grid_.box.cell_voxels;
   field_.max_distance = opt.max_distance;
   key_ = key, version_ = version, valid_ = true;
   return field_;
+}
+
+const DistanceField& FieldCache::update(OccupancyGrid grid, const SquaredEdt& edt, double resolution,
+                                        const DistanceOptions& opt, uint64_t version) {
+  const Key key = key_of(grid.box, opt, resolution);
+  return settle(key, version, edt, opt, [&](bool was_valid) {
+    Change c;
+    c.reuse = was_valid && same_key(key, key_, true);
+    ++stats_.reread;
+    c.any = !c.reuse || changed_box(grid_, grid, c.box);
+    grid_ = std::move(grid);
+    return c;
+  });
 }
 
 const DistanceField& FieldCache::update(const GridPatch& patch, const SquaredEdt& edt, const DistanceOptions& opt) {
@@ -163,40 +169,21 @@ const DistanceField& FieldCache::update(const GridPatch& patch, const SquaredEdt
     pending_valid_ = false;
     throw DistanceError("the distance field cache lost its entry (an update before this one failed): ask again");
   }
-  try {
-    valid_ = false;
+  return settle(key_, patch.to, edt, opt, [&](bool) {
+    Change c;
+    c.reuse = true;
     const GridDims d = grid_.box.dims;
-    IndexBox changed;
-    bool any = false;
-    for (const CellChange& c : patch.cells) {
-      uint8_t& cell = grid_.occupied.at(c.index);
-      if (cell == c.occupied) continue;
-      cell = c.occupied;
-      const int64_t i = c.index % d.nx, j = (c.index / d.nx) % d.ny, k = c.index / (int64_t(d.nx) * d.ny);
-      changed.add(i, j, k, any);
+    for (const CellChange& ch : patch.cells) {
+      uint8_t& cell = grid_.occupied.at(ch.index);
+      if (cell == ch.occupied) continue;
+      cell = ch.occupied;
+      const int64_t i = ch.index % d.nx, j = (ch.index / d.nx) % d.ny, k = ch.index / (int64_t(d.nx) * d.ny);
+      c.box.add(i, j, k, c.any);
     }
     ++stats_.patched;
     stats_.patch_changes += int64_t(patch.cells.size());
-    if (!any)
-      ++stats_.unchanged;
-    else if (partial_pays(changed, key_.pad, d)) {
-      memo_.reset();
-      transform_part(grid_, changed, key_.pad, edt, field_, stats_);
-    } else {
-      memo_.reset();
-      field_ = compute_field(grid_, edt, key_.resolution, opt);
-      ++stats_.full;
-    }
-  } catch (...) {
-    pending_valid_ = false;
-    memo_.reset();
-    throw;
-  }
-  field_.box = grid_.box;
-  field_.cell_size = key_.resolution * grid_.box.cell_voxels;
-  field_.max_distance = opt.max_distance;
-  version_ = patch.to, valid_ = true;
-  return field_;
+    return c;
+  });
 }
 
 }  // namespace ort::distance

@@ -22,6 +22,7 @@
 // query worker is its only user.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -42,6 +43,15 @@ struct FieldCacheStats {
   int64_t patch_changes = 0;  // the cell changes those patches carried
   int64_t reread = 0;         // updates from a grid read from the map again
   int64_t replies_kept = 0;   // box replies sent the bytes kept from the last one (field unchanged)
+};
+
+// The cells [lo, hi] (inclusive, per axis) of a grid, in its own index space: where a grid
+// changed.
+struct IndexBox {
+  std::array<int64_t, 3> lo{}, hi{};
+  int64_t cells() const { return (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1); }
+  // Grows the box to hold (i, j, k); the first cell (`any` false) makes it that cell alone.
+  void add(int64_t i, int64_t j, int64_t k, bool& any);
 };
 
 // A cell of the cached grid and whether it is an obstacle now.
@@ -110,6 +120,18 @@ class FieldCache {
   };
   static Key key_of(const CellBox& box, const DistanceOptions& opt, double resolution);
   static bool same_key(const Key& a, const Key& b, bool with_box);
+  // Both updates' end, once grid_ is the new grid: the field kept (`any` false: no cell
+  // changed), transformed over the reach of `changed` (the entry's field is for grid_'s box
+  // and options before the change, `reuse`) or computed whole; then the entry is `key` at
+  // `version`. `bring_grid(was_valid)` brings grid_ up to date and says whether (and where) cells
+  // changed.
+  struct Change {
+    bool reuse = false, any = false;
+    IndexBox box;
+  };
+  template <class BringGrid>
+  const DistanceField& settle(const Key& key, uint64_t version, const SquaredEdt& edt, const DistanceOptions& opt,
+                              BringGrid&& change);
 
   bool valid_ = false;
   Key key_;

@@ -49,6 +49,39 @@ void expect_same_box(const distance::BoxDistances& got, const distance::BoxDista
   }
 }
 
+// Both update tests' set-up and step: a real map's box read once and cached (at `version`),
+// its grid changed by the test; check() compares the cache's updated field with the field of
+// the grid computed whole and counts the steps whose change moved the answer.
+struct CachedBox {
+  CachedBox(const octomap::OcTree& t, const distance::DistanceOptions& o, const distance::SquaredEdt& e,
+            uint64_t version)
+      : opt(o), edt(e), read(read_around_obstacle(t, o)), grid(read.grid) {
+    cache.update(grid, edt, read.resolution, opt, version);
+    before = fresh();
+  }
+  static distance::BoxRead read_around_obstacle(const octomap::OcTree& t, const distance::DistanceOptions& o) {
+    double lo[3], hi[3];
+    box_around_obstacle(t, o.cell_voxels, lo, hi);
+    return distance::read_box(t, lo, hi, o, {});
+  }
+  distance::BoxDistances fresh() const {
+    return distance::answer_box(read, distance::compute_field(grid, edt, read.resolution, opt), true);
+  }
+  void check(const distance::DistanceField& updated) {
+    const distance::BoxDistances want = fresh();
+    expect_same_box(distance::answer_box(read, updated, true), want, wrong);
+    if (want.squared != before.squared) ++visible;
+    before = std::move(want);
+  }
+  const distance::DistanceOptions opt;
+  const distance::SquaredEdt& edt;
+  const distance::BoxRead read;
+  distance::FieldCache cache;
+  distance::OccupancyGrid grid;  // the map's cells as the test changed them
+  distance::BoxDistances before;
+  int wrong = 0, visible = 0;
+};
+
 TEST(FieldCache, UpdatedFieldsAnswerAsFreshOnesOnARealMap) {
   const octomap::OcTree& t = *query_test_maps()[0].tree;
   const auto edt = distance::cpu_edt(2);
@@ -58,13 +91,10 @@ TEST(FieldCache, UpdatedFieldsAnswerAsFreshOnesOnARealMap) {
       SCOPED_TRACE("cell_voxels " + std::to_string(m) + (unknown == UnknownAs::kFree ? " free" : " occupied"));
       distance::DistanceOptions opt;
       opt.max_distance = 6.45 * t.getResolution() * m, opt.cell_voxels = m, opt.unknown = unknown;
-      double lo[3], hi[3];
-      box_around_obstacle(t, m, lo, hi);
-      const distance::BoxRead read = distance::read_box(t, lo, hi, opt, {});
-      distance::FieldCache cache;
-      distance::OccupancyGrid grid = read.grid;
-      cache.update(grid, edt, read.resolution, opt);
-      cache.update(grid, edt, read.resolution, opt);
+      CachedBox box(t, opt, edt, 0);
+      distance::FieldCache& cache = box.cache;
+      distance::OccupancyGrid& grid = box.grid;
+      cache.update(grid, edt, box.read.resolution, opt);
       EXPECT_EQ(cache.stats().full, 1);
       EXPECT_EQ(cache.stats().unchanged, 1);
       const distance::GridDims d = grid.box.dims;
@@ -72,9 +102,6 @@ TEST(FieldCache, UpdatedFieldsAnswerAsFreshOnesOnARealMap) {
         return grid.occupied[size_t((k * d.ny + j) * d.nx + i)];
       };
       auto random_cell = [&](int axis) { return std::uniform_int_distribution<int64_t>(0, (&d.nx)[axis] - 1)(rng); };
-      distance::BoxDistances before =
-          distance::answer_box(read, distance::compute_field(grid, edt, read.resolution, opt), true);
-      int wrong = 0, visible = 0;
       for (int step = 0; step < 24; ++step) {
         const int kind = step % 4;  // one cell; a 3-cell cluster; two far apart; a 6-cell block
         const int clusters = kind == 2 ? 2 : 1, side = kind == 3 ? 6 : kind == 0 ? 1 : 3;
@@ -84,16 +111,10 @@ TEST(FieldCache, UpdatedFieldsAnswerAsFreshOnesOnARealMap) {
             for (int64_t j = y; j < std::min<int64_t>(d.ny, y + side); ++j)
               for (int64_t i = x; i < std::min<int64_t>(d.nx, x + side); ++i) cell(i, j, k) ^= 1;
         }
-        const distance::BoxDistances got =
-            distance::answer_box(read, cache.update(grid, edt, read.resolution, opt), true);
-        const distance::BoxDistances want =
-            distance::answer_box(read, distance::compute_field(grid, edt, read.resolution, opt), true);
-        expect_same_box(got, want, wrong);
-        if (want.squared != before.squared) ++visible;
-        before = want;
+        box.check(cache.update(grid, edt, box.read.resolution, opt));
       }
-      EXPECT_EQ(wrong, 0);
-      EXPECT_GE(visible, 8) << "the changes must move the answer, or a cache that kept its field would pass";
+      EXPECT_EQ(box.wrong, 0);
+      EXPECT_GE(box.visible, 8) << "the changes must move the answer, or a cache that kept its field would pass";
       EXPECT_GE(cache.stats().partial, 12);
     }
 }
@@ -107,17 +128,11 @@ TEST(FieldCache, PatchedFieldsAnswerAsFreshOnesOnARealMap) {
   std::mt19937 rng(41);
   distance::DistanceOptions opt;
   opt.max_distance = 6.45 * t.getResolution();
-  double lo[3], hi[3];
-  box_around_obstacle(t, 1, lo, hi);
-  const distance::BoxRead read = distance::read_box(t, lo, hi, opt, {});
-  distance::FieldCache cache;
-  distance::OccupancyGrid grid = read.grid;
-  cache.update(grid, edt, read.resolution, opt, 7);
+  CachedBox box(t, opt, edt, 7);
+  distance::FieldCache& cache = box.cache;
+  distance::OccupancyGrid& grid = box.grid;
   const distance::GridDims d = grid.box.dims;
   std::uniform_int_distribution<uint32_t> any_cell(0, uint32_t(d.cells() - 1));
-  distance::BoxDistances before =
-      distance::answer_box(read, distance::compute_field(grid, edt, read.resolution, opt), true);
-  int wrong = 0, visible = 0;
   uint64_t version = 7;
   for (int step = 0; step < 16; ++step) {
     distance::GridPatch patch;
@@ -130,15 +145,10 @@ TEST(FieldCache, PatchedFieldsAnswerAsFreshOnesOnARealMap) {
     }
     patch.cells.push_back({any_cell(rng), 0});  // a change back and forth within the patch
     patch.cells.back().occupied = grid.occupied[patch.cells.back().index];
-    const distance::BoxDistances got = distance::answer_box(read, cache.update(patch, edt, opt), true);
-    const distance::BoxDistances want =
-        distance::answer_box(read, distance::compute_field(grid, edt, read.resolution, opt), true);
-    expect_same_box(got, want, wrong);
-    if (want.squared != before.squared) ++visible;
-    before = want;
+    box.check(cache.update(patch, edt, opt));
   }
-  EXPECT_EQ(wrong, 0);
-  EXPECT_GE(visible, 6);
+  EXPECT_EQ(box.wrong, 0);
+  EXPECT_GE(box.visible, 6);
   EXPECT_EQ(cache.stats().patched, 16);
   EXPECT_GE(cache.stats().partial, 12);
   distance::GridPatch stale;

@@ -84,13 +84,16 @@ void print_failures(const ort::bench::DistanceReplies& replies) {
 int main(int argc, char** argv) {
   CLI::App app{"octomap-rt-distance-bench: distance queries against the daemon in one process"};
   std::string graph = "../shared/data/octomap_share/scan_dat.graph", csv;
-  int producers = 3, points = 1000, box_queries = 20, point_queries = 50, reference_reps = 3;
+  int producers = 3, points = 1000, box_queries = 20, point_queries = 50, reference_reps = 3, journal_phases = 0;
   double phase_s = 10, box_rate = 10, max_distance = 2.0, box_x = 20, box_y = 20, box_z = 3, wait_s = 300;
   double answer_timeout_s = 30;
   bool reference_vulkan = false;
   app.add_option("--graph", graph, "scans (ScanGraph) streamed in first and by the producers")->capture_default_str();
   app.add_option("--producers", producers, "producers streaming during the loaded phases")->capture_default_str();
   app.add_option("--phase-s", phase_s, "seconds of each streaming phase")->capture_default_str();
+  app.add_option("--journal-phases", journal_phases,
+                 "mapping phases before the first distance query (change journal unarmed) and after it")
+      ->capture_default_str();
   app.add_option("--box-rate", box_rate, "box queries per second while streaming")->capture_default_str();
   app.add_option("--box-queries", box_queries, "box queries in the idle phase")->capture_default_str();
   app.add_option("--point-queries", point_queries, "point queries per phase")->capture_default_str();
@@ -132,6 +135,7 @@ int main(int argc, char** argv) {
   // The field cache's counters since the last call (distance/field_cache.h): how its entry was
   // brought up to date (from the change lists or by reading the box again) and what that cost.
   ort::distance::FieldCacheStats cache_before;
+  ort::daemon::ChangeJournalStats journal_before;
   auto cache_line = [&](const char* phase) {
     const ort::distance::FieldCacheStats c = server.distance_cache_stats();
     std::printf(
@@ -145,6 +149,14 @@ int main(int argc, char** argv) {
             : 0.0,
         (long long)(c.full - cache_before.full), (long long)(c.replies_kept - cache_before.replies_kept));
     cache_before = c;
+    // Stage 2's time in the journal (its applied(): the scans' class changes classified and kept).
+    if (const auto j = server.change_journal_stats()) {
+      const uint64_t n = j->scans - journal_before.scans;
+      std::printf("  change journal (%s): %llu scans, %llu class changes, stage 2 in it %.1f us a scan\n", phase,
+                  (unsigned long long)n, (unsigned long long)(j->changes - journal_before.changes),
+                  n ? 1000.0 * (j->record_ms - journal_before.record_ms) / double(n) : 0.0);
+      journal_before = *j;
+    }
   };
 
   // Preload: at most 2 scans in flight; then wait until every scan ended (applied, refused or
@@ -263,21 +275,6 @@ int main(int argc, char** argv) {
     print_failures(replies);
   };
 
-  // Idle: one query at a time.
-  LatencyStats idle_box, idle_points;
-  for (int i = 0; i < box_queries; ++i) {
-    const auto [id, t] = box_query();
-    idle_box.add(replies.wait(id, t, answer_timeout_s));
-  }
-  report("box idle", idle_box, 0);
-  cache_line("box idle");
-  for (int i = 0; i < point_queries; ++i) {
-    const auto [id, t] = point_query();
-    idle_points.add(replies.wait(id, t, answer_timeout_s));
-  }
-  report("points idle", idle_points, 0);
-  cache_line("points idle");
-
   // Streaming: producers keep 2 scans in flight each (as fast as the server maps), each going
   // round the scans in its own order; the phase lasts --phase-s whatever the queries do.
   // exploring: each scan's pose moved by a shift that grows with its seq (0.4 m, 0.25 m a scan,
@@ -310,7 +307,49 @@ int main(int argc, char** argv) {
                     t.reasons.c_str());
     return scans_per_s;
   };
-  report("mapping alone", LatencyStats{}, stream([](const std::atomic<bool>&) {}));
+  // The change journal's cost on stage 2 (daemon/map/change_journal.h): mapping before any
+  // distance query armed it, then after; and stage 2's own time in it (record_ms).
+  double off_sum = 0, on_sum = 0;
+  for (int i = 0; i < journal_phases; ++i) {
+    const double r = stream([](const std::atomic<bool>&) {});
+    off_sum += r;
+    report("mapping, journal off", LatencyStats{}, r);
+  }
+  // Idle: one query at a time.
+  LatencyStats idle_box, idle_points;
+  for (int i = 0; i < box_queries; ++i) {
+    const auto [id, t] = box_query();
+    idle_box.add(replies.wait(id, t, answer_timeout_s));
+  }
+  report("box idle", idle_box, 0);
+  cache_line("box idle");
+  for (int i = 0; i < point_queries; ++i) {
+    const auto [id, t] = point_query();
+    idle_points.add(replies.wait(id, t, answer_timeout_s));
+  }
+  report("points idle", idle_points, 0);
+  cache_line("points idle");
+  auto journal_ms = [&] {
+    const auto j = server.change_journal_stats();
+    return j ? j->record_ms : 0.0;
+  };
+  const double record_before = journal_ms();
+  const int64_t applied_before = applied_total(server);
+  for (int i = 0; i < std::max(1, journal_phases); ++i) {
+    const double r = stream([](const std::atomic<bool>&) {});
+    on_sum += r;
+    report("mapping alone", LatencyStats{}, r);
+  }
+  if (journal_phases > 0) {
+    const int64_t n = applied_total(server) - applied_before;
+    std::printf(
+        "  change journal's cost: mapping %.1f scans/s armed = %.1f %% of %.1f unarmed (%d phases each); stage 2 in "
+        "the journal's applied() %.1f us a scan (%.3f %% of the armed phases' time; the octree stage's leaf log not "
+        "included)\n",
+        on_sum / journal_phases, 100.0 * on_sum / off_sum, off_sum / journal_phases, journal_phases,
+        n > 0 ? 1000.0 * (journal_ms() - record_before) / double(n) : 0.0,
+        100.0 * (journal_ms() - record_before) / (1000.0 * phase_s * journal_phases));
+  }
   // Boxes at --box-rate for the phase, then every reply waited for.
   auto boxes_at_rate = [&](LatencyStats& stats) {
     const auto t0 = SteadyClock::now();
@@ -343,9 +382,9 @@ int main(int argc, char** argv) {
   if (const auto j = server.change_journal_stats())
     std::printf(
         "  change journal: %llu scans, %llu class changes recorded, %zu held, %llu trimmed; %llu asked, "
-        "%llu could not say\n",
+        "%llu could not say; stage 2 in it %.1f ms\n",
         (unsigned long long)j->scans, (unsigned long long)j->changes, j->held_changes, (unsigned long long)j->trimmed,
-        (unsigned long long)j->answered, (unsigned long long)j->refused);
+        (unsigned long long)j->answered, (unsigned long long)j->refused, j->record_ms);
   server.stop();
   return 0;
 }

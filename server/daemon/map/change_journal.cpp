@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <utility>
 
+#include "core/clock.h"
+
 namespace ort::daemon {
 
 ChangeJournal::ChangeJournal(size_t max_changes, size_t max_states)
@@ -10,6 +12,7 @@ ChangeJournal::ChangeJournal(size_t max_changes, size_t max_states)
 
 void ChangeJournal::applied(const LeafChanges& changes, float occupancy_thres_log, uint64_t version) {
   if (!armed()) return;
+  const auto t0 = SteadyClock::now();
   State s;
   s.version = version;
   // Classified here, outside the journal's lock: stage 2's time, one pass over the log.
@@ -28,6 +31,7 @@ void ChangeJournal::applied(const LeafChanges& changes, float occupancy_thres_lo
     states_.pop_front();
     stats_.trimmed++;
   }
+  stats_.record_ms += ms_since(t0);
 }
 
 bool ChangeJournal::changes_between(uint64_t from, uint64_t to, size_t max_out, std::vector<ClassChange>& out) {

@@ -41,6 +41,7 @@ struct ChangeJournalStats {
   uint64_t trimmed = 0;   // states dropped for room
   uint64_t answered = 0;  // changes_between that could answer
   uint64_t refused = 0;   // ... that could not (a state not in the journal)
+  double record_ms = 0;   // stage 2's time in applied() (classify, append, trim) since armed
   size_t held_changes = 0;
 };
 
