@@ -13,7 +13,8 @@ import numpy as np
 
 import octomap_rt
 from octomap_rt.queries import Wait
-from octomap_rt.shards import ShardClient
+from octomap_rt.shards import ShardClient, ShardSet, shards_for_rays
+from octomap_rt import map_info_t
 from server_fixture import ShardSetGroup
 
 SHARDS = 3
@@ -150,6 +151,45 @@ class ShardSetTest(unittest.TestCase):
             t.close()
         finally:
             c.close()
+
+
+class ShardRaysRouteTest(unittest.TestCase):
+    """ShardClient.cast_rays asks only the shards a ray can reach on a boxes set (shards_for_rays, as the C++
+    client's ShardRays test checks on real maps): every voxel along each ray, to a voxel's diagonal past its
+    max range, is owned by an asked shard, and short rays ask fewer shards than the set has. No daemon."""
+
+    RES = 0.1
+    # Four boxes of depth-13 regions (0.8 m at 0.1 m) meeting at x = 0, y = 0 (region 4096), every z.
+    BOXES = ShardSet(map_info_t.SHARD_RULE_BOXES, 13, 4,
+                     ((0, 0, 0, 4096, 4096, 8192), (4096, 0, 0, 8192, 4096, 8192),
+                      (0, 4096, 0, 4096, 8192, 8192), (4096, 4096, 0, 8192, 8192, 8192)))
+
+    def test_asked_shards_hold_every_voxel_a_ray_reaches(self):
+        rng = np.random.default_rng(26)
+        fewer = 0
+        for max_range in (0.6, 2.0, 6.0):
+            for _ in range(300):
+                o = rng.uniform([-4, -4, 0], [4, 4, 2]).astype(np.float32)
+                d = rng.normal(size=3).astype(np.float32)
+                asked = shards_for_rays(self.BOXES, o, d, max_range, self.RES)
+                fewer += len(asked) < self.BOXES.count
+                u = d.astype(np.float64) / np.linalg.norm(d.astype(np.float64))
+                t = np.arange(0.0, max_range + 1.8 * self.RES, self.RES / 8)
+                along = (o.astype(np.float64) + t[:, None] * u).astype(np.float32).astype(np.float64)
+                keys = {tuple(k) for k in (np.floor((1.0 / self.RES) * along).astype(np.int64) + (1 << 15))}
+                for k in keys:
+                    owner = self.BOXES.shard_of_key(k)
+                    self.assertIn(owner, asked, f"ray {o} {d} range {max_range}: key {k} in shard {owner}")
+        self.assertGreater(fewer, 300)  # most 0.6 m rays and many 2 m rays stay in one or two boxes
+
+    def test_every_shard_without_a_max_range_or_for_the_hash_rule(self):
+        o, d = (0.5, 0.5, 0.5), (1.0, 0.0, 0.0)
+        self.assertEqual(shards_for_rays(self.BOXES, o, d, -1.0, self.RES), [0, 1, 2, 3])
+        self.assertEqual(shards_for_rays(self.BOXES, o, d, float("inf"), self.RES), [0, 1, 2, 3])
+        self.assertEqual(shards_for_rays(self.BOXES, o, (0.0, 0.0, 0.0), 2.0, self.RES), [0, 1, 2, 3])
+        hashed = ShardSet(map_info_t.SHARD_RULE_HASH, 13, 3)
+        self.assertEqual(shards_for_rays(hashed, o, d, 0.5, self.RES), [0, 1, 2])
+        self.assertEqual(shards_for_rays(self.BOXES, o, d, 0.5, self.RES), [3])  # x, y > 0: the fourth box
 
 
 if __name__ == "__main__":

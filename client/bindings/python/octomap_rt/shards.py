@@ -9,6 +9,7 @@ stop at one voxel; a grid cell is the most of the shards' cells (occupied > free
 A shard that does not answer is named in the answer's `missing` (a partial answer), never left
 out silently."""
 
+import math
 import time
 from dataclasses import dataclass, field
 from typing import Dict, Optional
@@ -87,6 +88,62 @@ class ShardSet:
     def shard_of_key(self, key) -> int:
         s = TREE_DEPTH - self.region_depth
         return self.shard_of_region(key[0] >> s, key[1] >> s, key[2] >> s)
+
+
+def shards_meeting(s: ShardSet, lo, hi) -> list:
+    """The shards whose regions meet the key box lo .. hi (inclusive; shard_distance.cpp's shards_meeting)."""
+    if s.count == 1:
+        return [0]
+    shift = TREE_DEPTH - s.region_depth
+    top = (1 << TREE_DEPTH) - 1
+    lo = [min(max(int(v), 0), top) for v in lo]
+    hi = [min(max(int(v), 0), top) for v in hi]
+    if any(h < l for l, h in zip(lo, hi)):
+        return []
+    r0, r1 = [v >> shift for v in lo], [v >> shift for v in hi]
+    if s.rule == map_info_t.SHARD_RULE_BOXES:
+        return [i for i, b in enumerate(s.boxes) if all(r0[a] < b[3 + a] and r1[a] >= b[a] for a in range(3))]
+    met = {s.shard_of_region(x, y, z) for z in range(r0[2], r1[2] + 1) for y in range(r0[1], r1[1] + 1)
+           for x in range(r0[0], r1[0] + 1)}
+    return sorted(i for i in met if i < s.count)
+
+
+def shards_for_rays(s: ShardSet, origins, directions, max_range: float, resolution: float) -> list:
+    """The shards a batch of rays can reach (shard_rays.cpp's shards_for_rays): for the boxes rule with a
+    finite max range, the boxes meeting each ray's key box from its origin to past max_range (2 keys wider);
+    every shard otherwise (a hashed set's small regions meet every shard along a few metres)."""
+    import numpy as np
+
+    every = list(range(s.count))
+    if s.rule != map_info_t.SHARD_RULE_BOXES or not max_range > 0 or not math.isfinite(max_range):
+        return every
+    dirs = np.asarray(directions, dtype=np.float32).reshape(-1, 3).astype(np.float64)
+    orig = np.broadcast_to(np.asarray(origins, dtype=np.float32).reshape(-1, 3), dirs.shape).astype(np.float64)
+    asked = set()
+    for o, d in zip(orig, dirs):
+        norm = math.sqrt(float(d @ d))
+        if not norm > 0 or not math.isfinite(norm):
+            return every
+        lo, hi = [], []
+        for a in range(3):
+            k0 = _axis_key(o[a], resolution)
+            end = o[a] + d[a] / norm * (float(max_range) + 2 * resolution)  # castRay stops within a diagonal
+            if k0 is None or not math.isfinite(end):
+                return every
+            k1 = _axis_key(end, resolution)
+            if k1 is None:
+                k1 = 0 if end < 0 else (1 << TREE_DEPTH) - 1
+            lo.append(min(k0, k1) - 2)
+            hi.append(max(k0, k1) + 2)
+        asked.update(shards_meeting(s, lo, hi))
+    return sorted(asked) or [0]  # no ray: one shard answers the empty batch
+
+
+def _axis_key(c: float, resolution: float):
+    """shard_distance.cpp's voxel_key of one double coordinate: its key, or None outside the range."""
+    if not abs(c) < resolution * _KEY_ORIGIN:
+        return None
+    return int(math.floor((1.0 / resolution) * c)) + _KEY_ORIGIN
 
 
 def voxel_key(point, resolution: float):
@@ -204,12 +261,14 @@ class ShardClient:
         return ShardAnswer((occ, prob), a.missing)
 
     def cast_rays(self, origins, directions, max_range: float = -1.0, ignore_unknown: bool = False) -> ShardAnswer:
-        """(hit, end_state, end points) as MapClient.cast_rays: the one map's castRay answers."""
+        """(hit, end_state, end points) as MapClient.cast_rays: the one map's castRay answers, asked of
+        the shards the rays can reach (shards_for_rays)."""
         import numpy as np
 
         dirs = np.asarray(directions, dtype=np.float32).reshape(-1, 3)
         orig = np.broadcast_to(np.asarray(origins, dtype=np.float32).reshape(-1, 3), dirs.shape)
-        a = self._ask(range(self.set.count), lambda i, c: c.cast_rays(orig, dirs, max_range, ignore_unknown))
+        reach = shards_for_rays(self.set, orig, dirs, max_range, self.resolution)
+        a = self._ask(reach, lambda i, c: c.cast_rays(orig, dirs, max_range, ignore_unknown))
         n = len(dirs)
         hit, state, ends = np.zeros(n, dtype=bool), np.full(n, UNKNOWN, dtype=np.int8), np.zeros((n, 3), np.float32)
         for j in range(n):
