@@ -313,7 +313,7 @@ int main(int argc, char** argv) {
   for (int i = 0; i < journal_phases; ++i) {
     const double r = stream([](const std::atomic<bool>&) {});
     off_sum += r;
-    report("mapping, journal off", LatencyStats{}, r);
+    report("mapping unarmed", LatencyStats{}, r);
   }
   // Idle: one query at a time.
   LatencyStats idle_box, idle_points;
