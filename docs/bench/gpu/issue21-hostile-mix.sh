@@ -5,19 +5,19 @@
 # sends 100-point scans 400 m out from fresh robot ids; the robot's scans applied, the daemon's end-to-end
 # p50/p99 and how long each stop took, the same binary for both. Two calls, ~40-60 s each:
 #   now      the defaults (predicted cost charged when a scan is served, the shared class at 0.25
-#            of a robot's share, --max-scan-time 1);
+#            of a robot's share, round robin by producer id inside it, --max-scan-time 2);
 #   nobound  the same binary with --max-scan-time 0 --shared-class-share 1 (what is left of the
 #            share without the per-scan bound and the smaller shared class).
 # Every step is skipped, never cut, once its time is past (lib.sh's `left`); ~150 s in all.
 #   Here, after building octomap-rt-server octomap-rt octomap-rt-scenegen (and build/python, the
 #   generated Python types the hostile peers send with) in BUILD_DIR:
-#       docs/bench/gpu/issue21-hostile-mix.sh bundle BUILD_DIR      -> .device-bundle/bounds-s6
-#   There (carry [".device-bundle/bounds-s6"]), from the repository root:
+#       docs/bench/gpu/issue21-hostile-mix.sh bundle BUILD_DIR      -> .device-bundle/bounds-s7
+#   There (carry [".device-bundle/bounds-s7"]), from the repository root:
 #       docs/bench/gpu/issue21-hostile-mix.sh run
-#   The result, $OUT/bounds-s6.tar.gz: now.txt, nobound.txt (the bench's report), progress.txt,
+#   The result, $OUT/bounds-s7.tar.gz: now.txt, nobound.txt (the bench's report), progress.txt,
 #   machine.txt. The peers are Python (standard library only: octomap_rt's udpm transport).
 set -uo pipefail
-name=bounds-s6
+name=bounds-s7
 case "${1:-}" in
   bundle)
     set -e

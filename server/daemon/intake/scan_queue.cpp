@@ -132,6 +132,22 @@ ScanQueue::ShareClass* ScanQueue::next_class(SteadyClock::time_point now) {
   return best;
 }
 
+size_t ScanQueue::next_in_class(const ShareClass& c) const {
+  const auto shared = classes_.find(kNewProducersClass);
+  if (!fair_ || shared == classes_.end() || &shared->second != &c || shared_served_producer_ == SIZE_MAX) return 0;
+  // Round robin by producer id inside the shared class (from its oldest scan on): the next
+  // producer after the one served last, its oldest scan (the deque is in arrival order, so
+  // each producer's order is kept). Only scans older than the oldest edit: an edit still
+  // leaves before every scan that arrived after it.
+  const uint64_t before = edits_.empty() ? UINT64_MAX : edits_.front().arrival;
+  size_t best = 0, best_gap = SIZE_MAX;
+  for (size_t i = 0; i < c.scans.size() && c.scans[i].arrival < before; ++i) {
+    const size_t gap = c.scans[i].producer - shared_served_producer_ - 1;  // wraps: cyclic distance
+    if (gap < best_gap) best = i, best_gap = gap;
+  }
+  return best;
+}
+
 void ScanQueue::forget(const QueuedScan& s) {
   bytes_by_producer_[s.producer] -= s.bytes;
   depth_by_producer_[s.producer]--;
@@ -160,15 +176,16 @@ std::optional<QueuedScan> ScanQueue::pop() {
     // or the others stop streaming.
     ready_.wait_for(lock, std::chrono::milliseconds(50));
   }
+  const auto pick = c->scans.begin() + static_cast<std::ptrdiff_t>(next_in_class(*c));
   // Classes whose oldest scan arrived before the one served now lose this turn to their share.
   for (auto& [key, other] : classes_)
-    if (&other != c && !other.scans.empty() && other.scans.front().arrival < c->scans.front().arrival)
-      other.deferrals++;
+    if (&other != c && !other.scans.empty() && other.scans.front().arrival < pick->arrival) other.deferrals++;
   virtual_ms_ = c->used_ms;
   c->in_stages++;
   c->served = SteadyClock::now();
-  QueuedScan s = std::move(c->scans.front());
-  c->scans.pop_front();
+  QueuedScan s = std::move(*pick);
+  c->scans.erase(pick);
+  if (s.share_class == kNewProducersClass) shared_served_producer_ = s.producer;
   c->bytes -= s.bytes;
   s.passed_over = c->deferrals != s.deferrals_at_push;
   forget(s);

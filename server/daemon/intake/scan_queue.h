@@ -22,7 +22,9 @@
 // stage. fair = false: one FIFO.
 //
 // Order: each producer's scans leave in its arrival order (a producer that earns its history
-// takes its scans waiting in the shared class into its own, in order); across producers, by share. A map edit
+// takes its scans waiting in the shared class into its own, in order); across producers, by share;
+// inside the shared class, round robin by producer id (a new robot's first scans wait for one
+// scan of each other fresh id, not for every far scan queued before them). A map edit
 // leaves only after every scan that arrived before it, and before any that arrived after.
 //
 // Policy when a producer's budget is full: the NEWEST scan is refused (the caller counts it
@@ -136,6 +138,7 @@ class ScanQueue {
   // The class to serve next (least used; ties: oldest head), or nullptr when no scan may be.
   ShareClass* next_class(SteadyClock::time_point now);  // under mutex_
   ShareClass& class_named(size_t key);                  // under mutex_; made with its share
+  size_t next_in_class(const ShareClass& c) const;      // under mutex_: the index of the scan to serve
   bool streams(const ShareClass& c, SteadyClock::time_point now) const;
   bool empty_locked() const;
   bool others_stream(size_t producer, SteadyClock::time_point now) const;
@@ -154,7 +157,8 @@ class ScanQueue {
   size_t depth_ = 0;
   uint64_t total_bytes_ = 0;
   uint64_t next_arrival_ = 0;
-  double virtual_ms_ = 0;  // the used time of the class served last, when it was served
+  double virtual_ms_ = 0;                     // the used time of the class served last, when it was served
+  size_t shared_served_producer_ = SIZE_MAX;  // the producer whose scan the shared class served last
   uint64_t per_producer_budget_, total_budget_;
   bool fair_;
   double shared_class_share_;
