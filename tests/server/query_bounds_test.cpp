@@ -280,5 +280,28 @@ TEST(QueryBounds, AnIdleClientGivesItsSlotToANewOneAndTheTotalsStay) {
   EXPECT_EQ(clients.snapshot().size(), 4u);  // c, d, e and "~"
 }
 
+TEST(QueryBounds, ATurnOnAnOlderStateTakesOnlyTheClientsAnsweredFromNoNewerOne) {
+  // A query turn on the read replica at state 3: "a" was answered from state 5 (the map of
+  // record), so its query stays queued for a later turn; "b" (answered from 2) is served.
+  daemon::QueryClients clients(4, 8);
+  clients.received("a", "R", 0);
+  clients.received("b", "R", 0);
+  clients.answered_at("a", 5);
+  clients.answered_at("a", 4);  // never goes back
+  clients.answered_at("b", 2);
+  daemon::PendingQuery qa, qb;
+  qa.msg = octomap_rt::occupancy_query_t{};
+  qb.msg = octomap_rt::occupancy_query_t{};
+  ASSERT_TRUE(clients.push("a", std::move(qa)));
+  ASSERT_TRUE(clients.push("b", std::move(qb)));
+  EXPECT_EQ(clients.newest_answered("a"), 5u);
+  EXPECT_EQ(clients.oldest_answered_queued(), 2u);
+  ASSERT_TRUE(clients.pop(3).has_value());
+  EXPECT_FALSE(clients.pop(3).has_value()) << "a's query was taken by a turn older than its last answer";
+  EXPECT_EQ(clients.oldest_answered_queued(), 5u);
+  EXPECT_TRUE(clients.pop(5).has_value());
+  EXPECT_EQ(clients.queued(), 0u);
+}
+
 }  // namespace
 }  // namespace ort::test

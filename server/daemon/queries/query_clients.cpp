@@ -75,13 +75,13 @@ bool QueryClients::push(const std::string& client, PendingQuery&& q) {
   return true;
 }
 
-std::optional<PendingQuery> QueryClients::pop() {
+std::optional<PendingQuery> QueryClients::pop(uint64_t state) {
   std::lock_guard lock(mutex_);
   if (queued_ == 0) return std::nullopt;
   auto it = clients_.upper_bound(next_);
   for (size_t n = 0; n <= clients_.size(); ++n, ++it) {
     if (it == clients_.end()) it = clients_.begin();
-    if (!it->second.queue.empty()) {
+    if (!it->second.queue.empty() && it->second.newest_state <= state) {
       PendingQuery q = std::move(it->second.queue.front());
       it->second.queue.pop_front();
       --queued_;
@@ -90,6 +90,25 @@ std::optional<PendingQuery> QueryClients::pop() {
     }
   }
   return std::nullopt;
+}
+
+void QueryClients::answered_at(const std::string& client, uint64_t state) {
+  std::lock_guard lock(mutex_);
+  Client& c = at(client);
+  c.newest_state = std::max(c.newest_state, state);
+}
+
+uint64_t QueryClients::newest_answered(const std::string& client) {
+  std::lock_guard lock(mutex_);
+  return at(client).newest_state;
+}
+
+uint64_t QueryClients::oldest_answered_queued() const {
+  std::lock_guard lock(mutex_);
+  uint64_t oldest = UINT64_MAX;
+  for (const auto& [id, c] : clients_)
+    if (!c.queue.empty()) oldest = std::min(oldest, c.newest_state);
+  return oldest;
 }
 
 size_t QueryClients::queued() const {

@@ -63,8 +63,15 @@ class QueryClients {
   QueryClients(size_t per_client_queue, size_t max_clients, int64_t idle_expiry_us = int64_t(600) * 1'000'000);
   // Queues q for its client; false (counted busy) when that client's queue is full.
   bool push(const std::string& client, PendingQuery&& q);
-  // The next query, clients taken in turn; nullopt when none is queued.
-  std::optional<PendingQuery> pop();
+  // The next query, clients taken in turn, of a client whose newest answered map state is
+  // `state` or older (a turn on an older read replica leaves the others queued); nullopt
+  // when none is queued.
+  std::optional<PendingQuery> pop(uint64_t state = UINT64_MAX);
+  // Per client: the newest map state id it was answered from (answers never go back for it).
+  void answered_at(const std::string& client, uint64_t state);
+  uint64_t newest_answered(const std::string& client);
+  // The oldest of newest_answered over the clients with queued queries (UINT64_MAX: none).
+  uint64_t oldest_answered_queued() const;
   size_t queued() const;
 
   // A message with a usable address arrived from `client`, to be answered on `reply_channel`.
@@ -82,6 +89,7 @@ class QueryClients {
   struct Client {
     QueryClientStats stats;
     std::deque<PendingQuery> queue;
+    uint64_t newest_state = 0;
   };
   Client& at(const std::string& client);                                 // under mutex_
   size_t named_clients() const;                                          // under mutex_

@@ -248,6 +248,10 @@ bool QueryService::answer_locked(PendingQuery& q, std::vector<EncodedReplies>& o
   const MapStamp stamp{static_cast<int64_t>(map.version), map.last_scan_utime, static_cast<int64_t>(map.epoch)};
   // The robot id keys the wait: "" = no wait, whatever wait_seq holds (a default message
   // has wait_seq 0), so a plain query is never parked for a robot that does not exist.
+  // Never an older state for a client than one it was answered from (the map of record is
+  // never older than the replica): on an older replica it waits for a later turn.
+  if (&map != &map_ && map.version < clients_.newest_answered(h.client_id)) return false;
+  clients_.answered_at(h.client_id, map.version);
   const bool waits_for_scan = !h.wait_robot_id.empty();
   int64_t applied = -1;
   if (waits_for_scan) {
@@ -336,9 +340,12 @@ void QueryService::run() {
         lock = std::shared_lock(map_.mutex);
         turn_map_ = &map_;
       } else {
-        turn_map_ = &lock_for_short_read(map_, answered_version_, lock);
+        // The replica is new enough when some waiting client was answered from no newer state.
+        uint64_t min_version = clients_.oldest_answered_queued();
+        for (const PendingQuery& p : parked)
+          min_version = std::min(min_version, clients_.newest_answered(header_of(p.msg).client_id));
+        turn_map_ = &lock_for_short_read(map_, min_version == UINT64_MAX ? 0 : min_version, lock);
       }
-      answered_version_ = std::max(answered_version_, turn_map_->version);
       const MapHoldNote note(turn_map_->holders, "query turn");
       const auto turn_end = SteadyClock::now() + kReadTurn;
       for (size_t i = 0; i < parked.size();) {
@@ -350,7 +357,7 @@ void QueryService::run() {
         }
       }
       while (SteadyClock::now() < turn_end) {
-        auto q = clients_.pop();
+        auto q = clients_.pop(turn_map_ == &map_ ? UINT64_MAX : turn_map_->version);
         if (!q) break;
         if (answer_locked(*q, out)) continue;
         if (parked.size() < kMaxParked) {

@@ -94,9 +94,9 @@ class QueryService {
   std::vector<PendingQuery> to_restore_;
   bool exclusive_turn_ = false;
   // What a turn reads: the map of record, or the read replica while stage 2 holds the map
-  // (lock_for_short_read, daemon/map/map_replica.h); and the newest state answered from.
+  // (lock_for_short_read, daemon/map/map_replica.h); the newest state each client was
+  // answered from is kept per client (QueryClients::newest_answered).
   MapState* turn_map_ = nullptr;
-  uint64_t answered_version_ = 0;
   GridPublisher grids_;
   distance::SquaredEdt edt_;          // CPU threads or the device; used by the worker thread only
   distance::FieldCache field_cache_;  // the last distance field (distance/field_cache.h); the worker's
