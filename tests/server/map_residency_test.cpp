@@ -86,6 +86,48 @@ TEST(MapResidency, RestoresMakeRoomBeforeTheUpdate) {
   EXPECT_TRUE(d.maps_equal()) << d.differing_voxels << " voxels differ: " << d.first_difference;
 }
 
+// Scans that keep mapping the same place (32 wedges, twice: every region was touched by one of
+// the last 32 scans, all of them in use by the daemon's rule) under a bound just below their
+// map (1/1.05 of it): the map stays above the bound, within kHotOvershoot of it, and nothing
+// is evicted, so nothing comes back (before the rule a pass past the bound took regions in
+// use down to kLowWater and the next scans restored them); the map = OctoMap's.
+TEST(MapResidency, RegionsInUseStayWithinTheOvershoot) {
+  std::vector<VoxelList> lists = wedge_scans();
+  ASSERT_GE(lists.size(), 40u);
+  lists.resize(32);
+  octomap::OcTree unbounded(0.1);
+  OctreeStage stage(OctreeUpdateOptions{OctreeUpdateMode::kBatched, 2});
+  for (int pass = 0; pass < 2; ++pass)
+    for (const VoxelList& l : lists) stage.apply(unbounded, l);
+  const auto bound = static_cast<uint64_t>(double(unbounded.memoryUsage()) / 1.05);
+
+  daemon::MapState map;
+  map.tree = std::make_unique<octomap::OcTree>(0.1);
+  MemorySpill spill;
+  const RegionGrid grid = region_grid(daemon::evict_region_depth(test_config(0.1, true)));
+  std::ostringstream log;
+  daemon::MapResidency residency(map, grid, spill, bound, Log(log));
+  uint64_t most = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const VoxelList& l : lists) {
+      std::string error;
+      ASSERT_TRUE(residency.touch_scan(*map.tree, l, error)) << error;
+      stage.apply(*map.tree, l);
+      residency.enforce(*map.tree);
+      most = std::max<uint64_t>(most, map.tree->memoryUsage());
+    }
+  }
+  const daemon::MapResidencyStats st = residency.stats();
+  EXPECT_GT(most, bound) << "the map must pass the bound for the rule to matter";
+  EXPECT_LE(double(most), daemon::MapResidency::kHotOvershoot * double(bound))
+      << double(most) / double(bound) << " of the bound";
+  EXPECT_EQ(st.evictions, 0u) << "regions in use were evicted";
+  EXPECT_EQ(st.restores, 0u) << "regions in use went back and forth";
+  EXPECT_GT(st.hot_overshoots, 0u) << "the passes above the bound are counted";
+  const TreeDiff d = compare_leaves(*map.tree, unbounded);
+  EXPECT_TRUE(d.maps_equal()) << d.differing_voxels << " voxels differ: " << d.first_difference;
+}
+
 // A query's restores (daemon/queries: touch_boxes, then the answer, then the bound enforced)
 // make room first too (4 m boxes about each wedge's middle voxel, a bound 3/4 of the map):
 // right after its restores nothing the query reads is evicted though the pass may have taken

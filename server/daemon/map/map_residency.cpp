@@ -90,7 +90,7 @@ std::string residency_cost_line(const MapResidencyStats& a, const MapResidencySt
       "list %.1f, encode %.1f, store write %.1f, strip %.1f); %llu restores in %.1f ms (most %.1f ms a "
       "scan; store read %.1f, rebuild %.1f); exact counts recounted %llu regions, reused %llu; off stage: "
       "sizing %.1f ms, waits for the writer %.1f ms, %llu restores from kept nodes; sweeps over the store: %llu "
-      "steps owed, %llu regions deleted unread",
+      "steps owed, %llu regions deleted unread; %llu passes left the map above the bound (its regions in use)",
       (unsigned long long)(b.enforce_passes - a.enforce_passes), (unsigned long long)(b.evictions - a.evictions),
       b.enforce_ms - a.enforce_ms, b.max_enforce_ms, b.walk_ms - a.walk_ms, y.list_ms - x.list_ms,
       y.encode_ms - x.encode_ms, y.put_ms - x.put_ms, y.strip_ms - x.strip_ms,
@@ -98,7 +98,8 @@ std::string residency_cost_line(const MapResidencyStats& a, const MapResidencySt
       y.rebuild_ms - x.rebuild_ms, (unsigned long long)(b.regions_recounted - a.regions_recounted),
       (unsigned long long)(b.regions_reused - a.regions_reused), y.size_ms - x.size_ms,
       y.write_wait_ms - x.write_wait_ms, (unsigned long long)(y.reattached - x.reattached),
-      (unsigned long long)(b.steps_owed - a.steps_owed), (unsigned long long)(b.dropped - a.dropped));
+      (unsigned long long)(b.steps_owed - a.steps_owed), (unsigned long long)(b.dropped - a.dropped),
+      (unsigned long long)(b.hot_overshoots - a.hot_overshoots));
   return line;
 }
 
@@ -222,9 +223,26 @@ void MapResidency::enforce_locked(octomap::OcTree& tree, bool exact) {
   }
   if (bytes > soft) {
     const uint64_t before = residency_.stats().evictions;
-    EnforceResult r;
+    size_t listed = 0, regions = 0;
     try {
-      r = residency_.enforce(tree, bytes, groups == 1 ? soft : target, groups, kSliceMs, groups == 1 ? kSoftIdle : 0);
+      // Idle groups first, whichever side of the bound (to the low-water mark past it).
+      const EnforceResult idle =
+          residency_.enforce(tree, bytes, groups == 1 ? soft : target, groups, kSliceMs, kSoftIdle);
+      listed = idle.listed;
+      regions = idle.regions;
+      const uint64_t left = bytes - std::min(bytes, idle.bytes_freed);
+      const auto cap = static_cast<uint64_t>(kHotOvershoot * static_cast<double>(max_bytes_));
+      if (groups != 1 && left > cap) {
+        // Past the overshoot the regions in use go too, but only back to the bound itself.
+        const EnforceResult hot = residency_.enforce(tree, left, max_bytes_);
+        if (hot.listed) {  // listed after the idle groups went
+          listed = hot.listed;
+          regions = hot.regions;
+        }
+      } else if (groups != 1 && left > max_bytes_) {
+        std::lock_guard s(stats_mutex_);
+        stats_.hot_overshoots++;  // everything left above the bound is in use: it stays
+      }
     } catch (const std::exception& e) {  // the store refused a put: that region stays here
       std::lock_guard s(stats_mutex_);
       if (stats_.evict_failures++ == 0 || stats_.evict_failures % 1000 == 0)
@@ -232,7 +250,7 @@ void MapResidency::enforce_locked(octomap::OcTree& tree, bool exact) {
                           " so far; the map stays whole in memory, above --max-map-memory): ", e.what()));
       stats_.last_error = std::string("evict: ") + e.what();
     }
-    if (r.listed) resident_regions_ = r.listed - r.regions;
+    if (listed) resident_regions_ = listed - regions;
     if (residency_.stats().evictions != before) count_residency_change();
   }
   publish_stats(tree);

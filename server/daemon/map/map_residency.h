@@ -51,7 +51,8 @@ struct MapResidencyStats {
   uint64_t steps_owed = 0, dropped = 0;             // over the run: sweeps' steps kept, regions deleted unread
   uint64_t owed_now = 0;                            // steps kept now
   uint64_t evict_failures = 0, restore_failures = 0;
-  std::string last_error;  // the store's last refusal ("" if none)
+  uint64_t hot_overshoots = 0;  // passes past the bound that left it above (every region left was in use)
+  std::string last_error;       // the store's last refusal ("" if none)
   // Where the time goes, over the run (ms): the passes that evict, the exact memory walks
   // they start with, the scans' restores, and the octree layer's parts of both.
   uint64_t enforce_passes = 0;
@@ -82,6 +83,11 @@ class MapResidency {
   // changes go: spilling what the robots are mapping only to bring it back a scan later is
   // all cost and no room (the bound itself is enforced whatever the regions' age).
   static constexpr uint64_t kSoftIdle = 64;
+  // Past the bound the idle groups go first; when only regions in use are left the map stays
+  // above the bound, up to kHotOvershoot of it, rather than spill what the next scans bring
+  // back (the soak's ping-pong, docs/BENCHMARKS.md 'Memory bound'); past that they go too,
+  // back to the bound.
+  static constexpr double kHotOvershoot = 1.10;
   // How often the cost breakdown is logged while regions move.
   static constexpr double kCostReportS = 10;
 
