@@ -39,6 +39,19 @@ TEST(SlowestScans, KeepsTheSlowestEndToEndSlowestFirstWithTheirPlaceInTheRun) {
   EXPECT_EQ(s[2].applied_index, 8);
 }
 
+// Round robin in the shared class applies scans out of arrival order across producers: the
+// times stay from the earliest receipt, never negative.
+TEST(SlowestScans, ScansAppliedOutOfArrivalOrderCountFromTheEarliestReceipt) {
+  const auto start = SteadyClock::now();
+  SlowestScans kept(3);
+  kept.add(timing(start, 30.0, 5.0, 1));  // arrived second, applied first
+  kept.add(timing(start, 10.0, 4.0, 0));
+  const auto s = kept.slowest();
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_NEAR(s[0].received_s, 0.020, 1e-9);
+  EXPECT_NEAR(s[1].received_s, 0.0, 1e-9);
+}
+
 TEST(SlowestScans, FewerScansThanKeptAreAllListed) {
   const auto start = SteadyClock::now();
   SlowestScans kept(5);

@@ -137,7 +137,9 @@ TEST(ServerMemq, CraftedBadMessagesAreCountedAndServingGoesOn) {
 }
 
 // Three producers publishing at once; the map must equal MapEngine applied sequentially in
-// the order the server recorded, and that order must be the arrival order.
+// the order the server recorded. That order holds every published scan once, each producer's
+// in its publish order; across producers it may differ from the arrival order (fresh ids share
+// one class, served round robin: ScanQueue.InsideTheSharedClassProducersTakeTurns).
 void run_three_producers(bool pipelined) {
   const auto scans = robot_scans(3, 4, 8);
   lcm::LCM lc("memq://");
@@ -174,7 +176,13 @@ void run_three_producers(bool pipelined) {
     EXPECT_EQ(p.missed, 0);
   }
   const auto order = server.applied_order();
-  EXPECT_EQ(order, published) << "scans must be applied in arrival order";
+  ASSERT_EQ(order.size(), published.size());
+  const auto per_producer = [](const std::vector<daemon::AppliedEntry>& entries) {
+    std::map<std::string, std::vector<int64_t>> seqs;
+    for (const auto& e : entries) seqs[e.robot_id].push_back(e.seq);
+    return seqs;
+  };
+  EXPECT_EQ(per_producer(order), per_producer(published)) << "each producer's scans must be applied once, in its order";
 
   auto ref = engine_reference(cfg, order, [&](const std::string& robot, int64_t seq) -> const PosedScan& {
     return scans.at(robot).at(static_cast<size_t>(seq));

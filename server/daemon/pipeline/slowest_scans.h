@@ -16,7 +16,7 @@ namespace ort::daemon {
 
 struct SlowScan {
   int64_t applied_index = 0;  // 1 = the first scan the daemon applied
-  double received_s = 0;      // receipt, seconds after the first scan's receipt
+  double received_s = 0;      // receipt, seconds after the earliest receipt of an applied scan
   AppliedTiming timing;
 };
 
@@ -25,8 +25,10 @@ class SlowestScans {
   explicit SlowestScans(size_t kept = 5) : kept_(kept) {}
   // Every applied scan, in applied order.
   void add(const AppliedTiming& t);
-  // The kept scans, slowest first (end to end).
-  const std::vector<SlowScan>& slowest() const { return slowest_; }
+  // The kept scans, slowest first (end to end), each received_s from the earliest receipt of
+  // all applied so far: across producers scans may be applied out of arrival order (round
+  // robin in the shared class), so the first applied need not have come first.
+  std::vector<SlowScan> slowest() const;
 
  private:
   size_t kept_;
