@@ -1,36 +1,18 @@
 #include "distance/squared_edt.h"
 
 #include <algorithm>
-#include <atomic>
 #include <stdexcept>
-#include <thread>
 #include <vector>
+
+#include "distance/parallel_lines.h"
 
 namespace ort::distance {
 namespace {
 
 int64_t floor_div(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
-// Runs body(line) for line in [0, lines) on `threads` workers (the caller is one of them).
-template <class Body>
-void parallel_lines(int64_t lines, int threads, Body&& body) {
-  const int workers = static_cast<int>(std::clamp<int64_t>(threads, 1, std::max<int64_t>(1, lines / 16)));
-  std::atomic<int64_t> next{0};
-  constexpr int64_t kBatch = 16;
-  auto work = [&] {
-    for (;;) {
-      const int64_t first = next.fetch_add(kBatch);
-      if (first >= lines) return;
-      for (int64_t l = first; l < std::min(lines, first + kBatch); ++l) body(l);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int w = 1; w < workers; ++w) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
-}
+}  // namespace
 
-// Pass x: squared distance to the nearest obstacle of the row (two sweeps).
 void row_pass(const uint8_t* occ, int n, uint32_t* out) {
   constexpr int64_t kFar = int64_t(1) << 40;
   int64_t last = -kFar;
@@ -46,8 +28,6 @@ void row_pass(const uint8_t* occ, int n, uint32_t* out) {
     if (d < kMaxGridAxis) out[x] = std::min(out[x], static_cast<uint32_t>(d * d));
   }
 }
-
-}  // namespace
 
 void envelope_1d(const uint32_t* f, int n, uint32_t* d, int32_t* v, int32_t* z) {
   // v[0..k]: the sites of the lower envelope; site v[j] is lowest on [z[j], z[j+1]).

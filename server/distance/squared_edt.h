@@ -15,6 +15,10 @@ namespace ort::distance {
 // `threads` >= 1 workers split each pass's rows; the result does not depend on it.
 void squared_edt(std::span<const uint8_t> occupied, GridDims dims, std::span<uint32_t> out, int threads);
 
+// The 1-D pass of x on one row of n cells: out[x] = squared distance to the row's nearest
+// obstacle (kNoObstacle without one).
+void row_pass(const uint8_t* occ, int n, uint32_t* out);
+
 // The 1-D pass of y and z on one line of n values (kNoObstacle = no site): d[x] =
 // min_q (x - q)^2 + f[q]. `v` and `z` are scratch of n ints each. f and d may not alias.
 void envelope_1d(const uint32_t* f, int n, uint32_t* d, int32_t* v, int32_t* z);
