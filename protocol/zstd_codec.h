@@ -15,8 +15,9 @@ struct CodecError : std::runtime_error {
 
 // level: zstd's 1 (fast) .. 19 (small); values outside are clamped by zstd.
 std::string zstd_compress(std::string_view raw, int level);
-// Refuses (CodecError) a frame whose content size is unknown, above `max_size` or not
-// what it decompresses to, and any corrupt frame.
+// One frame or several concatenated (decompressed one after the other). Refuses (CodecError)
+// frames whose content sizes are unknown, sum above `max_size` or are not what they
+// decompress to, and any corrupt frame.
 std::string zstd_decompress(std::string_view compressed, size_t max_size);
 
 }  // namespace ort::protocol

@@ -43,6 +43,16 @@ struct FieldCacheStats {
   int64_t patch_changes = 0;  // the cell changes those patches carried
   int64_t reread = 0;         // updates from a grid read from the map again
   int64_t replies_kept = 0;   // box replies sent the bytes kept from the last one (field unchanged)
+  int64_t frames = 0;         // zstd frames (z-slabs) of the box replies made again
+  int64_t frames_kept = 0;    // of those, kept from the last reply (the slab's bytes unchanged)
+};
+
+// A box reply's frames as last made (daemon/queries/box_frames.h): per frame its bytes before
+// and after compression, under the key of the box and options they were made for. Correct
+// whatever the field did since: a frame is reused only where its bytes are equal.
+struct KeptFrames {
+  std::string key;
+  std::vector<std::string> raw, packed;
 };
 
 // The cells [lo, hi] (inclusive, per axis) of a grid, in its own index space: where a grid
@@ -109,6 +119,10 @@ class FieldCache {
   }
   const Memo& keep_memo(Memo m) { return memo_.emplace(std::move(m)); }
 
+  // The frames of the last box reply made from this cache's field; counted in stats().
+  KeptFrames& kept_frames() { return frames_; }
+  void count_frames(int64_t made, int64_t kept) { stats_.frames += made, stats_.frames_kept += kept; }
+
   const FieldCacheStats& stats() const { return stats_; }
 
  private:
@@ -142,6 +156,7 @@ class FieldCache {
   Key pending_key_;
   uint64_t pending_version_ = 0;
   std::optional<Memo> memo_;
+  KeptFrames frames_;
   FieldCacheStats stats_;
 };
 

@@ -50,6 +50,7 @@ file(GLOB FUZZ_QUERY_CORE ${CMAKE_SOURCE_DIR}/server/query/*.cpp ${CMAKE_SOURCE_
 octomap_rt_add_fuzz_target(fuzz_query_message
   SOURCES ${CMAKE_SOURCE_DIR}/protocol/inbound_checks.cpp ${CMAKE_SOURCE_DIR}/server/daemon/queries/query_answers.cpp
           ${CMAKE_SOURCE_DIR}/server/daemon/queries/distance_answers.cpp ${CMAKE_SOURCE_DIR}/protocol/shards/shard_set.cpp
+          ${CMAKE_SOURCE_DIR}/server/daemon/queries/box_frames.cpp
           ${CMAKE_SOURCE_DIR}/server/daemon/queries/field_patch.cpp ${CMAKE_SOURCE_DIR}/server/daemon/map/change_journal.cpp
           ${CMAKE_SOURCE_DIR}/server/octree/batched/morton_order.cpp
           ${CMAKE_SOURCE_DIR}/protocol/channels.cpp

@@ -90,6 +90,10 @@ octomap_rt_add_test(server_shard_ray_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/shar
 # Issues 26 + 27: distances across shards, merged as the shard client merges them, equal one daemon's.
 octomap_rt_add_test(server_shard_distance_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/shard_distance_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon octomap_rt_shard_client TIMEOUT 120)
+# Issue 27: a distance box's blob by z-slabs, the unchanged slabs' frames kept (real data).
+octomap_rt_add_test(server_box_frames_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/box_frames_test.cpp
+                    $<TARGET_OBJECTS:octomap_rt_query_test_maps> LIBS octomap_rt_daemon TIMEOUT 120)
+set_property(TEST server_box_frames_test APPEND PROPERTY LABELS data)
 # Issue 27: the distance field cache kept from the map's change lists while a robot explores (real data).
 octomap_rt_add_test(server_distance_journal_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/distance_journal_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)

@@ -140,14 +140,16 @@ int main(int argc, char** argv) {
     const ort::distance::FieldCacheStats c = server.distance_cache_stats();
     std::printf(
         "  field cache (%s): %lld from change lists (%lld cell changes), %lld box reads; %lld unchanged, %lld partial "
-        "(%.0f cells each), %lld whole; %lld replies' bytes kept\n",
+        "(%.0f cells each), %lld whole; %lld replies' bytes kept; of the replies made again, %lld of %lld z-slab "
+        "frames kept\n",
         phase, (long long)(c.patched - cache_before.patched), (long long)(c.patch_changes - cache_before.patch_changes),
         (long long)(c.reread - cache_before.reread), (long long)(c.unchanged - cache_before.unchanged),
         (long long)(c.partial - cache_before.partial),
         c.partial > cache_before.partial
             ? double(c.partial_cells - cache_before.partial_cells) / double(c.partial - cache_before.partial)
             : 0.0,
-        (long long)(c.full - cache_before.full), (long long)(c.replies_kept - cache_before.replies_kept));
+        (long long)(c.full - cache_before.full), (long long)(c.replies_kept - cache_before.replies_kept),
+        (long long)(c.frames_kept - cache_before.frames_kept), (long long)(c.frames - cache_before.frames));
     cache_before = c;
     // Stage 2's time in the journal (its applied(): the scans' class changes classified and kept).
     if (const auto j = server.change_journal_stats()) {
@@ -234,6 +236,12 @@ int main(int argc, char** argv) {
         cfg.queries.distance.threads, cfg.queries.distance.zstd_level, rt.read_ms, rt.whole_ms, rt.cached_ms,
         rt.clamp_ms, rt.zstd_ms, (long long)rt.blob_bytes, (long long)rt.raw_bytes, (long long)rt.chunks);
     std::printf("  zstd levels on the box's bytes:%s\n", rt.levels.c_str());
+    std::printf(
+        "  by z-slabs (%lld frames, %d threads, %lld bytes): cut, clamped and compressed %.2f ms (the two stages "
+        "above take %.2fx that); again with the frames kept (%lld of them), cut and clamped %.2f ms\n",
+        (long long)rt.slab_frames, cfg.queries.distance.threads, (long long)rt.slab_blob_bytes, rt.slabs_made_ms,
+        rt.slabs_made_ms > 0 ? (rt.clamp_ms + rt.zstd_ms) / rt.slabs_made_ms : 0.0, (long long)rt.slab_frames_kept,
+        rt.slabs_kept_ms);
   }
 
   std::mt19937 rng(27);

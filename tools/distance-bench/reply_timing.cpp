@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/clock.h"
+#include "daemon/queries/box_frames.h"
 #include "daemon/queries/distance_answers.h"
 #include "distance/squared_edt.h"
 #include "octomap_rt/distance_box_chunk_t.hpp"
@@ -71,6 +72,19 @@ ReplyTimes time_box_reply(const octomap::OcTree& tree, const double lo[3], const
     zstd.push_back(ms_since(t0));
   }
   t.clamp_ms = median(clamp), t.zstd_ms = median(zstd);
+  std::vector<double> made, kept_ms;
+  for (int r = 0; r < std::max(1, reps); ++r) {
+    distance::KeptFrames kept;
+    auto t0 = SteadyClock::now();
+    const daemon::BoxBlob first = daemon::box_blob(br, f, false, zstd_level, threads, "box", &kept);
+    made.push_back(ms_since(t0));
+    t0 = SteadyClock::now();
+    const daemon::BoxBlob again = daemon::box_blob(br, f, false, zstd_level, threads, "box", &kept);
+    kept_ms.push_back(ms_since(t0));
+    t.slab_frames = first.frames, t.slab_frames_kept = again.frames_kept;
+    t.slab_blob_bytes = int64_t(first.bytes.size());
+  }
+  t.slabs_made_ms = median(made), t.slabs_kept_ms = median(kept_ms);
   // zstd's levels on the same bytes: what --distance-zstd-level trades.
   const distance::BoxDistances b = distance::answer_box(br, f, false);
   const std::string_view raw(reinterpret_cast<const char*>(b.squared.data()), b.squared.size() * 4);

@@ -20,6 +20,10 @@ struct ReplyTimes {
   double cached_ms = 0;  // its finish from the cache, the grid unchanged (the diff, the clamp, encoding)
   double clamp_ms = 0;   // of those: the box cut out of the field, clamped
   double zstd_ms = 0;    // and its bytes copied and compressed
+  // The same by z-slabs on the distance threads (daemon/queries/box_frames.h): every frame
+  // made, and every frame kept from the last blob (the clamp alone), with the frames' count.
+  double slabs_made_ms = 0, slabs_kept_ms = 0;
+  int64_t slab_frames = 0, slab_frames_kept = 0, slab_blob_bytes = 0;
   int64_t blob_bytes = 0, raw_bytes = 0;
   int64_t chunks = 0;
   std::string levels;  // "LEVEL: MS ms BYTES B;" per zstd level tried on the same bytes

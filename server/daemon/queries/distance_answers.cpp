@@ -5,6 +5,7 @@
 #include <memory>
 #include <string_view>
 
+#include "daemon/queries/box_frames.h"
 #include "daemon/queries/field_patch.h"
 #include "octomap_rt/distance_box_chunk_t.hpp"
 #include "octomap_rt/distance_path_reply_t.hpp"
@@ -107,30 +108,6 @@ void path_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const st
   out.messages.push_back(encode_message(r));
 }
 
-// A box's reply bytes: the field cut to the box and clamped, then compressed.
-struct BoxBlob {
-  std::string bytes;
-  int64_t raw_size = 0;
-};
-BoxBlob box_blob(const distance::BoxRead& read, const distance::DistanceField* f, const distance::SquaredEdt& edt,
-                 bool with_gradient, int zstd_level) {
-  const auto b = f ? distance::answer_box(read, *f, with_gradient) : distance::answer_box(read, edt, with_gradient);
-  // Little-endian hosts only (x86-64, arm64). Without the gradient the distances are the blob's
-  // bytes as they are (no copy); an empty part is not copied: memcpy from an empty vector's null
-  // data() is undefined even for 0 bytes.
-  std::string joined;
-  if (!b.gradient.empty()) {
-    joined.resize(b.squared.size() * 4 + b.gradient.size() * 4);
-    if (!b.squared.empty()) std::memcpy(joined.data(), b.squared.data(), b.squared.size() * 4);
-    std::memcpy(joined.data() + b.squared.size() * 4, b.gradient.data(), b.gradient.size() * 4);
-  }
-  const std::string_view raw =
-      b.gradient.empty() ? std::string_view(reinterpret_cast<const char*>(b.squared.data()), b.squared.size() * 4)
-                         : std::string_view(joined);
-  return BoxBlob{zstd_level != 0 ? protocol::zstd_compress(raw, zstd_level) : std::string(raw),
-                 static_cast<int64_t>(raw.size())};
-}
-
 void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std::string& id, distance::BoxRead& read,
                const distance::SquaredEdt& edt, const DistanceServiceConfig& cfg, distance::FieldCache* cache,
                const CacheUse& use) {
@@ -149,8 +126,16 @@ void box_reply(EncodedReplies& out, const Query& q, const MapStamp& s, const std
   BoxBlob made;
   const distance::FieldCache::Memo* kept = f ? cache->memo(key) : nullptr;
   if (!kept) {
-    made = box_blob(read, f, edt, gradient, cfg.zstd_level);
-    if (f) kept = &cache->keep_memo(distance::FieldCache::Memo{key, std::move(made.bytes), made.raw_size});
+    // Made again: per z-slab, the slabs whose bytes did not change keep their frames (box_frames.h).
+    if (f) {
+      made =
+          box_blob(read, *f, gradient, cfg.zstd_level, cfg.threads, key, &cache->kept_frames(), cfg.reply_slab_cells);
+      cache->count_frames(made.frames, made.frames_kept);
+      kept = &cache->keep_memo(distance::FieldCache::Memo{key, std::move(made.bytes), made.raw_size});
+    } else {
+      const auto whole = distance::compute_field(read.grid, edt, read.resolution, read.opt);
+      made = box_blob(read, whole, gradient, cfg.zstd_level, cfg.threads, key, nullptr, cfg.reply_slab_cells);
+    }
   }
   const std::string& blob = kept ? kept->bytes : made.bytes;
   const int64_t raw_size = kept ? kept->raw_size : made.raw_size;

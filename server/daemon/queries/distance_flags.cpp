@@ -16,6 +16,12 @@ void add_distance_flags(CLI::App& app, DistanceServiceConfig& d) {
                  "less time, more bytes); 0: sent uncompressed (COMPRESSION_NONE: more chunks)")
       ->check(CLI::Range(-50, 19))
       ->capture_default_str();
+  app.add_option("--distance-slab-cells", d.reply_slab_cells,
+                 "cells of a distance box reply's z-slab (whole layers): slabs cut, clamped and compressed apart on "
+                 "the distance threads, an unchanged slab's frame kept from the last reply; 0: the whole box one zstd "
+                 "frame (two with the gradient) made on one thread (the same bytes once decompressed)")
+      ->check(CLI::Range(int64_t(0), int64_t(1) << 32))
+      ->capture_default_str();
   app.add_option("--distance-field-cache", d.field_cache,
                  "keep the last distance field and transform again only where its grid changed (the same answer)")
       ->capture_default_str();

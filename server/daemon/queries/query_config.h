@@ -43,7 +43,10 @@ struct DistanceServiceConfig {
   distance::DistanceLimits limits{.max_grid_cells = 16'000'000, .max_box_cells = 4'000'000};
   int64_t max_reply_bytes = 16 << 20;  // compressed box blob; larger is refused as too large
   int zstd_level = 1;                  // 1..19; negative: zstd's fast levels (same frames); 0: none
-  bool field_cache = true;             // keep the last field for the next query (distance/field_cache.h)
+  // Cells of a box reply's z-slab (box_frames.h's kSlabCells): slabs compressed apart on the
+  // EDT's threads, an unchanged slab's frame kept; 0: the box one frame on one thread.
+  int64_t reply_slab_cells = 65536;
+  bool field_cache = true;  // keep the last field for the next query (distance/field_cache.h)
   // Bring the cached field's grid up to date from the scans' change lists
   // (daemon/map/change_journal.h) instead of reading its box from the map again.
   bool change_lists = true;

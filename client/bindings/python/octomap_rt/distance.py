@@ -40,6 +40,21 @@ def distance_points(q: QueryChannel, points, max_distance: float = 2.0, unknown_
     return d, (np.asarray(grad, dtype=np.float32).reshape(-1, 3) if gradient else None)
 
 
+def _zstd_frames(zstandard, blob: bytes, size: int) -> bytes:
+    """A box's blob: zstd frames (one per z-slab) concatenated, decompressed one after the other."""
+    out, rest = [], blob
+    while rest:
+        d = zstandard.ZstdDecompressor().decompressobj()
+        out.append(d.decompress(rest))
+        rest = d.unused_data
+        if sum(map(len, out)) > size:
+            raise QueryError(f"distance box: frames decompress past {size} bytes")
+    raw = b"".join(out)
+    if len(raw) != size:
+        raise QueryError(f"distance box: {len(raw)} bytes decompressed, {size} declared")
+    return raw
+
+
 def distance_box(q: QueryChannel, box_min, box_max, max_distance: float = 2.0, unknown_occupied: bool = False,
                  gradient: bool = False, cell_voxels: int = 1, min_snapshot_id: int = 0):
     """The dense field of a box: a dict with 'distance' float32 [z, y, x] (metres, clamped),
@@ -61,7 +76,7 @@ def distance_box(q: QueryChannel, box_min, box_max, max_distance: float = 2.0, u
         raise QueryError("distance box: blob hash differs")
     raw = bytes(blob)
     if first.compression == distance_box_chunk_t.COMPRESSION_ZSTD:
-        raw = zstandard.ZstdDecompressor().decompress(raw, max_output_size=first.uncompressed_size)
+        raw = _zstd_frames(zstandard, raw, first.uncompressed_size)
     nx, ny, nz = first.size
     cells = nx * ny * nz
     sq = np.frombuffer(raw, dtype="<u4", count=cells).reshape(nz, ny, nx)
