@@ -18,8 +18,9 @@
 // will have once the updates of the reads so far ran (pending()).
 //
 // One entry (the grid and its field: 5 bytes a cell; the daemon caches boxes of at most
-// DistanceLimits::single_grid_cells padded cells, 40 MB at its default); not thread-safe: the
-// query worker is its only user.
+// DistanceLimits::single_grid_cells padded cells, 40 MB at its default) and the last box
+// reply's frames (KeptFrames: 4 bytes a box cell, 16 with the gradient, and their compressed
+// bytes); not thread-safe: the query worker is its only user.
 #pragma once
 
 #include <array>

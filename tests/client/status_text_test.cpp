@@ -218,6 +218,26 @@ TEST(StatusText, ShowsWhatTheMemoryBoundCosts) {
     EXPECT_NE(json.find(field), std::string::npos) << field << " in " << json;
 }
 
+TEST(StatusText, TheDistanceFieldCacheLineOnlyOnceItWorked) {
+  octomap_rt::server_status_t s = example_status();
+  EXPECT_EQ(format_status(s, s.utime).find("  distance  "), std::string::npos) << "no distance queries, no line";
+  s.queries_received = 1300;  // the line is among the queries' (none: "none yet", no distance line)
+  s.distance_fields_whole = 3, s.distance_fields_partial = 5, s.distance_fields_unchanged = 1200;
+  s.distance_patched = 1190, s.distance_patch_changes = 43210, s.distance_reread = 18;
+  s.distance_replies_kept = 1100, s.distance_frames = 240, s.distance_frames_kept = 97;
+  const std::string text = format_status(s, s.utime);
+  EXPECT_NE(text.find("  distance  fields 1,208: 3 whole, 5 partial, 1,200 unchanged (1,190 from change lists of "
+                      "43,210 cells, 18 boxes read again); replies 1,100 resent, frames 97 of 240 kept\n"),
+            std::string::npos)
+      << text;
+  const std::string json = status_json(s);
+  for (const char* field :
+       {"\"distance_fields_whole\":3", "\"distance_fields_partial\":5", "\"distance_fields_unchanged\":1200",
+        "\"distance_patched\":1190", "\"distance_patch_changes\":43210", "\"distance_reread\":18",
+        "\"distance_replies_kept\":1100", "\"distance_frames\":240", "\"distance_frames_kept\":97"})
+    EXPECT_NE(json.find(field), std::string::npos) << field << " in " << json;
+}
+
 TEST(StatusJson, EveryFieldAndEscapedStrings) {
   const std::string json = status_json(example_status());
   EXPECT_EQ(json.front(), '{');

@@ -136,6 +136,17 @@ void queries(std::ostringstream& o, const Status& s, int64_t now) {
       o << (i ? ", " : " ") << s.query_refusal_reason[i] << " " << with_commas(s.query_refusal_count[i]);
     o << "\n";
   }
+  // The distance field cache: what the distance queries' fields and box replies cost.
+  const int64_t fields = s.distance_fields_whole + s.distance_fields_partial + s.distance_fields_unchanged;
+  if (fields > 0)
+    o << fmt(
+        "  distance  fields %s: %s whole, %s partial, %s unchanged (%s from change lists of %s cells, %s boxes "
+        "read again); replies %s resent, frames %s of %s kept\n",
+        with_commas(fields).c_str(), with_commas(s.distance_fields_whole).c_str(),
+        with_commas(s.distance_fields_partial).c_str(), with_commas(s.distance_fields_unchanged).c_str(),
+        with_commas(s.distance_patched).c_str(), with_commas(s.distance_patch_changes).c_str(),
+        with_commas(s.distance_reread).c_str(), with_commas(s.distance_replies_kept).c_str(),
+        with_commas(s.distance_frames_kept).c_str(), with_commas(s.distance_frames).c_str());
   if (s.query_clients.empty()) return;
   o << fmt("\n  %-16s %9s %9s %6s %7s %9s %7s %6s %10s  %s\n", "query client", "received", "answered", "bad", "busy",
            "not ready", "dropped", "queued", "last", "reply channel");

@@ -149,6 +149,16 @@ octomap_rt::server_status_t make_status(const StatusInputs& in) {
   s.evict_ms_max = in.evict_ms_max;
   s.restore_ms = in.restore_ms;
   s.restore_ms_max = in.restore_ms_max;
+  const distance::FieldCacheStats& fc = in.queries.field_cache;
+  s.distance_fields_whole = fc.full;
+  s.distance_fields_partial = fc.partial;
+  s.distance_fields_unchanged = fc.unchanged;
+  s.distance_patched = fc.patched;
+  s.distance_patch_changes = fc.patch_changes;
+  s.distance_reread = fc.reread;
+  s.distance_replies_kept = fc.replies_kept;
+  s.distance_frames = fc.frames;
+  s.distance_frames_kept = fc.frames_kept;
   s.map_saves = in.map_saves;
   s.last_save_utime = in.last_save_utime;
   s.latest_snapshot_id = in.latest_snapshot_id;
