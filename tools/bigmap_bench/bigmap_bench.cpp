@@ -83,6 +83,7 @@ struct Args {
   std::string replica_version_writes = "cells";
   unsigned replica_threads = 0;
   double snapshot_period = 1, save_interval = 10, raw_rate = 1, query_rate = 100;
+  int query_clients = 1;
   cli::EngineFlags engine;
 };
 
@@ -169,7 +170,8 @@ int run(const Args& a) {
     t.getMetricMax(hi[0], hi[1], hi[2]);
     return 0;
   });
-  bench::BenchReaders r(server, lc, readers ? a.snapshot_period : 0, readers ? a.query_rate : 0, lo, hi);
+  bench::BenchReaders r(server, lc, readers ? a.snapshot_period : 0, readers ? a.query_rate : 0, a.query_clients, lo,
+                        hi);
   server.start();
   r.start();
   std::vector<octomap_rt::scan_t> msgs;
@@ -227,9 +229,11 @@ int run(const Args& a) {
   print_holders("map of record's", holders);
   if (!replica_holders.empty()) print_holders("read replica's", replica_holders);
   std::printf("  scans end to end: p50 %.1f ms, p99 %.1f ms\n", st.end_to_end_ms_p50, st.end_to_end_ms_p99);
-  std::printf("  queries: %lld sent, %zu answered, p50 %.2f ms, p99 %.2f ms, %lld unanswered\n",
-              (long long)rs.queries_sent, rs.query_ms.size(), percentile(rs.query_ms, 0.5),
-              percentile(rs.query_ms, 0.99), (long long)rs.queries_unanswered);
+  std::printf(
+      "  queries (%d clients): %lld sent, %zu answered, p50 %.2f ms, p99 %.2f ms, %lld unanswered, "
+      "%lld answered not OK\n",
+      readers ? a.query_clients : 0, (long long)rs.queries_sent, rs.query_ms.size(), percentile(rs.query_ms, 0.5),
+      percentile(rs.query_ms, 0.99), (long long)rs.queries_unanswered, (long long)rs.queries_not_ok);
   std::printf("  snapshots: %lld fetched (%lld timed out), mean %.2f s, max %.2f s, %.1f MB; saves %lld\n",
               (long long)rs.snapshots, (long long)rs.snapshot_timeouts,
               rs.snapshots ? rs.snapshot_s_sum / double(rs.snapshots) : 0.0, rs.snapshot_s_max,
@@ -260,14 +264,15 @@ int run(const Args& a) {
   std::printf("  memory: RSS %.0f MiB before the map, %.0f MiB loaded, %.0f MiB at the end, peak %.0f MiB\n",
               rss_before, rss_loaded, rss_end, hwm);
   // readers, replica, nodes, scans, s, stall max, stall p99, e2e p50, e2e p99, query p50, query p99, snapshots,
-  // snapshot max s, RSS loaded, RSS peak, replica update s, replica batch voxels, replica nice
-  std::printf("csv,%s,%s,%lld,%lld,%.1f,%.3f,%.3f,%.2f,%.2f,%.2f,%.2f,%lld,%.2f,%.0f,%.0f,%.1f,%llu,%d\n",
+  // snapshot max s, RSS loaded, RSS peak, replica update s, replica batch voxels, replica nice, query clients,
+  // stage 2's wait for the replica's room [ms]
+  std::printf("csv,%s,%s,%lld,%lld,%.1f,%.3f,%.3f,%.2f,%.2f,%.2f,%.2f,%lld,%.2f,%.0f,%.0f,%.1f,%llu,%d,%d,%.1f\n",
               readers ? "on" : "off", a.replica.c_str(), (long long)loaded.num_nodes, (long long)st.scans_applied,
               seconds, st.octree_lock_wait_ms_max, st.octree_lock_wait_ms_p99, st.end_to_end_ms_p50,
               st.end_to_end_ms_p99, percentile(rs.query_ms, 0.5), percentile(rs.query_ms, 0.99),
               (long long)rs.snapshots, rs.snapshot_s_max, rss_loaded, hwm,
-              replica ? replica->apply_ms_total / 1e3 : 0.0, (unsigned long long)a.replica_batch_voxels,
-              a.replica_nice);
+              replica ? replica->apply_ms_total / 1e3 : 0.0, (unsigned long long)a.replica_batch_voxels, a.replica_nice,
+              readers ? a.query_clients : 0, replica ? replica->writer_waited_ms : 0.0);
   return 0;
 }
 
@@ -329,6 +334,9 @@ int main(int argc, char** argv) {
   r->add_option("--save-interval", a.save_interval, "autosave period [s]")->capture_default_str();
   r->add_option("--octomap-raw-rate", a.raw_rate, "viewer publisher rate [Hz]")->capture_default_str();
   r->add_option("--query-rate", a.query_rate, "point queries a second")->capture_default_str();
+  r->add_option("--query-clients", a.query_clients, "query clients (own client ids) sharing --query-rate")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
     return g->parsed() ? grow(a) : run(a);

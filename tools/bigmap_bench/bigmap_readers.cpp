@@ -24,8 +24,12 @@ double seconds_between(SteadyClock::time_point a, SteadyClock::time_point b) {
 }  // namespace
 
 BenchReaders::BenchReaders(daemon::MappingServer& server, lcm::LCM& lc, double snapshot_period_s, double query_rate_hz,
-                           const double box_min[3], const double box_max[3])
-    : server_(server), lc_(lc), snapshot_period_s_(snapshot_period_s), query_rate_hz_(query_rate_hz) {
+                           int query_clients, const double box_min[3], const double box_max[3])
+    : server_(server),
+      lc_(lc),
+      snapshot_period_s_(snapshot_period_s),
+      query_rate_hz_(query_rate_hz),
+      query_clients_(std::max(1, query_clients)) {
   std::copy(box_min, box_min + 3, box_min_);
   std::copy(box_max, box_max + 3, box_max_);
   server_.lcm_loop().subscribe(kMapReply, [this](const lcm::ReceiveBuffer& rb, const std::string&) {
@@ -48,6 +52,8 @@ BenchReaders::BenchReaders(daemon::MappingServer& server, lcm::LCM& lc, double s
     if (it == in_flight_.end()) return;
     if (r.status == octomap_rt::occupancy_reply_t::REPLY_OK)
       stats_.query_ms.push_back(1e3 * seconds_between(it->second, now));
+    else
+      stats_.queries_not_ok++;
     in_flight_.erase(it);
   });
 }
@@ -56,13 +62,16 @@ BenchReaders::~BenchReaders() { stop(); }
 
 void BenchReaders::start() {
   if (snapshot_period_s_ > 0) snapshots_ = std::thread([this] { pull_snapshots(); });
-  if (query_rate_hz_ > 0) queries_ = std::thread([this] { send_queries(); });
+  if (query_rate_hz_ > 0)
+    for (int c = 0; c < query_clients_; ++c) queries_.emplace_back([this, c] { send_queries(c); });
 }
 
 void BenchReaders::stop() {
   stop_ = true;
   if (snapshots_.joinable()) snapshots_.join();
-  if (queries_.joinable()) queries_.join();
+  for (auto& q : queries_)
+    if (q.joinable()) q.join();
+  queries_.clear();
 }
 
 ReaderStats BenchReaders::stats() {
@@ -114,18 +123,22 @@ void BenchReaders::pull_snapshots() {
   }
 }
 
-// Point queries of 64 random points in the map's box, at the rate (no waiting for scans).
-void BenchReaders::send_queries() {
-  std::mt19937 rng(7);
+// One query client: point queries of 64 random points in the map's box, at its share of the
+// rate (no waiting for scans). The clients start spread over one period so their queries interleave.
+void BenchReaders::send_queries(int client) {
+  std::mt19937 rng(7 + static_cast<unsigned>(client));
   std::uniform_real_distribution<float> u(0.f, 1.f);
-  const auto period = std::chrono::duration<double>(1.0 / query_rate_hz_);
-  auto next = SteadyClock::now();
-  int64_t id = 0;
+  const auto period = std::chrono::duration<double>(query_clients_ / query_rate_hz_);
+  auto next = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(period * client / query_clients_);
+  std::this_thread::sleep_until(next);
+  // Client 0 keeps the one-client name of earlier runs.
+  const std::string client_id = client == 0 ? "bench-queries" : "bench-queries-" + std::to_string(client);
   while (!stop_) {
     octomap_rt::occupancy_query_t q{};
-    q.request_id = ++id;
+    const int64_t id = ++next_query_id_;
+    q.request_id = id;
     q.wait_seq = -1;
-    q.client_id = "bench-queries";
+    q.client_id = client_id;
     q.reply_channel = kQueryReply;
     for (int i = 0; i < 64; ++i)
       for (int k = 0; k < 3; ++k)
