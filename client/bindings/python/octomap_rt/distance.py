@@ -41,18 +41,21 @@ def distance_points(q: QueryChannel, points, max_distance: float = 2.0, unknown_
 
 
 def _zstd_frames(zstandard, blob: bytes, size: int) -> bytes:
-    """A box's blob: zstd frames (one per z-slab) concatenated, decompressed one after the other."""
-    out, rest = [], blob
-    while rest:
-        d = zstandard.ZstdDecompressor().decompressobj()
-        out.append(d.decompress(rest))
-        rest = d.unused_data
-        if sum(map(len, out)) > size:
-            raise QueryError(f"distance box: frames decompress past {size} bytes")
-    raw = b"".join(out)
-    if len(raw) != size:
-        raise QueryError(f"distance box: {len(raw)} bytes decompressed, {size} declared")
-    return raw
+    """A box's blob: zstd frames (one per z-slab) concatenated, decompressed one after the other,
+    never more than size + 1 bytes of output (a frame that declares less and holds more is refused)."""
+    import io
+
+    out = bytearray()
+    with zstandard.ZstdDecompressor().stream_reader(io.BytesIO(blob), read_across_frames=True) as r:
+        while len(out) <= size:
+            part = r.read(size + 1 - len(out))
+            if not part:
+                break
+            out += part
+    if len(out) != size:
+        got = f"more than {size}" if len(out) > size else str(len(out))
+        raise QueryError(f"distance box: the frames decompress to {got} bytes, {size} declared")
+    return bytes(out)
 
 
 def distance_box(q: QueryChannel, box_min, box_max, max_distance: float = 2.0, unknown_occupied: bool = False,
