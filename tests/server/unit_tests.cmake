@@ -38,9 +38,11 @@ octomap_rt_add_test(server_shutdown_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/serve
 # The query service (issue 11): answers, read-your-writes, edits, bad queries, over memq://.
 octomap_rt_add_test(server_query_service_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/query_service_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/query_edits_test.cpp ${CMAKE_CURRENT_LIST_DIR}/query_bounds_test.cpp
-                    ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
+                    ${CMAKE_CURRENT_LIST_DIR}/query_replica_test.cpp ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon
+                    TIMEOUT 300)
 octomap_rt_lcm_handler_sources(server_query_service_test ${CMAKE_CURRENT_LIST_DIR}/query_service_test.cpp
-                               ${CMAKE_CURRENT_LIST_DIR}/query_edits_test.cpp ${CMAKE_CURRENT_LIST_DIR}/query_bounds_test.cpp)
+                               ${CMAKE_CURRENT_LIST_DIR}/query_edits_test.cpp ${CMAKE_CURRENT_LIST_DIR}/query_bounds_test.cpp
+                               ${CMAKE_CURRENT_LIST_DIR}/query_replica_test.cpp)
 # ... its counters in the status and the grid it publishes at a rate (issue 11).
 octomap_rt_add_test(server_query_status_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/query_status_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 120)
