@@ -20,6 +20,7 @@
 #include "octomap_rt/distance_query_t.hpp"
 #include "octomap_rt/map_edit_ack_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
+#include "octomap_rt/server_status_t.hpp"
 #include "protocol/channels.h"
 #include "protocol/limits.h"
 #include "protocol/zstd_codec.h"
@@ -155,6 +156,19 @@ TEST(DistanceJournal, ARobotExploringGetsExactAnswersFromTheChangeLists) {
   // The first box reads the map; every later box and every points query takes the change lists.
   EXPECT_GE(s.patched, int64_t(e.scans.size()) - 2 + int64_t(e.scans.size()) / 3 - 1);
   EXPECT_GE(s.partial + s.full, int64_t(e.scans.size()) - 2) << "each part must change the box's grid";
+  // Every box made again is two z-slab frames (60 x 60 x 25 cells: slabs of 18 layers); the status says the same.
+  EXPECT_GE(s.frames, 2 * (s.partial + s.full));
+  EXPECT_LE(s.frames_kept, s.frames);
+  const octomap_rt::server_status_t st = e.fixture.server.status();
+  EXPECT_EQ(st.distance_fields_whole, s.full);
+  EXPECT_EQ(st.distance_fields_partial, s.partial);
+  EXPECT_EQ(st.distance_fields_unchanged, s.unchanged);
+  EXPECT_EQ(st.distance_patched, s.patched);
+  EXPECT_EQ(st.distance_patch_changes, s.patch_changes);
+  EXPECT_EQ(st.distance_reread, s.reread);
+  EXPECT_EQ(st.distance_replies_kept, s.replies_kept);
+  EXPECT_EQ(st.distance_frames, s.frames);
+  EXPECT_EQ(st.distance_frames_kept, s.frames_kept);
   ASSERT_TRUE(e.fixture.server.change_journal_stats().has_value());
   EXPECT_GE(e.fixture.server.change_journal_stats()->changes, 1000u);
 
