@@ -96,6 +96,9 @@ struct ServerConfig {
   uint64_t replica_pending_bytes = 256ull << 20;  // changes the replica may lag behind by
   // Scans waiting for the replica are applied together, up to this many voxels (0: one by one).
   uint64_t replica_batch_voxels = uint64_t{1} << 23;
+  // ... and only while the update's estimated time stays within this (0: no time bound), so that
+  // a query turn waits behind no whole catch-up (daemon/map/map_replica.h).
+  double replica_batch_ms = 0;
   unsigned replica_threads = 0;  // its octree stage's threads (0: every hardware thread)
   int replica_nice = 10;         // how much the replica's thread lowers its priority: the octree stage goes first
   // Snapshots, saves and the viewer map read versions of the replica kept per region, no lock

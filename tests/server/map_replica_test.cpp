@@ -275,5 +275,55 @@ TEST(MapReplica, StopLeavesItsBacklogAndReadersReadTheMapOfRecord) {
   map.replica = nullptr;
 }
 
+// The time bound on a batch (goal 1 of issue 23's session-7 list): with --replica-batch-ms the
+// scans queued behind a reader are applied in updates of about that long each, not as one
+// catch-up that holds the replica's lock for all of them (a query turn that needs the replica
+// waits behind one such update at most). A bound far below one scan's time: one scan an update,
+// each cut counted; no bound: one joined update. The same tree either way.
+TEST(MapReplica, ATimeBoundCutsTheCatchUpIntoUpdatesOfAboutThatLong) {
+  std::string trees[2];
+  for (const bool bounded : {false, true}) {
+    SCOPED_TRACE(bounded ? "1e-9 ms" : "no time bound");
+    daemon::MapState map;
+    map.tree = std::make_unique<octomap::OcTree>(0.1);
+    daemon::MapReplica replica(map, OctreeUpdateOptions{}, uint64_t{1} << 32, daemon::MapReplica::kDefaultBatchVoxels,
+                               0, std::nullopt, true, bounded ? 1e-9 : 0);
+    map.replica = &replica;
+    const int n = 50;
+    {
+      std::shared_lock reader(replica.state().mutex);  // a reader holds it: the backlog grows
+      for (uint16_t k = 0; k < n; ++k) {
+        VoxelList voxels;
+        for (uint16_t i = 0; i < 1000; ++i)
+          voxels.push_back(VoxelUpdate{uint16_t(32768 + i), uint16_t(32768 + k), 32768, kStateOccupied});
+        map.version++;
+        map.scans++;
+        map.newest_scan["rover"] = daemon::MapState::NewestScan{"rover", k, map.scans};
+        replica.scan_applied(voxels, map, "rover");
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    ASSERT_TRUE(replica.wait_for(map.version, 20));
+    const auto stats = replica.stats();
+    EXPECT_EQ(stats.version, map.version);
+    if (bounded) {
+      EXPECT_EQ(stats.largest_batch, 1u);
+      EXPECT_EQ(stats.updates, uint64_t(n));
+      EXPECT_GE(stats.batches_cut_by_time, 1u) << "the cuts are not counted";
+      EXPECT_GT(stats.ms_per_voxel, 0) << "no estimate of the update's time";
+    } else {
+      EXPECT_GE(stats.largest_batch, uint64_t(n) - 10) << "the backlog was not joined";
+      EXPECT_EQ(stats.batches_cut_by_time, 0u);
+    }
+    {
+      std::shared_lock lock(replica.state().mutex);
+      trees[bounded] = daemon::serialize_map(*replica.state().tree);
+    }
+    replica.stop();
+    map.replica = nullptr;
+  }
+  EXPECT_TRUE(trees[0] == trees[1]) << "the cut catch-up made another tree";
+}
+
 }  // namespace
 }  // namespace ort::test

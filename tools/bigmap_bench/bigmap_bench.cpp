@@ -78,6 +78,7 @@ struct Args {
   uint64_t replica_batch_voxels = daemon::MapReplica::kDefaultBatchVoxels;
   uint64_t replica_pending_bytes = daemon::ServerConfig{}.replica_pending_bytes;
   int replica_nice = 10;
+  double replica_batch_ms = 0;
   std::string replica_versions = "on";
   unsigned replica_version_depth = 0;
   std::string replica_version_writes = "cells";
@@ -98,6 +99,7 @@ daemon::ServerConfig server_config(const Args& a) {
   cfg.replica_batch_voxels = a.replica_batch_voxels;
   cfg.replica_pending_bytes = a.replica_pending_bytes;
   cfg.replica_nice = a.replica_nice;
+  cfg.replica_batch_ms = a.replica_batch_ms;
   cfg.replica_versions = a.replica_versions == "on";
   cfg.replica_version_depth = a.replica_version_depth;
   cfg.replica_version_cells = a.replica_version_writes == "cells";
@@ -243,11 +245,12 @@ int run(const Args& a) {
     std::printf(
         "  read replica: %.1f s of updates on its thread (%llu updates, %llu scans in batches, at most %llu in one), "
         "at most %.1f MB pending, stage 2 waited %.1f ms for room; its thread waited %.1f s for readers (at most "
-        "%.1f ms)\n",
+        "%.1f ms); %llu batches cut at --replica-batch-ms %.1f (estimate %.2f us a voxel)\n",
         replica->apply_ms_total / 1e3, (unsigned long long)replica->updates,
         (unsigned long long)replica->scans_in_batches, (unsigned long long)replica->largest_batch,
         double(replica->max_pending_bytes_seen) / 1e6, replica->writer_waited_ms, replica->lock_wait_ms_total / 1e3,
-        replica->lock_wait_ms_max);
+        replica->lock_wait_ms_max, (unsigned long long)replica->batches_cut_by_time, a.replica_batch_ms,
+        1e3 * replica->ms_per_voxel);
   if (replica && replica->versions_built > 0)
     std::printf(
         "  versions for whole-map readers: %llu made on the replica's thread, %.1f s in all, at most %.1f ms; the "
@@ -307,6 +310,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   r->add_option("--replica-batch-voxels", a.replica_batch_voxels,
                 "scans waiting for the read replica are applied together up to this many voxels (0: one by one)")
+      ->capture_default_str();
+  r->add_option("--replica-batch-ms", a.replica_batch_ms,
+                "... and only while the update's estimated time stays within this [ms] (0: no time bound)")
+      ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
   r->add_option("--replica-pending-bytes", a.replica_pending_bytes,
                 "how far (bytes of changes) the read replica may lag before stage 2 waits for it")

@@ -13,10 +13,12 @@
 namespace ort::daemon {
 
 MapReplica::MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
-                       uint64_t max_batch_voxels, int nice, std::optional<RegionGrid> version_grid, bool version_cells)
+                       uint64_t max_batch_voxels, int nice, std::optional<RegionGrid> version_grid, bool version_cells,
+                       double max_batch_ms)
     : stage_(octree),
       max_pending_bytes_(max_pending_bytes),
       max_batch_voxels_(max_batch_voxels),
+      max_batch_ms_(max_batch_ms),
       has_versions_(version_grid.has_value()),
       version_cells_(version_cells),
       builder_(version_grid.value_or(region_grid(11)), version_cells),
@@ -104,7 +106,14 @@ void MapReplica::take_batch(std::deque<Item>& batch) {
   queue_.pop_front();
   if (batch.front().step) return;
   uint64_t voxels = batch.front().voxels.size();
+  uint64_t limit = max_batch_voxels_;
+  if (max_batch_ms_ > 0)  // without an estimate yet, one scan
+    limit = std::min<uint64_t>(limit, ms_per_voxel_ > 0 ? uint64_t(max_batch_ms_ / ms_per_voxel_) : 0);
   while (!queue_.empty() && !queue_.front().step && voxels + queue_.front().voxels.size() <= max_batch_voxels_) {
+    if (voxels + queue_.front().voxels.size() > limit) {
+      stats_.batches_cut_by_time++;
+      break;
+    }
     voxels += queue_.front().voxels.size();
     batch.push_back(std::move(queue_.front()));
     queue_.pop_front();
@@ -196,8 +205,15 @@ void MapReplica::run() {
       else
         for (const Item& it : batch) builder_.changed(it.voxels);
     }
-    uint64_t bytes = 0;
-    for (const Item& it : batch) bytes += it.bytes;
+    uint64_t bytes = 0, voxels = 0;
+    for (const Item& it : batch) {
+      bytes += it.bytes;
+      voxels += it.voxels.size();
+    }
+    if (!batch.front().step && voxels > 0) {  // the estimate take_batch's time bound uses: recent updates weigh most
+      const double sample = (applied_ms - std::min(applied_ms, waited)) / double(voxels);
+      ms_per_voxel_ = ms_per_voxel_ > 0 ? 0.7 * ms_per_voxel_ + 0.3 * sample : sample;
+    }
     const uint64_t items = batch.size();
     batch.clear();  // the voxel lists are freed outside both locks
     {
@@ -208,6 +224,7 @@ void MapReplica::run() {
       stats_.updates++;
       if (items > 1) stats_.scans_in_batches += items;
       stats_.largest_batch = std::max(stats_.largest_batch, items);
+      stats_.ms_per_voxel = ms_per_voxel_;
       stats_.pending_items -= std::min(stats_.pending_items, items);
       stats_.pending_bytes -= std::min(stats_.pending_bytes, bytes);
       stats_.version = state_.version;

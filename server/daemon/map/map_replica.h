@@ -29,7 +29,10 @@
 // scans give one by one; it costs less because each node on the scans' shared paths is walked
 // and settled once, nodes pruned by one scan and expanded by the next are not, and the stage's
 // fixed cost per update is paid once. The replica then goes from the state before the first
-// to the state after the last (readers never see a state within a scan). Its octree stage's
+// to the state after the last (readers never see a state within a scan). With a time bound
+// (`max_batch_ms`, ServerConfig::replica_batch_ms) a batch joins scans only while its estimated
+// update time stays within it, so a catch-up is many short holds of the replica's lock, each
+// about max(bound, one scan), instead of one long one; the scans stay whole. Its octree stage's
 // helper threads run at nice 19 (octree/worker_pool.h): they take the cores the octree stage
 // leaves idle, and yield them to it; the replica's own thread lowers its priority too (the
 // server's: by 10), so that on a machine with few cores the octree stage goes first and the
@@ -80,12 +83,14 @@ struct ReplicaStats {
   double apply_ms_total = 0;      // the replica thread's own update time (its lock held)
   double lock_wait_ms_total = 0;  // the replica thread's wait for its lock (readers inside)
   double lock_wait_ms_max = 0;
-  uint64_t updates = 0;                                   // tree updates it made: one per batch of scans or per step
-  uint64_t scans_in_batches = 0;                          // scans applied together with others
-  uint64_t largest_batch = 0;                             // most scans in one update
-  uint64_t versions_built = 0;                            // versions made for whole-map readers
-  double version_ms_total = 0, version_ms_max = 0;        // the replica thread's time making them
-  double version_ms_later = 0, version_cpu_ms_later = 0;  // of those after the first: wall, its CPU
+  uint64_t updates = 0;              // tree updates it made: one per batch of scans or per step
+  uint64_t scans_in_batches = 0;     // scans applied together with others
+  uint64_t largest_batch = 0;        // most scans in one update
+  uint64_t batches_cut_by_time = 0;  // batches that stopped joining scans at max_batch_ms (the estimate said so)
+  double ms_per_voxel = 0;           // the estimate: of the replica's recent scan updates (0: none yet)
+  uint64_t versions_built = 0;       // versions made for whole-map readers
+  double version_ms_total = 0, version_ms_max = 0;            // the replica thread's time making them
+  double version_ms_later = 0, version_cpu_ms_later = 0;      // of those after the first: wall, its CPU
   uint64_t version_regions = 0, version_regions_written = 0;  // of the last one
   uint64_t version_bytes = 0, version_bytes_written = 0;      // of the last one: its records, those written
   uint64_t version_bytes_written_later = 0;                   // by every version after the first
@@ -106,9 +111,14 @@ class MapReplica {
   // compare). `version_cells`: a version writes the cells the octree stage's change log names
   // (octree/versions/region_records.h); false: it rewrites the regions the scans' keys touched
   // whole (the design before, session 5).
+  // `max_batch_ms` > 0: a batch joins scans only while the update's time, estimated from the ms
+  // per voxel of the replica's recent scan updates, stays within it (no estimate yet: one scan),
+  // so that the replica's lock is held about max(max_batch_ms, one scan) at a time and a query
+  // turn that needs the replica waits behind no whole catch-up. 0: bounded by voxels only.
   MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
              uint64_t max_batch_voxels = kDefaultBatchVoxels, int nice = 0,
-             std::optional<RegionGrid> version_grid = region_grid(11), bool version_cells = true);
+             std::optional<RegionGrid> version_grid = region_grid(11), bool version_cells = true,
+             double max_batch_ms = 0);
   ~MapReplica();
   MapReplica(const MapReplica&) = delete;
   MapReplica& operator=(const MapReplica&) = delete;
@@ -166,7 +176,8 @@ class MapReplica {
   void wait_room_locked(std::unique_lock<std::mutex>& lock, uint64_t bytes);
   void push(Item item);
   void run();
-  // Under mutex_: the front item, and the scans right behind a scan up to max_batch_voxels_.
+  // Under mutex_: the front item, and the scans right behind a scan up to max_batch_voxels_
+  // (and max_batch_ms_ as estimated).
   void take_batch(std::deque<Item>& batch);
   // Applies a batch to the tree and takes its last item's state (under state_.mutex), with
   // `log_changes` the leaves it changed in changes_. Returns how long it waited for that lock (ms).
@@ -179,6 +190,8 @@ class MapReplica {
   OctreeStage stage_;
   uint64_t max_pending_bytes_;
   uint64_t max_batch_voxels_;
+  double max_batch_ms_;
+  double ms_per_voxel_ = 0;   // the replica's thread's estimate (only that thread reads or writes it)
   VoxelList joined_;          // a batch's voxel lists one after the other (capacity kept)
   LeafChanges changes_;       // the leaves a batch changed, while versions are on (capacity kept)
   mutable std::mutex mutex_;  // the queue and the stats
