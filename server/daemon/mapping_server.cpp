@@ -35,8 +35,8 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
     : cfg_(cfg),
       log_(std::move(log)),
       producers_(literal_prefix(cfg.scan_channels), producer_policy(cfg)),
-      queue_(queue_budget(cfg), 8 * queue_budget(cfg), cfg.scan_costs.producer_share,
-             cfg.scan_costs.shared_class_share) {
+      queue_(queue_budget(cfg), 8 * queue_budget(cfg), cfg.scan_costs.producer_share, cfg.scan_costs.shared_class_share,
+             cfg.scan_costs.shared) {
   start_ = SteadyClock::now();
   start_utime_ = now_utime();
   host_ = host_name();

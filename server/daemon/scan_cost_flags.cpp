@@ -81,6 +81,39 @@ void add_scan_cost_flags(CLI::App& app, ScanCostBounds& c) {
          "too slow' before any ray is shot; 0: no limit [s]")
       ->capture_default_str()
       ->check(number_in(0.0, 1e6));
+  SharedClassBounds& sh = c.shared;
+  app.add_option("--shared-budget", sh.enabled,
+                 "bound what robot ids without history take of the stages: per scan while others stream "
+                 "(--shared-scan-*, --shared-unknown-ray-*: past it rejected as 'predicted too slow' before it is "
+                 "shot), per second while a robot with history streams (--shared-stage-*: past it the scans wait); "
+                 "false: only their share bounds them")
+      ->capture_default_str();
+  app.add_option("--shared-unknown-ray-floor", sh.unknown_ray_floor_voxels,
+                 "see --shared-budget: a scan whose rays are longer on average than this many voxels and than "
+                 "--shared-unknown-ray-ratio times the longest shape applied has no known cost")
+      ->capture_default_str()
+      ->check(number_in(1.0, 1e9));
+  app.add_option("--shared-unknown-ray-ratio", sh.unknown_ray_ratio, "see --shared-unknown-ray-floor")
+      ->capture_default_str()
+      ->check(number_in(1.0, 1e6));
+  app.add_option("--shared-stage-floor", sh.floor_ms_per_s, "see --shared-budget [ms of the stages a second]")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e6));
+  app.add_option("--shared-stage-ratio", sh.robot_ratio, "see --shared-budget")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e3));
+  app.add_option("--shared-stage-burst", sh.burst_ms, "see --shared-budget [ms]")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e7));
+  app.add_option("--shared-scan-floor", sh.scan_floor_ms,
+                 "see --shared-budget: while others stream, a scan of a robot id without history predicted (from "
+                 "scans of its shape) to take more than this or --shared-scan-ratio times the robots' mean scan is "
+                 "rejected as 'predicted too slow' [ms]")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e7));
+  app.add_option("--shared-scan-ratio", sh.scan_ratio, "see --shared-scan-floor")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e6));
 }
 
 }  // namespace ort::daemon

@@ -24,15 +24,18 @@ octomap_rt_lcm_handler_sources(lcm_loop_test ${CMAKE_CURRENT_LIST_DIR}/lcm_loop_
 octomap_rt_add_test(server_run_summary_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/run_summary_test.cpp
                     LIBS octomap_rt_daemon TIMEOUT 60)
 octomap_rt_add_test(server_producer_registry_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/producer_registry_test.cpp
-                    ${CMAKE_CURRENT_LIST_DIR}/scan_queue_test.cpp LIBS octomap_rt_daemon TIMEOUT 60)
+                    ${CMAKE_CURRENT_LIST_DIR}/scan_queue_test.cpp ${CMAKE_CURRENT_LIST_DIR}/shared_class_budget_test.cpp
+                    LIBS octomap_rt_daemon TIMEOUT 60)
 # The rule behind the status' DEGRADED state and its causes.
 octomap_rt_add_test(server_degraded_causes_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/degraded_causes_test.cpp
                     LIBS octomap_rt_daemon TIMEOUT 60)
 octomap_rt_add_test(server_hardening_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_hardening_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/scan_costs_test.cpp ${CMAKE_CURRENT_LIST_DIR}/producer_share_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/shared_budget_server_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 600)
 octomap_rt_lcm_handler_sources(server_hardening_test ${CMAKE_CURRENT_LIST_DIR}/scan_costs_test.cpp
-                               ${CMAKE_CURRENT_LIST_DIR}/producer_share_test.cpp)
+                               ${CMAKE_CURRENT_LIST_DIR}/producer_share_test.cpp
+                               ${CMAKE_CURRENT_LIST_DIR}/shared_budget_server_test.cpp)
 octomap_rt_add_test(server_shutdown_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/server_shutdown_test.cpp
                     ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
 # The query service (issue 11): answers, read-your-writes, edits, bad queries, over memq://.

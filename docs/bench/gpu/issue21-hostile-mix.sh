@@ -3,21 +3,20 @@
 # hostile-mix bench (tools/hostile-mix-bench, docs/RELIABILITY.md "Hostile-mix load"): one robot
 # replays fr079 at scale 0.5 at 5 Hz, quiet and then while the attacker who knows the mean-ray bound
 # sends 100-point scans 400 m out from fresh robot ids; the robot's scans applied, the daemon's end-to-end
-# p50/p99 and how long each stop took, the same binary for both. Two calls, ~40-60 s each:
-#   now      the defaults (predicted cost charged when a scan is served, the shared class at 0.25
-#            of a robot's share, round robin by producer id inside it, --max-scan-time 2);
-#   nobound  the same binary with --max-scan-time 0 --shared-class-share 1 (what is left of the
-#            share without the per-scan bound and the smaller shared class).
-# Every step is skipped, never cut, once its time is past (lib.sh's `left`); ~150 s in all.
+# p50/p99 and how long each stop took, the same binary for both. Two calls, ~35 s each:
+#   now       the defaults (session 9: the shared class's budget of stage time per second and its
+#             per-scan bound while a robot with history streams, intake/shared_class_budget.h);
+#   nobudget  the same binary with --shared-budget false (session 7's share and round robin only).
+# Every step is skipped, never cut, once its time is past (lib.sh's `left`); ~70 s in all.
 #   Here, after building octomap-rt-server octomap-rt octomap-rt-scenegen (and build/python, the
 #   generated Python types the hostile peers send with) in BUILD_DIR:
-#       docs/bench/gpu/issue21-hostile-mix.sh bundle BUILD_DIR      -> .device-bundle/bounds-s7
-#   There (carry [".device-bundle/bounds-s7"]), from the repository root:
+#       docs/bench/gpu/issue21-hostile-mix.sh bundle BUILD_DIR      -> .device-bundle/bounds-s9
+#   There (carry [".device-bundle/bounds-s9"]), from the repository root:
 #       docs/bench/gpu/issue21-hostile-mix.sh run
-#   The result, $OUT/bounds-s7.tar.gz: now.txt, nobound.txt (the bench's report), progress.txt,
+#   The result, $OUT/bounds-s9.tar.gz: now.txt, nobudget.txt (the bench's report), progress.txt,
 #   machine.txt. The peers are Python (standard library only: octomap_rt's udpm transport).
 set -uo pipefail
-name=bounds-s7
+name=bounds-s9
 case "${1:-}" in
   bundle)
     set -e
@@ -45,7 +44,7 @@ case "${1:-}" in
         --rate 5 --hostile far400 -- "$@" > "$O/$tag.txt" 2>&1
       echo "rc=$?" >> "$O/$tag.txt"; }
     left 60 && bench now
-    left 90 && bench nobound --max-scan-time 0 --shared-class-share 1
+    left 60 && bench nobudget --shared-budget false
     ;;
   *) echo "usage: $0 bundle BUILD_DIR | run" >&2; exit 2 ;;
 esac

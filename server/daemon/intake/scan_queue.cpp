@@ -12,8 +12,10 @@ size_t queued_bytes(const octomap_rt::scan_t& msg) {
   return sizeof(QueuedScan) + msg.xyz.capacity() * sizeof(float) + msg.robot_id.size() + msg.map_frame.size();
 }
 
-ScanQueue::ScanQueue(uint64_t per_producer_budget, uint64_t total_budget, bool fair, double shared_class_share)
-    : per_producer_budget_(per_producer_budget),
+ScanQueue::ScanQueue(uint64_t per_producer_budget, uint64_t total_budget, bool fair, double shared_class_share,
+                     SharedClassBounds shared_bounds)
+    : shared_budget_(shared_bounds),
+      per_producer_budget_(per_producer_budget),
       total_budget_(total_budget),
       fair_(fair),
       // A share of nothing would never be served; NaN would compare false everywhere.
@@ -115,10 +117,21 @@ bool ScanQueue::streams(const ShareClass& c, SteadyClock::time_point now) const 
          (c.served != SteadyClock::time_point{} && now - c.served < kStreamingWindow);
 }
 
+bool ScanQueue::robots_stream(SteadyClock::time_point now) const {
+  for (const auto& [key, c] : classes_)
+    if (key != kNewProducersClass && streams(c, now)) return true;
+  return false;
+}
+
 ScanQueue::ShareClass* ScanQueue::next_class(SteadyClock::time_point now) {
   ShareClass* best = nullptr;
   for (auto& [key, c] : classes_) {
     if (c.scans.empty()) continue;
+    // Its budget spent while a robot streams: it waits for the refill (pop() looks again).
+    if (fair_ && key == kNewProducersClass && robots_stream(now) && !shared_budget_.may_serve(now)) {
+      shared_deferrals_++;
+      continue;
+    }
     if (fair_ && c.in_stages > 0) {  // one scan in the stages while a class that used less streams
       bool behind = false;
       for (const auto& [other_key, other] : classes_)
@@ -195,6 +208,9 @@ std::optional<QueuedScan> ScanQueue::pop() {
   in_stages_[s.arrival] = InStages{s.share_class, s.producer, s.predicted.ms, 0, s.walk_voxels, s.mean_ray_voxels};
   const auto now = SteadyClock::now();
   s.others_stream = others_stream(s.producer, now);
+  if (fair_ && s.share_class == kNewProducersClass && s.others_stream)
+    s.shared_refusal =
+        shared_budget_.refusal(s.producer, s.predicted, s.mean_ray_voxels, costs_.longest_learned_ray_voxels());
   served_by_producer_[s.producer] = now;
   return s;
 }
@@ -207,6 +223,10 @@ void ScanQueue::charge(uint64_t arrival, double ms) {
   InStages& t = it->second;
   const double over_before = std::max(0.0, t.spent_ms - t.predicted_ms);
   t.spent_ms += ms;
+  if (t.share_class == kNewProducersClass)
+    shared_budget_.shared_used(ms);
+  else
+    shared_budget_.robots_used(ms);
   const double over = std::max(0.0, t.spent_ms - t.predicted_ms);
   if (auto c = classes_.find(t.share_class); c != classes_.end())
     c->second.used_ms += (over - over_before) / c->second.share;
@@ -220,6 +240,7 @@ void ScanQueue::leave(uint64_t arrival, bool applied) {
     const InStages t = it->second;
     in_stages_.erase(it);
     if (applied) costs_.learn(t.walk_voxels, t.mean_ray_voxels, t.spent_ms);
+    if (applied) shared_budget_.scan_done(t.producer, t.spent_ms, t.share_class != kNewProducersClass);
     if (auto c = classes_.find(t.share_class); c != classes_.end()) {
       ShareClass& cls = c->second;
       cls.used_ms -= std::max(0.0, t.predicted_ms - t.spent_ms) / cls.share;  // what it did not use
@@ -287,6 +308,11 @@ size_t ScanQueue::producer_depth(size_t producer) const {
   return producer < depth_by_producer_.size() ? depth_by_producer_[producer] : 0;
 }
 
+uint64_t ScanQueue::shared_deferrals() const {
+  std::lock_guard lock(mutex_);
+  return shared_deferrals_;
+}
+
 std::string ScanQueue::policy() const {
   const std::string budget = "per-producer byte budget " + std::to_string(per_producer_budget_ >> 20) + " MiB (total " +
                              std::to_string(total_budget_ >> 20) +
@@ -296,7 +322,12 @@ std::string ScanQueue::policy() const {
   return budget + "each producer with history has its share of the stages' time, producers without share one of " +
          std::to_string(shared_class_share_).substr(0, 4) +
          " of a producer's (and one byte budget), each scan charged as predicted when it is served: scans are applied in arrival order per producer, by share across producers; a scan that "
-         "waited past the latency bound while others were served in its turn is dropped as 'over its share'";
+         "waited past the latency bound while others were served in its turn is dropped as 'over its share'" +
+         (shared_budget_.bounds().enabled
+              ? "; while others stream a scan of a robot id without history predicted past its bound or of unknown "
+                "cost is rejected as 'predicted too slow', and while a robot with history streams the shared class "
+                "waits once its stage time per second is spent"
+              : std::string());
 }
 
 }  // namespace ort::daemon

@@ -19,7 +19,11 @@
 // less streams (has scans waiting or in the stages, or had one served within
 // kStreamingWindow), a class has at most one scan in the stages: a scan is applied whole, so
 // what a robot's scan may wait for is one scan of each class ahead of it, not one in each
-// stage. fair = false: one FIFO.
+// stage. fair = false: one FIFO. On top of the share, the shared class's budget
+// (intake/shared_class_budget.h): its scans' cost is bounded one by one while others stream
+// (pop() sets shared_refusal; stage 1 refuses them), and its stage time per second while a
+// robot with history streams (next_class() holds it back while that is spent): a scan is
+// applied whole, and a work-conserving share hands an idle robot's time to the far scans.
 //
 // Order: each producer's scans leave in its arrival order (a producer that earns its history
 // takes its scans waiting in the shared class into its own, in order); across producers, by share;
@@ -40,9 +44,11 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "core/clock.h"
+#include "daemon/intake/shared_class_budget.h"
 #include "daemon/intake/stage_cost_model.h"
 #include "octomap_rt/scan_t.hpp"
 
@@ -75,6 +81,9 @@ struct QueuedScan {
   double walk_voxels = 0;            // set by the intake: its rays' voxels (rays x mean length)
   double mean_ray_voxels = 0;        // set by the intake
   StageCostPrediction predicted;     // set by pop(): what it will cost the stages
+  // Set by pop() for a scan of the shared class while others stream: why it is refused for its
+  // cost (intake/shared_class_budget.h); empty: admitted.
+  std::string shared_refusal;
   octomap_rt::scan_t msg;
   std::shared_ptr<MapEditItem> edit;  // set: a map edit, not a scan (msg is empty)
 };
@@ -85,7 +94,7 @@ size_t queued_bytes(const octomap_rt::scan_t& msg);
 class ScanQueue {
  public:
   ScanQueue(uint64_t per_producer_budget, uint64_t total_budget, bool fair = true,
-            double shared_class_share = kSharedClassShare);
+            double shared_class_share = kSharedClassShare, SharedClassBounds shared_bounds = SharedClassBounds::off());
 
   // False when the producer's (or the total) budget would be exceeded, or after close().
   bool try_push(QueuedScan&& s);
@@ -115,6 +124,9 @@ class ScanQueue {
   size_t producer_depth(size_t producer) const;
   uint64_t per_producer_budget() const { return per_producer_budget_; }
   std::string policy() const;
+  // Times the shared class was not served because its stage-time budget was spent while a
+  // robot with history streamed (its scans waited; intake/shared_class_budget.h).
+  uint64_t shared_deferrals() const;
 
  private:
   struct ShareClass {
@@ -142,7 +154,8 @@ class ScanQueue {
   bool streams(const ShareClass& c, SteadyClock::time_point now) const;
   bool empty_locked() const;
   bool others_stream(size_t producer, SteadyClock::time_point now) const;
-  void forget(const QueuedScan& s);  // its bytes and depth, once it left the queue
+  bool robots_stream(SteadyClock::time_point now) const;  // a class other than the shared one streams
+  void forget(const QueuedScan& s);                       // its bytes and depth, once it left the queue
 
   mutable std::mutex mutex_;
   std::condition_variable ready_;
@@ -150,6 +163,8 @@ class ScanQueue {
   std::deque<QueuedScan> edits_;            // arrival order
   std::map<uint64_t, InStages> in_stages_;  // by arrival
   StageCostModel costs_;
+  SharedClassBudget shared_budget_;
+  uint64_t shared_deferrals_ = 0;
   std::vector<uint64_t> bytes_by_producer_;
   std::vector<size_t> depth_by_producer_;
   std::vector<size_t> new_class_depth_;                      // by producer: its scans waiting in kNewProducersClass

@@ -21,6 +21,12 @@ StageCostPrediction StageCostModel::predict(double walk_voxels, double mean_ray_
   return {};
 }
 
+double StageCostModel::longest_learned_ray_voxels() const {
+  for (size_t k = kShapes; k-- > 0;)
+    if (ms_per_voxel_[k] > 0) return std::ldexp(1.0, static_cast<int>(k) + 1);
+  return 0;
+}
+
 void StageCostModel::learn(double walk_voxels, double mean_ray_voxels, double ms) {
   if (!(walk_voxels >= 1) || !(ms > 0) || !std::isfinite(ms)) return;
   double& rate = ms_per_voxel_[shape_of(mean_ray_voxels)];

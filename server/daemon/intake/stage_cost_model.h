@@ -28,6 +28,10 @@ class StageCostModel {
   StageCostPrediction predict(double walk_voxels, double mean_ray_voxels) const;
   // A scan of this walk and shape took `ms` of the stages, applied whole.
   void learn(double walk_voxels, double mean_ray_voxels, double ms);
+  // The longest mean ray (in voxels: the upper end of its shape) of any shape learned; 0: none.
+  // A scan whose rays are much longer walks into space no applied scan reached, where every
+  // voxel is a new node: a borrowed rate says nothing about its cost.
+  double longest_learned_ray_voxels() const;
 
  private:
   static size_t shape_of(double mean_ray_voxels);

@@ -32,6 +32,7 @@
 
 #include "core/clock.h"
 #include "daemon/intake/reject_reason.h"
+#include "daemon/intake/shared_class_budget.h"
 #include "daemon/intake/stage_cost_model.h"
 
 namespace ort::daemon {
@@ -64,6 +65,9 @@ struct ScanCostBounds {
   // be predicted to take while another producer streams; two fifths of the default latency
   // bound. 0: no limit.
   double max_scan_stage_s = 2.0;
+  // While a robot with history streams, what the shared class may take of the stages per
+  // second and per scan (intake/shared_class_budget.h).
+  SharedClassBounds shared;
 };
 
 class ScanCostGate {

@@ -114,6 +114,10 @@ bool ScanPipeline::shoot(QueuedScan& item, ShotJob& job) {
     // The per-scan time bound is for producers without history (fresh ids are free to make);
     // an established robot's scans are bounded by its share, and a slow machine's overload
     // drops them over their share, never refuses them for their cost.
+    if (refusal == Reject::kNone && !item.shared_refusal.empty()) {  // a robot streams: the queue's bound
+      refusal = Reject::kPredictedTooSlow;
+      detail = item.shared_refusal;
+    }
     if (refusal == Reject::kNone && item.share_class == kNewProducersClass)
       refusal = gate_.admit_stage_time(item.predicted, item.others_stream, detail);
     if (refusal == Reject::kNone) refusal = gate_.admit_origin(item.producer, job.origin, t0, detail);
