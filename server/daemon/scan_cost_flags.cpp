@@ -96,6 +96,11 @@ void add_scan_cost_flags(CLI::App& app, ScanCostBounds& c) {
   app.add_option("--shared-unknown-ray-ratio", sh.unknown_ray_ratio, "see --shared-unknown-ray-floor")
       ->capture_default_str()
       ->check(number_in(1.0, 1e6));
+  app.add_option("--shared-unknown-walk-floor", sh.unknown_walk_floor_voxels,
+                 "see --shared-unknown-ray-floor: only a scan walking more voxels in all (rays x mean length) than "
+                 "this is refused for an unknown cost")
+      ->capture_default_str()
+      ->check(number_in(0.0, 1e12));
   app.add_option("--shared-stage-floor", sh.floor_ms_per_s, "see --shared-budget [ms of the stages a second]")
       ->capture_default_str()
       ->check(number_in(0.0, 1e6));

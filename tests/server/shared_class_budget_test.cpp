@@ -85,25 +85,26 @@ TEST(SharedClassBudget, AScanBoundOfAFloorOrAMultipleOfTheRobotsMeanScan) {
   early.scan_done(2, 650, false);
   EXPECT_DOUBLE_EQ(early.scan_bound_ms(1), 40);
   EXPECT_DOUBLE_EQ(early.scan_bound_ms(2), 2600);
-  EXPECT_DOUBLE_EQ(early.scan_bound_ms(9), 20);
+  EXPECT_DOUBLE_EQ(early.scan_bound_ms(9), 40);  // no scan of its own yet: the cheapest producer's
 }
 
 TEST(SharedClassBudget, RefusesAScanPredictedPastItsBoundOrOfUnknownCost) {
   SharedClassBudget b(bounds());
   b.scan_done(0, 10, true);  // the bound: 40 ms
-  EXPECT_EQ(b.refusal(1, {30, true}, 50, 64), "");
-  EXPECT_NE(b.refusal(1, {650, true}, 4000, 4096).find("predicted to take 650 ms"), std::string::npos);
-  EXPECT_NE(b.refusal(1, {650, true}, 4000, 4096).find("above 40 ms"), std::string::npos);
+  EXPECT_EQ(b.refusal(1, {30, true}, 400'000, 50, 64), "");
+  EXPECT_NE(b.refusal(1, {650, true}, 400'000, 4000, 4096).find("predicted to take 650 ms"), std::string::npos);
+  EXPECT_NE(b.refusal(1, {650, true}, 400'000, 4000, 4096).find("above 40 ms"), std::string::npos);
   // Not learned: its rays decide. Above 512 voxels and 4x the longest shape applied: unknown.
-  EXPECT_NE(b.refusal(1, {1, false}, 4000, 64).find("not known"), std::string::npos);
-  EXPECT_NE(b.refusal(1, {}, 4000, 0).find("above 512"), std::string::npos);  // nothing applied yet
-  EXPECT_EQ(b.refusal(1, {1, false}, 500, 64), "");                           // a robot's rays: borrowed
-  EXPECT_EQ(b.refusal(1, {1, false}, 1000, 256), "");                         // within 4x a campus robot's shape
-  EXPECT_NE(b.refusal(1, {1, false}, 1100, 256).find("above 1024"), std::string::npos);
-  EXPECT_EQ(b.refusal(1, {1, false}, std::nan(""), 64), "");  // no ray length: the intake's bounds decide
+  EXPECT_NE(b.refusal(1, {1, false}, 400'000, 4000, 64).find("not known"), std::string::npos);
+  EXPECT_NE(b.refusal(1, {}, 400'000, 4000, 0).find("above 512"), std::string::npos);  // nothing applied yet
+  EXPECT_EQ(b.refusal(1, {1, false}, 400'000, 500, 64), "");                           // a robot's rays: borrowed
+  EXPECT_EQ(b.refusal(1, {1, false}, 400'000, 1000, 256), "");  // within 4x a campus robot's shape
+  EXPECT_NE(b.refusal(1, {1, false}, 400'000, 1100, 256).find("above 1024"), std::string::npos);
+  EXPECT_EQ(b.refusal(1, {1, false}, 400'000, std::nan(""), 64), "");  // no ray length: the intake's bounds decide
+  EXPECT_EQ(b.refusal(1, {1, false}, 60'000, 3000, 64), "");  // 20 long-range points: cheap whatever their space
   SharedClassBudget off(SharedClassBounds::off());
-  EXPECT_EQ(off.refusal(1, {650, true}, 4000, 4096), "");
-  EXPECT_EQ(off.refusal(1, {1, false}, 4000, 64), "");
+  EXPECT_EQ(off.refusal(1, {650, true}, 400'000, 4000, 4096), "");
+  EXPECT_EQ(off.refusal(1, {1, false}, 400'000, 4000, 64), "");
   off.shared_used(1e9);
   EXPECT_TRUE(off.may_serve(at_ms(0)));
 }

@@ -209,8 +209,8 @@ std::optional<QueuedScan> ScanQueue::pop() {
   const auto now = SteadyClock::now();
   s.others_stream = others_stream(s.producer, now);
   if (fair_ && s.share_class == kNewProducersClass && s.others_stream)
-    s.shared_refusal =
-        shared_budget_.refusal(s.producer, s.predicted, s.mean_ray_voxels, costs_.longest_learned_ray_voxels());
+    s.shared_refusal = shared_budget_.refusal(s.producer, s.predicted, s.walk_voxels, s.mean_ray_voxels,
+                                              costs_.longest_learned_ray_voxels());
   served_by_producer_[s.producer] = now;
   return s;
 }

@@ -55,20 +55,24 @@ bool SharedClassBudget::may_serve(SteadyClock::time_point now) {
 }
 
 double SharedClassBudget::scan_bound_ms(size_t producer) const {
-  const double own = producer < own_scan_mean_ms_.size() ? own_scan_mean_ms_[producer] : 0;
-  const double scale = robot_scan_mean_ms_ > 0 ? robot_scan_mean_ms_ : own;
+  double scale = robot_scan_mean_ms_;
+  if (!(scale > 0)) scale = producer < own_scan_mean_ms_.size() ? own_scan_mean_ms_[producer] : 0;
+  if (!(scale > 0))  // the cheapest producer's: an attacker's applied far scans cannot open it
+    for (const double m : own_scan_mean_ms_)
+      if (m > 0 && (!(scale > 0) || m < scale)) scale = m;
   return std::max(bounds_.scan_floor_ms, bounds_.scan_ratio * scale);
 }
 
-std::string SharedClassBudget::refusal(size_t producer, const StageCostPrediction& predicted, double mean_ray_voxels,
-                                       double longest_learned_ray_voxels) const {
+std::string SharedClassBudget::refusal(size_t producer, const StageCostPrediction& predicted, double walk_voxels,
+                                       double mean_ray_voxels, double longest_learned_ray_voxels) const {
   if (!bounds_.enabled) return {};
   const double unknown_above =
       std::max(bounds_.unknown_ray_floor_voxels, bounds_.unknown_ray_ratio * longest_learned_ray_voxels);
-  if (!predicted.learned && mean_ray_voxels > unknown_above)  // NaN is no ray length: the intake's bounds
+  if (!predicted.learned && mean_ray_voxels > unknown_above &&
+      walk_voxels > bounds_.unknown_walk_floor_voxels)  // NaN is no ray length: the intake's bounds
     return "a robot id without history's rays are " + whole(mean_ray_voxels) + " voxels long on average, above " +
-           whole(unknown_above) +
-           " (--shared-unknown-ray-floor, or --shared-unknown-ray-ratio of the longest scan applied): its cost is "
+           whole(unknown_above) + ", " + whole(walk_voxels) + " voxels in all" +
+           " (--shared-unknown-ray-floor or --shared-unknown-ray-ratio of the longest shape applied, --shared-unknown-walk-floor): its cost is "
            "not known while others stream (a voxel in unknown space costs far more than one in mapped space)";
   if (const double bound = scan_bound_ms(producer); predicted.learned && predicted.ms > bound)
     return "a robot id without history's scan is predicted to take " + whole(predicted.ms) +

@@ -9,10 +9,12 @@
 //  - per scan, while another producer streams (alone, a scan delays no one): a shared-class
 //    scan is refused before it is shot ("predicted too slow") when it is predicted, from
 //    scans of its shape that ran, to take more than max(scan_floor_ms, scan_ratio times the
-//    mean applied scan of the robots with history, or, before any has history, of the
-//    producer's own applied scans: every producer's mean would be the far scans', and one
-//    applied alone made the bound seconds); and when its cost is not known: its rays are longer on average than
-//    max(unknown_ray_floor_voxels, unknown_ray_ratio times the longest shape ever applied).
+//    mean applied scan of the robots with history; before any has history, of the producer's
+//    own applied scans, or else of the cheapest producer's: every producer's mean would be
+//    the far scans', and one applied alone made the bound seconds); and when its cost is not
+//    known: not learned, its rays longer on average than max(unknown_ray_floor_voxels,
+//    unknown_ray_ratio times the longest shape ever applied), and its walk over
+//    unknown_walk_floor_voxels.
 //    Such rays walk into space no applied scan reached, where every voxel is a new node and
 //    costs orders of magnitude more than one of a robot's rays through mapped space, so a
 //    borrowed rate would let it through (the first far scan did, on every run before);
@@ -45,6 +47,9 @@ struct SharedClassBounds {
   // scan sets here average 27-170) and than unknown_ray_ratio times the longest shape applied.
   double unknown_ray_floor_voxels = 512;
   double unknown_ray_ratio = 4;
+  // ... and walking more voxels in all than this (a few long-range points are cheap whatever
+  // their space; 100 points 400 m out at 0.1 m walk 400 000).
+  double unknown_walk_floor_voxels = 100'000;
 
   static SharedClassBounds off() {
     SharedClassBounds b;
@@ -70,7 +75,7 @@ class SharedClassBudget {
   double scan_bound_ms(size_t producer) const;
   // Empty, or why a shared-class scan is refused while others stream: its prediction, its
   // rays' mean length [voxels] and the longest learned shape's (StageCostModel).
-  std::string refusal(size_t producer, const StageCostPrediction& predicted, double mean_ray_voxels,
+  std::string refusal(size_t producer, const StageCostPrediction& predicted, double walk_voxels, double mean_ray_voxels,
                       double longest_learned_ray_voxels) const;
 
   double tokens_ms() const { return tokens_ms_; }
