@@ -116,6 +116,17 @@ void print_boxes(const octomap_rt::box_reply_t& r, bool json) {
                 << (r.any_occupied[i] ? " (occupied)" : " (clear)") << "\n";
 }
 
+// A region's nodes, a line each, or JSON; exit status 2 when refused.
+void print_region(const std::vector<octomap_rt::region_chunk_t>& chunks, bool json) {
+  if (json) write_region_json(std::cout, chunks);
+  if (refused(chunks.front())) std::exit(2);
+  if (!json)
+    for (const auto& c : chunks)
+      for (int i = 0; i < c.num_voxels; ++i)
+        std::cout << c.center_xyz[3 * i] << " " << c.center_xyz[3 * i + 1] << " " << c.center_xyz[3 * i + 2]
+                  << " depth " << int(c.depth[i]) << " " << state_name(c.state[i]) << "\n";
+}
+
 void register_box(CLI::App& parent) {
   auto* cmd = parent.add_subcommand("box", "finest-voxel counts of boxes (or a region's nodes with --region)");
   auto a = std::make_shared<CommonArgs>();
@@ -132,9 +143,15 @@ void register_box(CLI::App& parent) {
   cmd->callback([=] {
     std::vector<Box> bs;
     for (const std::string& s : *boxes) bs.push_back(parse_box(s));
+    if (*region && bs.size() != 1) throw CLI::ValidationError("--region", "takes exactly one box");
     if (a->shards) {
-      if (*region) throw CLI::ValidationError("--region", "is not routed across shards; ask each shard's namespace");
       bool partial = false;
+      if (*region) {
+        const auto r = routed(connect_shards(*a)->region(bs[0], *depth, *free, shard_wait(*a)), partial);
+        print_region({r}, a->json);
+        if (partial) std::exit(3);
+        return;
+      }
       const int8_t mode = *any ? octomap_rt::box_query_t::MODE_ANY_OCCUPIED : octomap_rt::box_query_t::MODE_COUNTS;
       const auto r = routed(connect_shards(*a)->boxes(bs, mode, shard_wait(*a)), partial);
       print_boxes(r, a->json);
@@ -143,15 +160,7 @@ void register_box(CLI::App& parent) {
     }
     auto client = connect(*a);
     if (*region) {
-      if (bs.size() != 1) throw CLI::ValidationError("--region", "takes exactly one box");
-      const auto chunks = client->region(bs[0], *depth, *free, wait_for(*a));
-      if (a->json) write_region_json(std::cout, chunks);
-      if (refused(chunks.front())) std::exit(2);
-      if (!a->json)
-        for (const auto& c : chunks)
-          for (int i = 0; i < c.num_voxels; ++i)
-            std::cout << c.center_xyz[3 * i] << " " << c.center_xyz[3 * i + 1] << " " << c.center_xyz[3 * i + 2]
-                      << " depth " << int(c.depth[i]) << " " << state_name(c.state[i]) << "\n";
+      print_region(client->region(bs[0], *depth, *free, wait_for(*a)), a->json);
       return;
     }
     const int8_t mode = *any ? octomap_rt::box_query_t::MODE_ANY_OCCUPIED : octomap_rt::box_query_t::MODE_COUNTS;

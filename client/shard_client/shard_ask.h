@@ -21,6 +21,8 @@ const Reply& head(const Reply& r) {
 }
 inline const octomap_rt::distance_box_chunk_t& head(const DistanceBox& b) { return b.header; }
 inline const octomap_rt::grid_t& head(const Grid& g) { return g.header; }
+// A region list's is in its first chunk (the caller asks only for lists with one).
+inline const octomap_rt::region_chunk_t& head(const std::vector<octomap_rt::region_chunk_t>& c) { return c.front(); }
 
 // Runs ask(i) for every shard i in `which` side by side; each result or the reason it failed.
 template <class Reply>

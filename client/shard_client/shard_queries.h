@@ -16,6 +16,7 @@
 #include "protocol/shards/shard_set.h"
 #include "query_client/query_client.h"
 #include "shard_client/shard_distance.h"
+#include "shard_client/shard_region.h"
 
 namespace ort::client {
 
@@ -76,6 +77,9 @@ class ShardQueries {
   // A grid of a z band (shard_grid_edit.h): with a window, the shards owning a region in it; without,
   // every shard, merged on the union of their extents (the map's extent).
   Routed<Grid> grid(double z_min, double z_max, double cell_size, const Box* window, const ShardWait& w = {});
+  // A box's nodes at a depth (QueryClient::region; shard_region.h): from the shards owning a region
+  // the box meets, merged into one chunk, each node of the one map once.
+  Routed<octomap_rt::region_chunk_t> region(const Box& box, int depth, bool include_free, const ShardWait& w = {});
   // A map edit (QueryClient::edit) sent to the shards owning a region the box meets (every shard
   // for OP_RESET); reply status REPLY_OK when each applied it, else REPLY_NOT_READY with the
   // shards that did not (`shards.missing`: a refusal says why). Throws std::invalid_argument for

@@ -3,15 +3,18 @@
 // The CLI finds them by their statuses and merges their snapshots into one .bt that is OctoMap's
 // map of those scans; points and rays routed by region get OctoMap's answers, distances (points
 // with the gradient, a box, a path through the CLI) the distances on OctoMap's map, a band's grid
-// OctoMap's projected map, a query right after a scan that waits for it on every shard (read-your-
-// writes) OctoMap's map after it, a clear-box goes to the shard owning its box; with one shard
+// OctoMap's projected map, a box's nodes (region lists) OctoMap's nodes of the box, a query
+// right after a scan that waits for it on every shard (read-your-writes) OctoMap's map after it, a clear-box goes to the shard owning its box; with one shard
 // stopped, the map and the answers say they are partial and which shard is missing.
 #include <gtest/gtest.h>
 
 #include <signal.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <map>
 
 #include "core/clock.h"
 #include "distance/distance_queries.h"
@@ -19,9 +22,11 @@
 #include "octomap_rt/box_query_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "protocol/shards/shard_set.h"
+#include "query/key_box.h"
 #include "query/point_query.h"
 #include "query/projected_grid.h"
 #include "query/ray_query.h"
+#include "query/region_extract.h"
 #include "scene/scan_set.h"
 #include "shard_client/shard_queries.h"
 #include "shard_client/shard_roster.h"
@@ -194,6 +199,41 @@ TEST(ShardsIntegration, ThreeShardsServeOneMapAndSayWhenOneIsMissing) {
     for (size_t c = 0; c < want_grid.cells.size(); ++c)
       differing_cells += grid.reply.cells[c] != int8_t(want_grid.cells[c]);
     EXPECT_EQ(differing_cells, 0u) << "of " << want_grid.cells.size() << " cells";
+  }
+
+  // A box's nodes (region lists) from the shards owning a region of it: the box's voxels each in
+  // the state of its node, as in OctoMap's nodes of the box at that depth (begin_leafs_bbx), at
+  // the finest depth and at one coarser than the shards' regions (a node several shards hold
+  // parts of: occupied when any part is). Compared voxel by voxel: where OctoMap pruned
+  // siblings of different shards' regions into one leaf, the shards list the siblings.
+  {
+    const double lo[3] = {-2.0, -2.0, -0.4}, hi[3] = {2.0, 2.0, 0.8};
+    const client::Box region_box{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
+    const query::KeyBox kb = query::key_box(*reference, lo, hi);
+    using Voxels = std::map<std::array<int, 3>, int>;  // key -> state
+    auto add = [&](Voxels& v, int depth, const octomap::point3d& center, int state) {
+      const query::NodeCube c = query::node_cube(reference->coordToKey(center), unsigned(depth), 16);
+      for (int x = std::max<int>(c.lo[0], kb.min[0]); x <= std::min<int>(c.lo[0] + c.side - 1, kb.max[0]); ++x)
+        for (int y = std::max<int>(c.lo[1], kb.min[1]); y <= std::min<int>(c.lo[1] + c.side - 1, kb.max[1]); ++y)
+          for (int z = std::max<int>(c.lo[2], kb.min[2]); z <= std::min<int>(c.lo[2] + c.side - 1, kb.max[2]); ++z)
+            EXPECT_TRUE(v.emplace(std::array<int, 3>{x, y, z}, state).second) << "a voxel in two nodes";
+    };
+    for (const int depth : {0, 11}) {
+      const auto got = q.region(region_box, depth, true);
+      ASSERT_FALSE(got.shards.partial()) << got.shards.shortfall();
+      ASSERT_EQ(got.reply.status, 0) << got.reply.error;
+      query::RegionOptions ro;
+      ro.depth = depth, ro.include_free = true;
+      Voxels routed_voxels, want_voxels;
+      for (int32_t i = 0; i < got.reply.num_voxels; ++i)
+        add(routed_voxels, got.reply.depth[i],
+            {got.reply.center_xyz[3 * i], got.reply.center_xyz[3 * i + 1], got.reply.center_xyz[3 * i + 2]},
+            got.reply.state[i]);
+      for (const auto& v : query::extract_region(*reference, kb, ro)) add(want_voxels, v.depth, v.center, int(v.state));
+      EXPECT_GT(want_voxels.size(), 100u) << "depth " << depth;
+      EXPECT_TRUE(routed_voxels == want_voxels) << "depth " << depth << ": " << routed_voxels.size()
+                                                << " voxels routed, " << want_voxels.size() << " in OctoMap's map";
+    }
   }
 
   // Read-your-writes across the set: a scan shifted into space no scan saw, and at once a routed

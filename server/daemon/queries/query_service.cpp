@@ -7,13 +7,12 @@
 
 #include "core/clock.h"
 #include "core/errors.h"
+#include "daemon/distance_backend.h"
 #include "daemon/map/map_edit_item.h"
 #include "daemon/map/map_replica.h"
 #include "daemon/map/map_residency.h"
 #include "daemon/queries/edit_audit.h"
 #include "daemon/queries/query_footprint.h"
-#include "distance/squared_edt.h"
-#include "engine/distance_device.h"
 #include "octomap_rt/map_edit_ack_t.hpp"
 #include "octomap_rt/map_edit_t.hpp"
 #include "octomap_rt/occupancy_reply_t.hpp"
@@ -57,32 +56,9 @@ QueryService::QueryService(const QueryServiceConfig& cfg, MapState& map, ScanQue
       clients_(cfg.per_client_queue, cfg.max_clients, static_cast<int64_t>(cfg.client_idle_expiry_s * 1e6)),
       gate_({cfg.control_token, static_cast<int64_t>(cfg.edit_window_s * 1e6), cfg.max_edit_nonces}),
       grids_(cfg.grid, cfg.bounds, map, loop, server_id_) {
-  choose_distance_backend();
-}
-
-// cpu: CPU threads. vulkan: the device, or the server does not start. auto: the device
-// where it is a GPU (not a CPU implementation such as lavapipe), else CPU threads.
-void QueryService::choose_distance_backend() {
-  const DistanceServiceConfig& d = cfg_.distance;
-  if (d.backend != "cpu" && d.backend != "vulkan" && d.backend != "auto")
-    throw std::invalid_argument("--distance-backend must be cpu, vulkan or auto, not '" + d.backend + "'");
-  if (d.backend != "cpu") {
-    try {
-      EdtDevice device = open_edt_device(d.device);
-      if (d.backend == "vulkan" || !device.cpu_implementation) {
-        DeviceEdt run = std::move(device.run);
-        edt_ = [run](std::span<const uint8_t> occ, distance::GridDims g, std::span<uint32_t> out) {
-          run(occ, g.nx, g.ny, g.nz, out);
-        };
-        distance_backend_ = "vulkan (" + device.name + ")";
-        return;
-      }
-    } catch (const Unsupported&) {
-      if (d.backend == "vulkan") throw;
-    }
-  }
-  edt_ = distance::cpu_edt(std::max(1, d.threads));
-  distance_backend_ = "cpu (" + std::to_string(std::max(1, d.threads)) + " threads)";
+  DistanceBackend backend = choose_distance_backend(cfg.distance.backend, cfg.distance.device, cfg.distance.threads);
+  edt_ = std::move(backend.edt);
+  distance_backend_ = std::move(backend.name);
 }
 
 QueryService::~QueryService() { stop(); }

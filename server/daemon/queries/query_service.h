@@ -76,7 +76,6 @@ class QueryService {
   bool answer_locked(PendingQuery& q, std::vector<EncodedReplies>& out);
   void answer_restoring(std::vector<PendingQuery>& parked, std::vector<EncodedReplies>& out);
   void publish(const EncodedReplies& r);
-  void choose_distance_backend();
 
   QueryServiceConfig cfg_;
   MapState& map_;
