@@ -7,10 +7,10 @@
 
 #include "core/clock.h"
 #include "core/errors.h"
-#include "daemon/distance_backend.h"
 #include "daemon/map/map_edit_item.h"
 #include "daemon/map/map_replica.h"
 #include "daemon/map/map_residency.h"
+#include "daemon/queries/distance_flags.h"
 #include "daemon/queries/edit_audit.h"
 #include "daemon/queries/query_footprint.h"
 #include "octomap_rt/map_edit_ack_t.hpp"
