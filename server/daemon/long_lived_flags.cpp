@@ -30,6 +30,11 @@ void add_long_lived_flags(CLI::App& app, ServerConfig& c) {
                  "octree bytes kept in memory (e.g. 512MiB; 0: no bound); past them the least recently touched "
                  "regions go to FILE.ot.regions/ until touched")
       ->transform(CLI::AsSizeValue(false));
+  app.add_option("--working-set-seconds", c.working_set_s,
+                 "with --max-map-memory: below the bound, regions touched within this many seconds stay in memory; 0: "
+                 "50x the longest mean interval between two scans of one robot, within 1..120 s (5 s until a robot's "
+                 "second scan)")
+      ->capture_default_str();
   app.add_option("--evict-depth", c.evict_depth,
                  "octree depth of the regions --max-map-memory evicts and restores, --region-depth..16 (0: one "
                  "below --region-depth: 32 voxels a side)")
@@ -44,6 +49,8 @@ void check_long_lived_flags(const ServerConfig& c) {
   } catch (const std::invalid_argument& e) {
     throw CLI::ValidationError("upkeep", e.what());
   }
+  if (const std::string bad = working_set_problem(c.working_set_s); !bad.empty())
+    throw CLI::ValidationError("--working-set-seconds", bad);
   if (const std::string bad = memory_bound_problem(c); !bad.empty())
     throw CLI::ValidationError("--max-map-memory", bad);
 }

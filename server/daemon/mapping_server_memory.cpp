@@ -24,7 +24,8 @@ const MapLoadBound* MappingServer::map_load_bound() {
     log_.info(text("removed ", left.size(), " regions a previous run left in ", dir,
                    " (the map file holds the map as it was saved)"));
   const RegionGrid grid = region_grid(evict_region_depth(cfg_));
-  residency_ = std::make_unique<MapResidency>(map_, grid, *region_store_, cfg_.max_map_memory, log_);
+  residency_ =
+      std::make_unique<MapResidency>(map_, grid, *region_store_, cfg_.max_map_memory, log_, cfg_.working_set_s);
   // The file's regions past the low-water mark go straight to the store as it loads.
   load_bound_ =
       MapLoadBound{grid, static_cast<uint64_t>(MapResidency::kLowWater * double(cfg_.max_map_memory)),

@@ -15,11 +15,18 @@ uint64_t automatic_queue_budget() {
   return std::clamp<uint64_t>(phys / 64, 64ull << 20, 1ull << 30);
 }
 
+std::string working_set_problem(double seconds) {
+  constexpr double kMaxSeconds = 30 * 86400.0;
+  if (seconds == 0 || (seconds > 0 && seconds <= kMaxSeconds)) return "";  // NaN fails both
+  return "--working-set-seconds must be 0 (the scan rate's) or seconds in (0, 2592000]";
+}
+
 std::string memory_bound_problem(const ServerConfig& c) {
   constexpr uint64_t kMin = uint64_t(1) << 20, kMax = uint64_t(1) << 50;
   if (c.max_map_memory == 0) return "";
   if (c.max_map_memory < kMin || c.max_map_memory > kMax)
     return "must be 0 (no bound) or a number of bytes in [1 MiB, 2^50]";
+  if (const std::string bad = working_set_problem(c.working_set_s); !bad.empty()) return bad;
   if (c.region_store_max_bytes < kMin || c.region_store_max_bytes > kMax)
     return "--region-store-max must be a number of bytes in [1 MiB, 2^50]";
   if (c.evict_depth != 0 && (c.evict_depth < c.upkeep.region_depth || c.evict_depth > 16))

@@ -83,6 +83,10 @@ struct ServerConfig {
   // The memory bound (daemon/map/map_residency.h): past this many bytes of tree, the least
   // recently touched regions (--evict-depth) go to FILE.ot.regions/; 0: no bound.
   uint64_t max_map_memory = 0;
+  // Its working set (--working-set-seconds): below the bound, regions touched within this many
+  // seconds stay in memory (octree/residency/working_set_window.h); 0: T follows the robots'
+  // scan rate.
+  double working_set_s = 0;
   uint64_t region_store_max_bytes = uint64_t(1) << 40;  // the store's own bound on disk
   // Depth of the regions the bound evicts and restores: finer than decay's and clearing's
   // regions (--region-depth), so that a scan brings back little more than it sees; 0: one
@@ -119,6 +123,8 @@ struct ServerConfig {
 // below 1 MiB or past 2^50 bytes, no --map for the store to live beside, a --grid-rate whose
 // whole-map grid would bring every spilled region back each period).
 std::string memory_bound_problem(const ServerConfig& c);
+// "" when `seconds` is a --working-set-seconds the bound can use (0, or in (0, 30 days]).
+std::string working_set_problem(double seconds);
 // The depth the memory bound evicts at (ServerConfig::evict_depth, 0 resolved).
 unsigned evict_region_depth(const ServerConfig& c);
 // The depth of the read replica's version regions (ServerConfig::replica_version_depth, 0 resolved).

@@ -70,8 +70,10 @@ void RegionResidency::restore(octomap::OcTree& tree, RegionId id) {
 
 void RegionResidency::touch(octomap::OcTree& tree, std::span<const RegionId> ids) {
   ++tick_;
+  const WorkingSetWindow::TimePoint now = working_set_.now();
   for (RegionId id : ids) {
     last_touch_[id] = tick_;
+    working_set_.touch(id, now);
     tally_.changed(id);  // about to be read or changed
     if (spilled_.empty()) continue;
     // The region and its parent's other children (region_residency.h says why).
@@ -121,7 +123,7 @@ uint64_t inner_nodes(const std::vector<uint8_t>& encoded) {
 size_t RegionResidency::enforce(octomap::OcTree& tree) { return enforce(tree, memory(tree), max_bytes_).regions; }
 
 EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, uint64_t target, size_t max_groups,
-                                       double budget_ms, uint64_t min_idle) {
+                                       double budget_ms, bool idle_only) {
   EnforceResult result;
   const auto start = SteadyClock::now();
   std::string write_error;  // a background put that failed: thrown after this pass
@@ -143,19 +145,27 @@ EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, ui
     uint64_t touched;
     RegionId group, id;
   };
+  struct GroupTouch {
+    uint64_t tick = 0;
+    WorkingSetWindow::TimePoint at = WorkingSetWindow::TimePoint::min();
+  };
   const auto listing = SteadyClock::now();
   std::vector<Candidate> candidates;
-  std::unordered_map<RegionId, uint64_t> group_touched;
+  std::unordered_map<RegionId, GroupTouch> group_touched;
   for_each_region(tree, grid_, [&](RegionId id, const RegionNode& r) {
     if (r.depth != grid_.depth || !tree.nodeHasChildren(r.node)) return;  // coarse leaves, stand-ins
     auto it = last_touch_.find(id);
     const uint64_t touched = it == last_touch_.end() ? 0 : it->second;
     const RegionId group = sibling_group(id);
-    uint64_t& g = group_touched[group];
-    g = std::max(g, touched);
+    GroupTouch& g = group_touched[group];
+    g.tick = std::max(g.tick, touched);
+    if (idle_only) g.at = std::max(g.at, working_set_.last_touch(id));
     candidates.push_back({touched, group, id});
   });
-  for (Candidate& c : candidates) c.touched = group_touched[c.group];
+  for (Candidate& c : candidates) c.touched = group_touched[c.group].tick;
+  // One clock reading for the whole pass: a group is idle when its latest touch is at or
+  // before it.
+  const WorkingSetWindow::TimePoint idle_before = working_set_.idle_before();
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
     if (a.touched != b.touched) return a.touched < b.touched;
     return a.group != b.group ? a.group < b.group : a.id < b.id;
@@ -167,7 +177,8 @@ EnforceResult RegionResidency::enforce(octomap::OcTree& tree, uint64_t bytes, ui
   for (const Candidate& c : candidates) {
     if (c.group != group) {  // whole groups only: stop between two
       if (bytes <= target || groups == max_groups) break;
-      if (min_idle > 0 && c.touched + min_idle > tick_) break;  // the rest were touched later still
+      // Groups are in touch order and the clock never goes back: every later group is in use too.
+      if (idle_only && group_touched[c.group].at > idle_before) break;
       // The budget cuts the way from the bound down to `target`, never the way to the bound.
       if (budget_ms > 0 && groups > 0 && bytes <= max_bytes_ && ms_since(start) >= budget_ms) break;
       group = c.group;

@@ -30,6 +30,7 @@
 #include "octree/region_codec.h"
 #include "octree/region_sweep.h"
 #include "octree/region_tally.h"
+#include "octree/residency/working_set_window.h"
 
 namespace ort {
 
@@ -119,11 +120,18 @@ class RegionResidency {
   // `budget_ms` (> 0) ends the call between two groups once that much time has gone and the
   // memory is within the bound (at least one group goes): a caller that spreads the way from
   // the bound down to `target` over several calls.
-  // `min_idle` (> 0): only sibling groups no touch has reached in the last `min_idle` touches
-  // go (a caller below the bound that leaves the regions in use alone: under the bound,
-  // spilling a region the next scans touch again only moves it back and forth).
+  // `idle_only`: only sibling groups none of whose regions is in the working set go (a caller
+  // that leaves the regions in use alone: spilling a region the next scans touch again only
+  // moves it back and forth).
   EnforceResult enforce(octomap::OcTree& tree, uint64_t bytes_now, uint64_t target, size_t max_groups = SIZE_MAX,
-                        double budget_ms = 0, uint64_t min_idle = 0);
+                        double budget_ms = 0, bool idle_only = false);
+  // The regions in use (octree/residency/working_set_window.h): touch() touches them, scans
+  // feed its rate (working_set().scan()).
+  WorkingSetWindow& working_set() { return working_set_; }
+  const WorkingSetWindow& working_set() const { return working_set_; }
+  // Replaces the window (its T, its clock); call before the first touch: the regions touched
+  // until now count as never touched by the new one.
+  void set_working_set(WorkingSetWindow w) { working_set_ = std::move(w); }
   // The bytes of spilled region `id` (the store's, or a pending region's encoded from its
   // kept nodes). Call while nothing changes the tree (any lock that keeps writers out).
   std::vector<uint8_t> spilled_bytes(RegionId id) const;
@@ -202,8 +210,9 @@ class RegionResidency {
   RegionSpill& spill_;
   uint64_t max_bytes_;
   std::function<void(DetachedSubtree)> free_later_;
-  uint64_t tick_ = 0;
+  uint64_t tick_ = 0;  // orders touches (the clock may read the same for several)
   std::unordered_map<RegionId, uint64_t> last_touch_;
+  WorkingSetWindow working_set_;
   std::unordered_map<RegionId, uint64_t> spilled_;  // id -> bytes spilled
   std::unordered_map<RegionId, std::vector<std::shared_ptr<const RegionStep>>> owed_;
   uint64_t owed_now_ = 0;  // steps in owed_

@@ -175,6 +175,7 @@ void RegionResidency::drop(RegionId id) {
     owed_.erase(o);
   }
   last_touch_.erase(id);
+  working_set_.forget(id);
   tally_.changed(id);
   stats_.dropped++;
 }

@@ -34,6 +34,10 @@ octomap_rt_add_test(eviction_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/eviction_tes
   LIBS octomap_rt_query
   TIMEOUT 300)
 
+# The memory bound's working set (octree/residency/working_set_window.h) on a stepped clock.
+octomap_rt_add_test(working_set_window_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/working_set_window_test.cpp
+                    LIBS octomap_rt_octree TIMEOUT 60)
+
 # Versions kept per region (octree/versions/map_version.h), what whole-map readers read: OctoMap's .ot
 # byte for byte after every real scan and while nodes above the region depth prune and expand.
 octomap_rt_add_test(map_version_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_version_test.cpp

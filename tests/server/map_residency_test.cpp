@@ -3,11 +3,13 @@
 // the update runs reports), stays within 10 % of the bound; a .bt --prior larger than the
 // bound is loaded within it. Both compared with OctoMap's own map on real data.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -18,6 +20,8 @@
 #include "daemon/map/map_state.h"
 #include "octree/octree_update.h"
 #include "octree/real_scan_voxels.h"
+#include "octree/region.h"
+#include "octree/residency/working_set_window.h"
 #include "query/key_box.h"
 #include "server/scan_fixtures.h"
 #include "support/memory_spill.h"
@@ -125,6 +129,88 @@ TEST(MapResidency, RegionsInUseStayWithinTheOvershoot) {
   EXPECT_EQ(st.restores, 0u) << "regions in use went back and forth";
   EXPECT_GT(st.hot_overshoots, 0u) << "the passes above the bound are counted";
   const TreeDiff d = compare_leaves(*map.tree, unbounded);
+  EXPECT_TRUE(d.maps_equal()) << d.differing_voxels << " voxels differ: " << d.first_difference;
+}
+
+// Four robots at about 16 Hz each (a scan every 60 ms of a stepped clock, staggered), each
+// going round its own quarter of the wedges: a robot is back at a wedge after 18 of its scans,
+// 1.08 s and 72 changes of the map later. The working set's T follows the rate (50 x 60 ms =
+// 3 s), so every region is in use all along: under a bound just below the map (1/1.05 of it,
+// within the overshoot) nothing is evicted and nothing comes back, though more than 64 changes
+// pass between two touches of a region (the rule before, "in use = touched in the last 64
+// changes", evicted them and the robot brought them back 1.08 s later). Then robots 1-3 stop
+// and robot 0 goes on alone for 4 s: their regions, idle past T, are evicted; none robot 0
+// touched within T is. The map = OctoMap's.
+TEST(MapResidency, TheWorkingSetIsTheLastSecondsNotTheLastChanges) {
+  const std::vector<VoxelList> lists = wedge_scans();
+  constexpr size_t kRobots = 4;
+  const size_t per_robot = lists.size() / kRobots;
+  ASSERT_GE(per_robot * kRobots, 65u) << "a robot's round must span more than 64 changes";
+  struct Scan {
+    size_t robot;
+    const VoxelList* voxels;
+  };
+  std::vector<Scan> together, alone;  // all four robots twice round; then robot 0 alone, 4 s
+  for (size_t round = 0; round < 2 * per_robot; ++round)
+    for (size_t r = 0; r < kRobots; ++r) together.push_back({r, &lists[r * per_robot + round % per_robot]});
+  for (size_t i = 0; i < 4000 / 60; ++i) alone.push_back({0, &lists[i % per_robot]});
+
+  octomap::OcTree unbounded(0.1);
+  OctreeStage stage(OctreeUpdateOptions{OctreeUpdateMode::kBatched, 2});
+  uint64_t peak = 0;
+  for (const Scan& s : together) {
+    stage.apply(unbounded, *s.voxels);
+    peak = std::max<uint64_t>(peak, unbounded.memoryUsage());
+  }
+  for (const Scan& s : alone) stage.apply(unbounded, *s.voxels);
+  const auto bound = static_cast<uint64_t>(double(peak) / 1.05);
+
+  daemon::MapState map;
+  map.tree = std::make_unique<octomap::OcTree>(0.1);
+  MemorySpill spill;
+  const RegionGrid grid = region_grid(daemon::evict_region_depth(test_config(0.1, true)));
+  std::ostringstream log;
+  daemon::MapResidency residency(map, grid, spill, bound, Log(log));
+  WorkingSetWindow::TimePoint now{};
+  residency.set_working_set(WorkingSetWindow(0, [&now] { return now; }));
+  const auto step = std::chrono::duration_cast<SteadyClock::duration>(std::chrono::milliseconds(60));
+  auto apply = [&](const Scan& s, SteadyClock::duration between) {
+    now += between;
+    std::string error;
+    ASSERT_TRUE(residency.touch_scan(*map.tree, *s.voxels, error, "robot-" + std::to_string(s.robot))) << error;
+    stage.apply(*map.tree, *s.voxels);
+    residency.enforce(*map.tree);
+  };
+  uint64_t most = 0;
+  for (const Scan& s : together) {
+    apply(s, step / kRobots);
+    most = std::max<uint64_t>(most, map.tree->memoryUsage());
+  }
+  EXPECT_NEAR(residency.working_set_seconds(), 3.0, 1e-6) << "50 x a robot's 60 ms";
+  daemon::MapResidencyStats st = residency.stats();
+  EXPECT_GT(most, bound) << "the map must pass the bound for the rule to matter";
+  EXPECT_EQ(st.evictions, 0u) << "regions touched within the last " << residency.working_set_seconds()
+                              << " s were evicted";
+  EXPECT_EQ(st.restores, 0u) << "regions in use went back and forth";
+
+  std::vector<WorkingSetWindow::TimePoint> touched_at;
+  for (const Scan& s : alone) {
+    apply(s, step);
+    touched_at.push_back(now);
+  }
+  st = residency.stats();
+  EXPECT_GT(st.evictions, 0u) << "the regions of the robots that stopped, idle for over 3 s, stay in memory";
+  std::unordered_set<RegionId> spilled;
+  for (const auto& r : residency.spilled_regions()) spilled.insert(r.id);
+  const auto window = std::chrono::duration_cast<SteadyClock::duration>(std::chrono::seconds(3));
+  for (size_t i = 0; i < alone.size(); ++i) {
+    if (touched_at[i] <= now - window) continue;
+    for (const VoxelUpdate& v : *alone[i].voxels)
+      ASSERT_EQ(spilled.count(region_of(grid, v.key())), 0u) << "a region robot 0 touched within T was evicted";
+  }
+  octomap::OcTree whole(*map.tree);
+  daemon::MapResidency::fill_copy(whole, grid, residency.spilled_regions());
+  const TreeDiff d = compare_leaves(whole, unbounded);
   EXPECT_TRUE(d.maps_equal()) << d.differing_voxels << " voxels differ: " << d.first_difference;
 }
 

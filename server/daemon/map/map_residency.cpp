@@ -11,7 +11,8 @@
 
 namespace ort::daemon {
 
-MapResidency::MapResidency(MapState& map, const RegionGrid& grid, RegionSpill& spill, uint64_t max_bytes, Log log)
+MapResidency::MapResidency(MapState& map, const RegionGrid& grid, RegionSpill& spill, uint64_t max_bytes, Log log,
+                           double working_set_s)
     : map_(map),
       grid_(grid),
       max_bytes_(max_bytes),
@@ -20,6 +21,7 @@ MapResidency::MapResidency(MapState& map, const RegionGrid& grid, RegionSpill& s
       reaper_(std::max<uint64_t>(uint64_t(1) << 16, max_bytes / 4 / sizeof(octomap::OcTreeNode))),
       residency_(grid, spill, max_bytes) {
   stats_.max_bytes = max_bytes;
+  residency_.set_working_set(WorkingSetWindow(working_set_s));
   residency_.set_free_later([this](DetachedSubtree d) { reaper_.push(d); });
   // Encoding and the store's writes go to the residency's writer thread: an eviction on
   // stage 2 only counts and detaches a region's nodes. As many may wait as the reaper holds.
@@ -103,9 +105,21 @@ std::string residency_cost_line(const MapResidencyStats& a, const MapResidencySt
   return line;
 }
 
-bool MapResidency::touch_scan(octomap::OcTree& tree, std::span<const VoxelUpdate> voxels, std::string& error) {
+void MapResidency::set_working_set(WorkingSetWindow w) {
+  std::lock_guard lock(mutex_);
+  residency_.set_working_set(std::move(w));
+}
+
+double MapResidency::working_set_seconds() const {
+  std::lock_guard lock(mutex_);
+  return residency_.working_set().seconds();
+}
+
+bool MapResidency::touch_scan(octomap::OcTree& tree, std::span<const VoxelUpdate> voxels, std::string& error,
+                              std::string_view robot) {
   std::lock_guard lock(mutex_);
   const auto t0 = SteadyClock::now();
+  residency_.working_set().scan(robot);
   const uint64_t before = residency_.stats().restores;
   try {
     residency_.touch_voxels(tree, voxels);
@@ -227,7 +241,7 @@ void MapResidency::enforce_locked(octomap::OcTree& tree, bool exact) {
     try {
       // Idle groups first, whichever side of the bound (to the low-water mark past it).
       const EnforceResult idle =
-          residency_.enforce(tree, bytes, groups == 1 ? soft : target, groups, kSliceMs, kSoftIdle);
+          residency_.enforce(tree, bytes, groups == 1 ? soft : target, groups, kSliceMs, /*idle_only=*/true);
       listed = idle.listed;
       regions = idle.regions;
       const uint64_t left = bytes - std::min(bytes, idle.bytes_freed);

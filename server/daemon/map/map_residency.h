@@ -16,8 +16,9 @@
 // the nodes above the region depth and the regions changed since the last count are walked)
 // when the running estimate (nodes times the bytes a node took at the last count) passes the bound;
 // eviction then goes down to kLowWater of the bound. Between kSoftStart and the bound each
-// change spills one idle sibling group (kSoftIdle) by the estimate alone (no walk), so the map rarely gets
-// there: the cost is spread over the scans (docs/BENCHMARKS.md "The memory bound").
+// change spills one idle sibling group (none touched within the working set's T seconds:
+// octree/residency/working_set_window.h) by the estimate alone (no walk), so the map rarely
+// gets there: the cost is spread over the scans (docs/BENCHMARKS.md "The memory bound").
 #pragma once
 
 #include <cstdint>
@@ -25,6 +26,7 @@
 #include <mutex>
 #include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -79,10 +81,10 @@ class MapResidency {
   // back to the bound itself is never cut. Eviction only counts and detaches nodes (the
   // writer thread encodes and stores them).
   static constexpr double kSliceMs = 3;
-  // Between kSoftStart and the bound only regions no change touched in the last kSoftIdle
-  // changes go: spilling what the robots are mapping only to bring it back a scan later is
-  // all cost and no room (the bound itself is enforced whatever the regions' age).
-  static constexpr uint64_t kSoftIdle = 64;
+  // Between kSoftStart and the bound only regions outside the working set (none of the group
+  // touched in the last T seconds: octree/residency/working_set_window.h) go: spilling what
+  // the robots are mapping only to bring it back a scan later is all cost and no room (the
+  // bound itself is enforced whatever the regions' age, below).
   // Past the bound the idle groups go first; when only regions in use are left the map stays
   // above the bound, up to kHotOvershoot of it, rather than spill what the next scans bring
   // back (the soak's ping-pong, docs/BENCHMARKS.md 'Memory bound'); past that they go too,
@@ -91,12 +93,19 @@ class MapResidency {
   // How often the cost breakdown is logged while regions move.
   static constexpr double kCostReportS = 10;
 
-  MapResidency(MapState& map, const RegionGrid& grid, RegionSpill& spill, uint64_t max_bytes, Log log);
+  // `working_set_s` (--working-set-seconds): the working set's T; 0: it follows the scan rate.
+  MapResidency(MapState& map, const RegionGrid& grid, RegionSpill& spill, uint64_t max_bytes, Log log,
+               double working_set_s = 0);
 
   // Under the exclusive map lock. Brings back the scan's regions; false (with `error`) when
   // the store could not give one back: the scan must not be applied (its region would be
-  // updated as a coarse leaf).
-  bool touch_scan(octomap::OcTree& tree, std::span<const VoxelUpdate> voxels, std::string& error);
+  // updated as a coarse leaf). `robot` (the scan's robot id) feeds the working set's rate.
+  bool touch_scan(octomap::OcTree& tree, std::span<const VoxelUpdate> voxels, std::string& error,
+                  std::string_view robot = {});
+  // Replaces the working set's window (a fixed T, a test's clock); before the first scan.
+  void set_working_set(WorkingSetWindow w);
+  // The working set's T now, in seconds.
+  double working_set_seconds() const;
   // Under the exclusive map lock: brings back every region meeting the boxes (queries, edits).
   // Throws RegionStoreError-like std::runtime_error when the store refuses.
   void touch_boxes(octomap::OcTree& tree, std::span<const query::KeyBox> boxes);

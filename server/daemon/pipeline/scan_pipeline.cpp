@@ -248,7 +248,7 @@ bool ScanPipeline::apply(ShotJob& job) {
     const char* waited_for = map_.holders.last_released();
     const MapHoldNote note(map_.holders, "scan update (stage 2)");
     // Spilled regions the scan updates come back first (daemon/map/map_residency.h).
-    if (std::string why; map_.residency && !map_.residency->touch_scan(*map_.tree, job.shot.voxels, why))
+    if (std::string why; map_.residency && !map_.residency->touch_scan(*map_.tree, job.shot.voxels, why, job.robot_id))
       throw std::runtime_error(why);
     const auto nodes_before = static_cast<int64_t>(map_.tree->size());
     const bool log_changes = map_.observer || (map_.journal && map_.journal->armed());
