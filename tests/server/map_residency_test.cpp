@@ -46,6 +46,19 @@ std::vector<VoxelList> wedge_scans() {
                           });
 }
 
+// The working set's clock (octree/residency/working_set_window.h), stepped by the test: which
+// regions are in use never depends on how fast the machine runs the scans. One robot at 10 Hz
+// by default: T = 5 s, a wedge's regions in use for the next 50 scans.
+struct SteppedClock {
+  WorkingSetWindow::TimePoint now{};
+  void step(std::chrono::milliseconds ms = std::chrono::milliseconds(100)) {
+    now += std::chrono::duration_cast<SteadyClock::duration>(ms);
+  }
+  WorkingSetWindow window() {
+    return WorkingSetWindow(0, [this] { return now; });
+  }
+};
+
 // Stage 2's order (touch, update, enforce) over the wedges twice, under a bound 3/4 of the
 // map: the second pass brings regions back before each update.
 TEST(MapResidency, RestoresMakeRoomBeforeTheUpdate) {
@@ -63,11 +76,14 @@ TEST(MapResidency, RestoresMakeRoomBeforeTheUpdate) {
   const RegionGrid grid = region_grid(daemon::evict_region_depth(test_config(0.1, true)));  // the daemon's
   std::ostringstream log;
   daemon::MapResidency residency(map, grid, spill, bound, Log(log));
+  SteppedClock clock;
+  residency.set_working_set(clock.window());
   uint64_t most_after_restores = 0;
   size_t scans = 0, above = 0;
   for (int pass = 0; pass < 2; ++pass) {
     for (const VoxelList& l : lists) {
       std::string error;
+      clock.step();
       ASSERT_TRUE(residency.touch_scan(*map.tree, l, error)) << error;
       most_after_restores = std::max<uint64_t>(most_after_restores, map.tree->memoryUsage());
       ++scans;
@@ -90,8 +106,8 @@ TEST(MapResidency, RestoresMakeRoomBeforeTheUpdate) {
   EXPECT_TRUE(d.maps_equal()) << d.differing_voxels << " voxels differ: " << d.first_difference;
 }
 
-// Scans that keep mapping the same place (32 wedges, twice: every region was touched by one of
-// the last 32 scans, all of them in use by the daemon's rule) under a bound just below their
+// Scans that keep mapping the same place (32 wedges, twice, 10 Hz: every region was touched in
+// the last 3.2 s, all of them in use by the daemon's rule, T = 5 s) under a bound just below their
 // map (1/1.05 of it): the map stays above the bound, within kHotOvershoot of it, and nothing
 // is evicted, so nothing comes back (before the rule a pass past the bound took regions in
 // use down to kLowWater and the next scans restored them); the map = OctoMap's.
@@ -111,10 +127,13 @@ TEST(MapResidency, RegionsInUseStayWithinTheOvershoot) {
   const RegionGrid grid = region_grid(daemon::evict_region_depth(test_config(0.1, true)));
   std::ostringstream log;
   daemon::MapResidency residency(map, grid, spill, bound, Log(log));
+  SteppedClock clock;
+  residency.set_working_set(clock.window());
   uint64_t most = 0;
   for (int pass = 0; pass < 2; ++pass) {
     for (const VoxelList& l : lists) {
       std::string error;
+      clock.step();
       ASSERT_TRUE(residency.touch_scan(*map.tree, l, error)) << error;
       stage.apply(*map.tree, l);
       residency.enforce(*map.tree);
@@ -171,11 +190,11 @@ TEST(MapResidency, TheWorkingSetIsTheLastSecondsNotTheLastChanges) {
   const RegionGrid grid = region_grid(daemon::evict_region_depth(test_config(0.1, true)));
   std::ostringstream log;
   daemon::MapResidency residency(map, grid, spill, bound, Log(log));
-  WorkingSetWindow::TimePoint now{};
-  residency.set_working_set(WorkingSetWindow(0, [&now] { return now; }));
-  const auto step = std::chrono::duration_cast<SteadyClock::duration>(std::chrono::milliseconds(60));
-  auto apply = [&](const Scan& s, SteadyClock::duration between) {
-    now += between;
+  SteppedClock clock;
+  residency.set_working_set(clock.window());
+  const std::chrono::milliseconds step(60);
+  auto apply = [&](const Scan& s, std::chrono::milliseconds between) {
+    clock.step(between);
     std::string error;
     ASSERT_TRUE(residency.touch_scan(*map.tree, *s.voxels, error, "robot-" + std::to_string(s.robot))) << error;
     stage.apply(*map.tree, *s.voxels);
@@ -186,6 +205,7 @@ TEST(MapResidency, TheWorkingSetIsTheLastSecondsNotTheLastChanges) {
     apply(s, step / kRobots);
     most = std::max<uint64_t>(most, map.tree->memoryUsage());
   }
+  ASSERT_FALSE(HasFatalFailure());
   EXPECT_NEAR(residency.working_set_seconds(), 3.0, 1e-6) << "50 x a robot's 60 ms";
   daemon::MapResidencyStats st = residency.stats();
   EXPECT_GT(most, bound) << "the map must pass the bound for the rule to matter";
@@ -196,15 +216,16 @@ TEST(MapResidency, TheWorkingSetIsTheLastSecondsNotTheLastChanges) {
   std::vector<WorkingSetWindow::TimePoint> touched_at;
   for (const Scan& s : alone) {
     apply(s, step);
-    touched_at.push_back(now);
+    touched_at.push_back(clock.now);
   }
+  ASSERT_FALSE(HasFatalFailure());
   st = residency.stats();
   EXPECT_GT(st.evictions, 0u) << "the regions of the robots that stopped, idle for over 3 s, stay in memory";
   std::unordered_set<RegionId> spilled;
   for (const auto& r : residency.spilled_regions()) spilled.insert(r.id);
   const auto window = std::chrono::duration_cast<SteadyClock::duration>(std::chrono::seconds(3));
   for (size_t i = 0; i < alone.size(); ++i) {
-    if (touched_at[i] <= now - window) continue;
+    if (touched_at[i] <= clock.now - window) continue;
     for (const VoxelUpdate& v : *alone[i].voxels)
       ASSERT_EQ(spilled.count(region_of(grid, v.key())), 0u) << "a region robot 0 touched within T was evicted";
   }
@@ -231,8 +252,11 @@ TEST(MapResidency, QueryRestoresMakeRoomBeforeTheQueryReads) {
   const RegionGrid grid = region_grid(daemon::evict_region_depth(test_config(0.1, true)));
   std::ostringstream log;
   daemon::MapResidency residency(map, grid, spill, bound, Log(log));
+  SteppedClock clock;
+  residency.set_working_set(clock.window());
   for (const VoxelList& l : lists) {
     std::string error;
+    clock.step();
     ASSERT_TRUE(residency.touch_scan(*map.tree, l, error)) << error;
     stage.apply(*map.tree, l);
     residency.enforce(*map.tree);
@@ -249,6 +273,7 @@ TEST(MapResidency, QueryRestoresMakeRoomBeforeTheQueryReads) {
         box.min[a] = static_cast<uint16_t>(c[a] - 20);
         box.max[a] = static_cast<uint16_t>(c[a] + 20);
       }
+      clock.step();
       residency.touch_boxes(*map.tree, std::span<const query::KeyBox>(&box, 1));
       ASSERT_FALSE(residency.any_spilled_in(std::span<const query::KeyBox>(&box, 1))) << "the query reads it all";
       ++queries;

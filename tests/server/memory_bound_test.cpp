@@ -384,6 +384,12 @@ TEST(MemoryBound, FlagsThatCannotWorkAreRefusedWithTheirReason) {
   EXPECT_NE(daemon::memory_bound_problem(cfg).find("--evict-depth"), std::string::npos);
   cfg.evict_depth = 0;
   EXPECT_EQ(daemon::evict_region_depth(cfg), cfg.upkeep.region_depth + 1);
+  cfg.working_set_s = std::nan("");
+  EXPECT_NE(daemon::memory_bound_problem(cfg).find("--working-set-seconds"), std::string::npos);
+  cfg.working_set_s = -1;
+  EXPECT_NE(daemon::memory_bound_problem(cfg).find("--working-set-seconds"), std::string::npos);
+  cfg.working_set_s = 30;
+  EXPECT_EQ(daemon::memory_bound_problem(cfg), "");
   cfg.queries.grid.rate_hz = 1;
   EXPECT_NE(daemon::memory_bound_problem(cfg).find("--grid-rate"), std::string::npos);
 }

@@ -69,6 +69,9 @@ TEST(ServerFlags, AbsurdNumbersForTheWalkAndTheSensorModelAreRefusedAtStart) {
       // Shard regions: depth 0 and past the octree's 16 levels.
       {"-r 0.1 --shard 0/2 --shard-region-depth 0", "--shard-region-depth"},
       {"-r 0.1 --shard 0/2 --shard-region-depth 17", "--shard-region-depth"},
+      // The memory bound's working set: NaN, negative.
+      {"-r 0.1 --working-set-seconds nan", "--working-set-seconds"},
+      {"-r 0.1 --working-set-seconds -1", "--working-set-seconds"},
   };
   for (const auto& c : cases) {
     const ServerRun r = run_server(c.flags);
