@@ -83,8 +83,8 @@ class MapResidency {
   static constexpr double kSliceMs = 3;
   // Between kSoftStart and the bound only regions outside the working set (none of the group
   // touched in the last T seconds: octree/residency/working_set_window.h) go: spilling what
-  // the robots are mapping only to bring it back a scan later is all cost and no room (the
-  // bound itself is enforced whatever the regions' age, below).
+  // the robots are mapping only to bring it back a scan later is all cost and no room (past
+  // kHotOvershoot the regions in use go too, below).
   // Past the bound the idle groups go first; when only regions in use are left the map stays
   // above the bound, up to kHotOvershoot of it, rather than spill what the next scans bring
   // back (the soak's ping-pong, docs/BENCHMARKS.md 'Memory bound'); past that they go too,
