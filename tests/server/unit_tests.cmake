@@ -60,6 +60,9 @@ octomap_rt_add_test(map_upkeep_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_upkeep
 octomap_rt_add_test(memory_bound_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/memory_bound_test.cpp ${SERVER_TEST_FIXTURES}
                     LIBS octomap_rt_daemon TIMEOUT 300)
 octomap_rt_lcm_handler_sources(memory_bound_test ${CMAKE_CURRENT_LIST_DIR}/memory_bound_test.cpp)
+# The memory bound with two robots over memq://: the map with eviction is OctoMap's, whatever the working set.
+octomap_rt_add_test(memory_bound_robots_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/memory_bound_robots_test.cpp
+                    ${SERVER_TEST_FIXTURES} LIBS octomap_rt_daemon TIMEOUT 300)
 # The memory bound's edges: the map's memory right after a scan's restores, a .bt prior past the bound.
 octomap_rt_add_test(map_residency_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_residency_test.cpp ${SERVER_TEST_FIXTURES}
                     $<TARGET_OBJECTS:octomap_rt_octree_test_helpers> LIBS octomap_rt_daemon TIMEOUT 120)
