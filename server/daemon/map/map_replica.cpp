@@ -81,6 +81,7 @@ void MapReplica::wait_room_locked(std::unique_lock<std::mutex>& lock, uint64_t b
   // Room for it, unless the queue is empty (one item always fits: the bound never stops the map).
   if (queue_.empty() || stats_.pending_bytes + bytes <= max_pending_bytes_) return;
   const auto t0 = SteadyClock::now();
+  stats_.writer_waits++;
   room_.wait(lock, [&] { return stop_ || queue_.empty() || stats_.pending_bytes + bytes <= max_pending_bytes_; });
   stats_.writer_waited_ms += ms_since(t0);
 }

@@ -80,6 +80,7 @@ struct ReplicaStats {
   uint64_t pending_items = 0, pending_bytes = 0;
   uint64_t max_pending_bytes_seen = 0;
   double writer_waited_ms = 0;    // stage 2's total wait for room (the bound above)
+  uint64_t writer_waits = 0;      // the times stage 2 began such a wait (a test sees it begin)
   double apply_ms_total = 0;      // the replica thread's own update time (its lock held)
   double lock_wait_ms_total = 0;  // the replica thread's wait for its lock (readers inside)
   double lock_wait_ms_max = 0;
