@@ -324,10 +324,10 @@ std::shared_ptr<const ReplicaVersion> readable_version(MapState& map) {
   return map.replica->read_version(map.replica->record_version());
 }
 
-MapState& lock_for_short_read(MapState& map, uint64_t min_version, std::shared_lock<MapMutex>& lock) {
+MapState* lock_for_short_read(MapState& map, uint64_t min_version, std::shared_lock<MapMutex>& lock) {
   if (!map.replica) {
     lock = std::shared_lock(map.mutex);
-    return map;
+    return &map;
   }
   MapState& replica = map.replica->state();
   auto try_replica = [&] {
@@ -338,16 +338,14 @@ MapState& lock_for_short_read(MapState& map, uint64_t min_version, std::shared_l
   };
   // A replica that caught up is the map of record's state: read it, and leave the map of
   // record's lock to stage 2 (every reader that takes it may hold stage 2 up).
-  if (map.replica->caught_up() && try_replica()) return replica;
-  // Else whichever is free first. Never wait for one while holding the other: stage 2 may be
+  if (map.replica->caught_up() && try_replica()) return &replica;
+  // Else whichever is free now. Never wait for one while holding the other: stage 2 may be
   // waiting (under the map lock) for the replica's thread to make room, and that thread for
-  // the replica's lock; so both are tried, and tried again until one is free.
-  for (;;) {
-    lock = std::shared_lock(map.mutex, std::try_to_lock);
-    if (lock.owns_lock()) return map;
-    if (try_replica()) return replica;
-    std::this_thread::sleep_for(std::chrono::microseconds(500));
-  }
+  // the replica's lock.
+  lock = std::shared_lock(map.mutex, std::try_to_lock);
+  if (lock.owns_lock()) return &map;
+  if (try_replica()) return &replica;
+  return nullptr;
 }
 
 }  // namespace ort::daemon

@@ -229,8 +229,10 @@ std::shared_ptr<const ReplicaVersion> readable_version(MapState& map);
 // For short readers (a turn of queries): a shared lock on the map of record when stage 2 does
 // not hold it; while it does, on the read replica if its thread is not writing it and it is at
 // `min_version` or newer (a reader that passes the newest id it answered from never answers
-// from an older state after a newer one); else it waits for the map of record. Both are
-// states between two whole scans, each named by its own `version`. Returns the state locked.
-MapState& lock_for_short_read(MapState& map, uint64_t min_version, std::shared_lock<MapMutex>& lock);
+// from an older state after a newer one). Both are states between two whole scans, each named
+// by its own `version`. Returns the state locked, or null (`lock` empty) when neither is free
+// for `min_version` now: it never waits, so that the caller can ask again with the readers
+// waiting then (one that needs a newer state must not hold up those the replica can answer).
+MapState* lock_for_short_read(MapState& map, uint64_t min_version, std::shared_lock<MapMutex>& lock);
 
 }  // namespace ort::daemon

@@ -51,6 +51,9 @@ struct QueryServiceStats {
   // so that "depth 17 ..." and "depth 20 ..." count as one reason; at most kMaxReasons.
   std::vector<std::pair<std::string, int64_t>> refusal_reasons;
   int64_t grids_published = 0;
+  // Query turns that found neither the map of record free nor the read replica new enough for
+  // the clients waiting then, and so asked again (stage 2 held the map meanwhile).
+  int64_t turns_deferred = 0;
   distance::FieldCacheStats field_cache;  // the distance field cache's updates (distance/field_cache.h)
 };
 

@@ -30,6 +30,8 @@ const std::string kNoClient = "?";
 constexpr size_t kMaxParked = 256;  // queries waiting for their map state, all clients
 // Longest a batch of queries holds the map for reading (stage 2 may be waiting to write).
 constexpr auto kReadTurn = std::chrono::milliseconds(10);
+// How long a turn that found no map free to read waits for a new query before asking again.
+constexpr auto kTurnRetry = std::chrono::microseconds(500);
 
 // The ack's status for what the pipeline did with an edit.
 int8_t ack_status(const MapEditResult& r) {
@@ -89,6 +91,7 @@ QueryServiceStats QueryService::service_stats() const {
   s.clients = clients_.snapshot();
   s.refusal_reasons = clients_.refusal_reasons();
   s.grids_published = grids_.published();
+  s.turns_deferred = turns_deferred_;
   std::lock_guard lock(field_cache_stats_mutex_);
   s.field_cache = field_cache_stats_;
   return s;
@@ -320,7 +323,16 @@ void QueryService::run() {
         uint64_t min_version = clients_.oldest_answered_queued();
         for (const PendingQuery& p : parked)
           min_version = std::min(min_version, clients_.newest_answered(header_of(p.msg).client_id));
-        turn_map_ = &lock_for_short_read(map_, min_version == UINT64_MAX ? 0 : min_version, lock);
+        turn_map_ = lock_for_short_read(map_, min_version == UINT64_MAX ? 0 : min_version, lock);
+        if (!turn_map_) {
+          // Neither is free for the clients waiting now: ask again with those waiting then, so
+          // that a client needing a newer state than the replica's never holds up, for all of
+          // stage 2's hold, the queries of others that the replica can answer.
+          turns_deferred_++;
+          std::unique_lock wait(wake_mutex_);
+          if (!stopping_) wake_.wait_for(wait, kTurnRetry);
+          continue;
+        }
       }
       const MapHoldNote note(turn_map_->holders, "query turn");
       const auto turn_end = SteadyClock::now() + kReadTurn;

@@ -106,6 +106,7 @@ class QueryService {
   std::condition_variable wake_;
   bool stopping_ = false;
   std::atomic<bool> cut_now_{false};
+  std::atomic<int64_t> turns_deferred_{0};  // QueryServiceStats::turns_deferred
 };
 
 }  // namespace ort::daemon
