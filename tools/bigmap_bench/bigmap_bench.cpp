@@ -73,7 +73,7 @@ struct Args {
   double scan_scale = 1.0, point_scale = 0.25, stream_point_scale = 0.05;
   int64_t target_nodes = 5'000'000;
   int producers = 3;
-  double rate = 1.0, duration = 60;
+  double rate = 1.0, duration = 60, drain_timeout = 300;
   std::string readers = "on", replica = "on";
   uint64_t replica_batch_voxels = daemon::MapReplica::kDefaultBatchVoxels;
   uint64_t replica_pending_bytes = daemon::ServerConfig{}.replica_pending_bytes;
@@ -165,6 +165,8 @@ int run(const Args& a) {
   const double load_s = seconds_since(load0);
   const auto loaded = server.status();
   const double rss_loaded = rss_mib("VmRSS:");
+  // Progress on stderr (unbuffered): a run cut off by its caller still says how far it got.
+  std::fprintf(stderr, "run: map loaded, %lld nodes in %.1f s\n", (long long)loaded.num_nodes, load_s);
   // Queries go where the map is: its bounding box.
   double lo[3], hi[3];
   server.with_map([&](const octomap::OcTree& t) {
@@ -199,7 +201,11 @@ int run(const Args& a) {
       }
     });
   for (auto& t : producers) t.join();
-  while (finished(server) < published && SteadyClock::now() - t0 < std::chrono::duration<double>(a.duration + 300))
+  std::fprintf(stderr, "run: %lld scans published in %.1f s, %lld finished; waiting for the rest (at most %.0f s)\n",
+               (long long)published.load(), seconds_since(t0), (long long)finished(server), a.drain_timeout);
+  const auto drain_end = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
+                                                  std::chrono::duration<double>(a.drain_timeout));
+  while (finished(server) < published && SteadyClock::now() < drain_end)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   const double seconds = seconds_since(t0);
   r.stop();
@@ -302,6 +308,11 @@ int main(int argc, char** argv) {
   r->add_option("--producers", a.producers, "streaming robots")->capture_default_str();
   r->add_option("--rate", a.rate, "scans a second per robot")->capture_default_str();
   r->add_option("--duration", a.duration, "seconds of streaming")->capture_default_str();
+  r->add_option("--drain-timeout", a.drain_timeout,
+                "after streaming, wait at most this long [s] for the scans still queued (the rest count as not "
+                "applied)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
   r->add_option("--readers", a.readers, "on: snapshots, autosave, viewer publisher, queries; off: none")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
