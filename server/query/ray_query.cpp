@@ -120,7 +120,10 @@ std::vector<RayAnswer> cast_rays(const octomap::OcTree& tree, std::span<const fl
     const octomap::point3d origin(origins[i], origins[i + 1], origins[i + 2]);
     const octomap::point3d direction(directions[i], directions[i + 1], directions[i + 2]);
     if (budget) {
-      if (!budget->check_now()) break;
+      // Not before the first ray: a ray is bounded by the work bound below, and a turn that
+      // lost the core for the time bound before it started (a loaded machine) would answer
+      // nothing, so a client resending the rest would never progress.
+      if (!out.empty() && !budget->check_now()) break;
       const uint64_t bound = ray_walk_bound(tree, direction, opt);
       if (bound > budget->max_work || budget->used > budget->max_work) {
         budget->stop_with(Cut::kWork);

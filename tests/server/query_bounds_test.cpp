@@ -87,6 +87,27 @@ TEST(QueryBounds, RaysThroughUnknownSpaceAreCutAndTheReplySaysWhere) {
   EXPECT_EQ(cut, 1);
 }
 
+// The time bound never cuts a query before its first ray (each ray is within the work bound):
+// with a time bound already past when the turn starts (a turn that lost the core on a loaded
+// machine), the reply answers ray 0 and says it was cut by time at 1, so a client that resends
+// the rest always progresses. Before, such a reply answered none (CI's loaded ASan run).
+TEST(QueryBounds, TheTimeBoundAnswersTheFirstRayAtLeast) {
+  auto cfg = test_config(0.1, true);
+  cfg.queries.bounds.lock_ms = 1e-9;
+  QueryServer fixture(cfg);
+  auto& [lc, log, server, replies] = fixture;
+  map_walls(server, lc, 2);
+  const auto q = far_rays(1, 3);
+  lc.publish(wire::kQueryRaysChannel, &q);
+  const auto r = replies.wait_for<octomap_rt::ray_reply_t>(1);
+  ASSERT_EQ(r.status, Reply::REPLY_OK) << r.error;
+  EXPECT_EQ(r.cut, Reply::CUT_TIME);
+  EXPECT_EQ(r.num_rays, 1);
+  EXPECT_EQ(r.cut_at, 1);
+  EXPECT_NE(r.error.find("--query-lock-ms"), std::string::npos) << r.error;
+  server.stop();
+}
+
 TEST(QueryBounds, ARayLongerThanTheWorkBoundIsRefusedWithTheReason) {
   auto cfg = test_config(0.1, true);
   cfg.queries.bounds.max_work = 1000;

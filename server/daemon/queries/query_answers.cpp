@@ -164,8 +164,9 @@ EncodedReplies box_counts(const octomap::OcTree& t, const octomap_rt::box_query_
   EncodedReplies out = replies_on(h.reply_channel);
   stamp_reply(r, h, s, id, Reply::REPLY_OK, "");
   for (size_t i = 0; i + 5 < q.boxes.size(); i += 6) {
-    // A box the budget ran out in is not answered: its counts would be partial.
-    if (!budget.check_now()) break;
+    // A box the budget ran out in is not answered: its counts would be partial. The clock is
+    // not read before the first box (as for rays: query/ray_query.cpp's cast_rays).
+    if (i > 0 && !budget.check_now()) break;
     const query::KeyBox b = query::key_box(t, &q.boxes[i], &q.boxes[i + 3]);
     if (q.mode == Box::MODE_ANY_OCCUPIED) {
       const bool any = query::any_occupied(t, b, &budget);
