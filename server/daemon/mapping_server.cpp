@@ -71,7 +71,7 @@ MappingServer::MappingServer(const ServerConfig& cfg, lcm::LCM* shared, Log log)
     replica_ = std::make_unique<MapReplica>(
         map_, o, cfg_.replica_pending_bytes, cfg_.replica_batch_voxels, cfg_.replica_nice,
         cfg_.replica_versions ? std::optional(region_grid(replica_version_depth(cfg_))) : std::nullopt,
-        cfg_.replica_version_cells, cfg_.replica_batch_ms);
+        cfg_.replica_version_cells, cfg_.replica_batch_ms, cfg_.replica_rebuild_slice_nodes);
     map_.replica = replica_.get();
   }
   if (cfg_.queries.distance.field_cache && cfg_.queries.distance.change_lists) {

@@ -97,7 +97,12 @@ struct ServerConfig {
   // up; it costs one more tree in memory and a second octree update per scan on another
   // thread. false: they copy the map of record under its lock.
   bool read_replica = true;
-  uint64_t replica_pending_bytes = 256ull << 20;  // changes the replica may lag behind by
+  // Changes the replica may lag behind by; past it, stage 2 waits for it (outside the map lock),
+  // or with replica_rebuild_slice_nodes > 0 the replica falls behind and rebuilds from the map
+  // of record in slices of at most that many copied nodes (stage 2 never waits; whole-map
+  // readers copy the map of record until it caught up: daemon/map/map_replica.h).
+  uint64_t replica_pending_bytes = 256ull << 20;
+  uint64_t replica_rebuild_slice_nodes = 0;
   // Scans waiting for the replica are applied together, up to this many voxels (0: one by one).
   uint64_t replica_batch_voxels = uint64_t{1} << 23;
   // ... and only while the update's estimated time stays within this (0: no time bound), so that

@@ -15,6 +15,7 @@ octomap_rt_lcm_handler_sources(server_memq_test ${CMAKE_CURRENT_LIST_DIR}/server
 octomap_rt_add_test(server_persistence_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/map_store_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/server_persistence_test.cpp ${CMAKE_CURRENT_LIST_DIR}/map_file_integrity_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/map_identity_test.cpp ${CMAKE_CURRENT_LIST_DIR}/map_replica_test.cpp
+                    ${CMAKE_CURRENT_LIST_DIR}/map_replica_rebuild_test.cpp
                     ${CMAKE_CURRENT_LIST_DIR}/prior_map_test.cpp
                     ${SERVER_TEST_FIXTURES}
                     LIBS octomap_rt_daemon TIMEOUT 300)

@@ -79,6 +79,7 @@ struct Args {
   uint64_t replica_pending_bytes = daemon::ServerConfig{}.replica_pending_bytes;
   int replica_nice = 10;
   double replica_batch_ms = 0;
+  uint64_t replica_rebuild_slice_nodes = 0;
   std::string replica_versions = "on";
   unsigned replica_version_depth = 0;
   std::string replica_version_writes = "cells";
@@ -100,6 +101,7 @@ daemon::ServerConfig server_config(const Args& a) {
   cfg.replica_pending_bytes = a.replica_pending_bytes;
   cfg.replica_nice = a.replica_nice;
   cfg.replica_batch_ms = a.replica_batch_ms;
+  cfg.replica_rebuild_slice_nodes = a.replica_rebuild_slice_nodes;
   cfg.replica_versions = a.replica_versions == "on";
   cfg.replica_version_depth = a.replica_version_depth;
   cfg.replica_version_cells = a.replica_version_writes == "cells";
@@ -250,13 +252,22 @@ int run(const Args& a) {
   if (replica)
     std::printf(
         "  read replica: %.1f s of updates on its thread (%llu updates, %llu scans in batches, at most %llu in one), "
-        "at most %.1f MB pending, stage 2 waited %.1f ms for room; its thread waited %.1f s for readers (at most "
-        "%.1f ms); %llu batches cut at --replica-batch-ms %.1f (estimate %.2f us a voxel)\n",
+        "at most %.1f MB pending, stage 2 waited %.1f ms for room, fell behind %llu times (%llu changes dropped; %llu rebuilds caught up, %llu "
+        "slices holding the map of record %.1f ms in all, at most %.1f ms); its thread waited %.1f s for readers (at "
+        "most %.1f ms); %llu batches cut at --replica-batch-ms %.1f (estimate %.2f us a voxel)\n",
         replica->apply_ms_total / 1e3, (unsigned long long)replica->updates,
         (unsigned long long)replica->scans_in_batches, (unsigned long long)replica->largest_batch,
-        double(replica->max_pending_bytes_seen) / 1e6, replica->writer_waited_ms, replica->lock_wait_ms_total / 1e3,
+        double(replica->max_pending_bytes_seen) / 1e6, replica->writer_waited_ms,
+        (unsigned long long)replica->fell_behind, (unsigned long long)replica->dropped_items,
+        (unsigned long long)replica->rebuilds_done, (unsigned long long)replica->rebuild_slices,
+        replica->rebuild_hold_ms_total, replica->rebuild_hold_ms_max, replica->lock_wait_ms_total / 1e3,
         replica->lock_wait_ms_max, (unsigned long long)replica->batches_cut_by_time, a.replica_batch_ms,
         1e3 * replica->ms_per_voxel);
+  if (replica)
+    std::printf("  read replica's thread: %.1f s idle, %.1f s noting changes for versions after its updates\n",
+                replica->idle_ms_total / 1e3, replica->version_note_ms_total / 1e3);
+  if (replica && replica->fell_behind > 0)
+    std::printf("  read replica fell behind: %s\n", replica->behind_reason.c_str());
   if (replica && replica->versions_built > 0)
     std::printf(
         "  versions for whole-map readers: %llu made on the replica's thread, %.1f s in all, at most %.1f ms; the "
@@ -274,14 +285,15 @@ int run(const Args& a) {
               rss_before, rss_loaded, rss_end, hwm);
   // readers, replica, nodes, scans, s, stall max, stall p99, e2e p50, e2e p99, query p50, query p99, snapshots,
   // snapshot max s, RSS loaded, RSS peak, replica update s, replica batch voxels, replica nice, query clients,
-  // stage 2's wait for the replica's room [ms]
-  std::printf("csv,%s,%s,%lld,%lld,%.1f,%.3f,%.3f,%.2f,%.2f,%.2f,%.2f,%lld,%.2f,%.0f,%.0f,%.1f,%llu,%d,%d,%.1f\n",
-              readers ? "on" : "off", a.replica.c_str(), (long long)loaded.num_nodes, (long long)st.scans_applied,
-              seconds, st.octree_lock_wait_ms_max, st.octree_lock_wait_ms_p99, st.end_to_end_ms_p50,
-              st.end_to_end_ms_p99, percentile(rs.query_ms, 0.5), percentile(rs.query_ms, 0.99),
-              (long long)rs.snapshots, rs.snapshot_s_max, rss_loaded, hwm,
-              replica ? replica->apply_ms_total / 1e3 : 0.0, (unsigned long long)a.replica_batch_voxels, a.replica_nice,
-              readers ? a.query_clients : 0, replica ? replica->writer_waited_ms : 0.0);
+  // stage 2's wait for the replica's room [ms], the times the replica fell behind, --replica-rebuild-slice-nodes
+  std::printf(
+      "csv,%s,%s,%lld,%lld,%.1f,%.3f,%.3f,%.2f,%.2f,%.2f,%.2f,%lld,%.2f,%.0f,%.0f,%.1f,%llu,%d,%d,%.1f,%llu,%llu\n",
+      readers ? "on" : "off", a.replica.c_str(), (long long)loaded.num_nodes, (long long)st.scans_applied, seconds,
+      st.octree_lock_wait_ms_max, st.octree_lock_wait_ms_p99, st.end_to_end_ms_p50, st.end_to_end_ms_p99,
+      percentile(rs.query_ms, 0.5), percentile(rs.query_ms, 0.99), (long long)rs.snapshots, rs.snapshot_s_max,
+      rss_loaded, hwm, replica ? replica->apply_ms_total / 1e3 : 0.0, (unsigned long long)a.replica_batch_voxels,
+      a.replica_nice, readers ? a.query_clients : 0, replica ? replica->writer_waited_ms : 0.0,
+      replica ? (unsigned long long)replica->fell_behind : 0ull, (unsigned long long)a.replica_rebuild_slice_nodes);
   return 0;
 }
 
@@ -321,6 +333,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   r->add_option("--replica-batch-voxels", a.replica_batch_voxels,
                 "scans waiting for the read replica are applied together up to this many voxels (0: one by one)")
+      ->capture_default_str();
+  r->add_option("--replica-rebuild-slice-nodes", a.replica_rebuild_slice_nodes,
+                "> 0: past --replica-pending-bytes the replica falls behind and rebuilds from the map of record in "
+                "slices of at most this many nodes (stage 2 never waits); 0: stage 2 waits for its room")
       ->capture_default_str();
   r->add_option("--replica-batch-ms", a.replica_batch_ms,
                 "... and only while the update's estimated time stays within this [ms] (0: no time bound)")

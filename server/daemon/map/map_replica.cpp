@@ -12,13 +12,15 @@
 
 namespace ort::daemon {
 
-MapReplica::MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
+MapReplica::MapReplica(MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
                        uint64_t max_batch_voxels, int nice, std::optional<RegionGrid> version_grid, bool version_cells,
-                       double max_batch_ms)
-    : stage_(octree),
+                       double max_batch_ms, uint64_t rebuild_slice_nodes)
+    : record_(map),
+      stage_(octree),
       max_pending_bytes_(max_pending_bytes),
       max_batch_voxels_(max_batch_voxels),
       max_batch_ms_(max_batch_ms),
+      rebuild_slice_nodes_(rebuild_slice_nodes),
       has_versions_(version_grid.has_value()),
       version_cells_(version_cells),
       builder_(version_grid.value_or(region_grid(11)), version_cells),
@@ -87,17 +89,42 @@ void MapReplica::wait_room_locked(std::unique_lock<std::mutex>& lock, uint64_t b
 }
 
 void MapReplica::wait_for_room(size_t voxels) {
+  if (rebuild_slice_nodes_ > 0) return;  // it falls behind instead
   std::unique_lock lock(mutex_);
   wait_room_locked(lock, scan_bytes(voxels));
 }
 
 void MapReplica::push(Item item) {
   std::unique_lock lock(mutex_);
-  wait_room_locked(lock, item.bytes);
+  if (rebuild_slice_nodes_ == 0) wait_room_locked(lock, item.bytes);  // the rule without rebuilds
+  record_version_.store(item.version, std::memory_order_release);
+  if (behind_) {
+    mark_dirty_locked(item);
+    return;  // one scan's list, freed by stage 2 (a backlog's lists go to the replica's thread)
+  }
+  // One item always fits (an empty queue): the replica falls behind only with a backlog.
+  if (!queue_.empty() && stats_.pending_bytes + item.bytes > max_pending_bytes_) {
+    stats_.fell_behind++;
+    stats_.dropped_items += queue_.size();
+    stats_.behind_reason = std::to_string(queue_.size()) + " changes (" + std::to_string(stats_.pending_bytes) +
+                           " bytes) not applied yet and " + std::to_string(item.bytes) +
+                           " more would pass the bound of " + std::to_string(max_pending_bytes_) +
+                           " bytes: rebuilding from the map of record";
+    for (Item& it : queue_) dropped_.push_back(std::move(it));
+    dropped_.push_back(std::move(item));
+    queue_.clear();
+    stats_.pending_items = stats_.pending_bytes = 0;
+    drops_++;
+    behind_ = stats_.behind = true;
+    all_dirty_ = true;
+    dirty_.clear();
+    work_.notify_one();
+    progress_.notify_all();  // readers waiting for it read the map of record now
+    return;
+  }
   stats_.pending_items++;
   stats_.pending_bytes += item.bytes;
   stats_.max_pending_bytes_seen = std::max(stats_.max_pending_bytes_seen, stats_.pending_bytes);
-  record_version_.store(item.version, std::memory_order_release);
   queue_.push_back(std::move(item));
   work_.notify_one();
 }
@@ -105,12 +132,12 @@ void MapReplica::push(Item item) {
 void MapReplica::take_batch(std::deque<Item>& batch) {
   batch.push_back(std::move(queue_.front()));
   queue_.pop_front();
-  if (batch.front().step) return;
+  if (batch.front().whole()) return;
   uint64_t voxels = batch.front().voxels.size();
   uint64_t limit = max_batch_voxels_;
   if (max_batch_ms_ > 0)  // without an estimate yet, one scan
     limit = std::min<uint64_t>(limit, ms_per_voxel_ > 0 ? uint64_t(max_batch_ms_ / ms_per_voxel_) : 0);
-  while (!queue_.empty() && !queue_.front().step && voxels + queue_.front().voxels.size() <= max_batch_voxels_) {
+  while (!queue_.empty() && !queue_.front().whole() && voxels + queue_.front().voxels.size() <= max_batch_voxels_) {
     if (voxels + queue_.front().voxels.size() > limit) {
       stats_.batches_cut_by_time++;
       break;
@@ -121,7 +148,7 @@ void MapReplica::take_batch(std::deque<Item>& batch) {
   }
 }
 
-double MapReplica::apply_batch(std::deque<Item>& batch, bool log_changes) {
+double MapReplica::apply_batch(std::deque<Item>& batch, bool log_changes, std::unique_ptr<octomap::OcTree>& retired) {
   std::span<const VoxelUpdate> voxels = batch.front().voxels;
   if (batch.size() > 1) {
     joined_.clear();
@@ -135,15 +162,22 @@ double MapReplica::apply_batch(std::deque<Item>& batch, bool log_changes) {
   // The leaf count as the map of record keeps it (daemon/map/map_identity.h): the octree
   // stage says how the batch changed it; a step does not (0 if it left the tree empty).
   std::optional<int64_t> leaf_change;
-  if (batch.front().step)
-    batch.front().step(*state_.tree);
-  else
-    leaf_change = stage_.apply(*state_.tree, voxels, log_changes ? &changes_ : nullptr);
-  const int64_t leaves = state_.leaves.load(std::memory_order_relaxed);
-  state_.leaves.store(!state_.tree->getRoot()      ? 0
-                      : leaves >= 0 && leaf_change ? leaves + *leaf_change
-                                                   : -1,
-                      std::memory_order_relaxed);
+  if (Item& front = batch.front(); front.tree) {  // a rebuild: the map of record's tree and state then
+    retired = std::move(state_.tree);
+    state_.tree = std::move(front.tree);
+    state_.newest_scan = std::move(front.newest_all);
+    state_.leaves.store(front.leaves, std::memory_order_relaxed);
+  } else {
+    if (front.step)
+      front.step(*state_.tree);
+    else
+      leaf_change = stage_.apply(*state_.tree, voxels, log_changes ? &changes_ : nullptr);
+    const int64_t leaves = state_.leaves.load(std::memory_order_relaxed);
+    state_.leaves.store(!state_.tree->getRoot()      ? 0
+                        : leaves >= 0 && leaf_change ? leaves + *leaf_change
+                                                     : -1,
+                        std::memory_order_relaxed);
+  }
   for (Item& it : batch)
     if (!it.robot.empty()) state_.newest_scan[it.robot] = std::move(it.newest);
   const Item& last = batch.back();
@@ -159,20 +193,34 @@ void MapReplica::run() {
   // Versions take at most a third of this thread's time (after one that took t, the next comes
   // 2t later at the earliest), so that it keeps up where scans touch most regions between two
   // versions; readers wait for theirs meanwhile, off every lock.
-  SteadyClock::time_point next_version_at{};
+  SteadyClock::time_point next_version_at{}, next_slice_at{};
+  std::deque<Item> dropped;
+  std::unique_ptr<octomap::OcTree> retired;
   for (;;) {
     bool note_regions = false;
+    uint64_t drops = 0;
+    dropped.clear();  // what push dropped or did not queue: freed here, outside both locks
+    retired.reset();
     {
       std::unique_lock lock(mutex_);
+      dropped.swap(dropped_);
+      // A rebuild's slices take at most half this thread's time (after one that held the map of
+      // record for t, the next comes t later at the earliest), so that stage 2 gets the lock
+      // between them (the map of record's lock prefers readers).
+      auto slice_due = [&] { return behind_ && queue_.empty() && SteadyClock::now() >= next_slice_at; };
       // A reader waiting for a version the tree has reached goes before the next batch.
       auto version_wanted = [&] { return wanted_ && stats_.version >= wanted_version_; };
       auto version_due = [&] { return version_wanted() && SteadyClock::now() >= next_version_at; };
-      while (!stop_ && queue_.empty() && !version_due()) {
-        if (version_wanted())
+      const auto idle_from = SteadyClock::now();
+      while (!stop_ && queue_.empty() && !version_due() && !slice_due()) {
+        if (behind_ && (!version_wanted() || next_slice_at < next_version_at))
+          work_.wait_until(lock, next_slice_at);
+        else if (version_wanted())
           work_.wait_until(lock, next_version_at);
         else
           work_.wait(lock);
       }
+      stats_.idle_ms_total += ms_since(idle_from);
       if (version_due()) {
         wanted_ = false;
         lock.unlock();
@@ -191,27 +239,37 @@ void MapReplica::run() {
         progress_.notify_all();
         return;
       }
+      if (queue_.empty()) {  // behind: a slice of the rebuild
+        lock.unlock();
+        const double held_ms = rebuild_slice();
+        next_slice_at = SteadyClock::now() + std::chrono::microseconds(int64_t(held_ms * 1e3));
+        continue;
+      }
       take_batch(batch);
       note_regions = versions_on_;
+      drops = drops_;
     }
     const auto t0 = SteadyClock::now();
-    const double waited = apply_batch(batch, note_regions && version_cells_);
+    const double waited = apply_batch(batch, note_regions && version_cells_, retired);
     const double applied_ms = ms_since(t0);
+    double note_ms = 0;
     if (note_regions) {  // what the next version writes again: the regions of the leaves that changed
+      const auto n0 = SteadyClock::now();
       std::lock_guard build(build_mutex_);
-      if (batch.front().step)
+      if (batch.front().whole())
         builder_.changed_all();
       else if (version_cells_)
         builder_.changed(changes_);
       else
         for (const Item& it : batch) builder_.changed(it.voxels);
+      note_ms = ms_since(n0);
     }
     uint64_t bytes = 0, voxels = 0;
     for (const Item& it : batch) {
       bytes += it.bytes;
       voxels += it.voxels.size();
     }
-    if (!batch.front().step && voxels > 0) {  // the estimate take_batch's time bound uses: recent updates weigh most
+    if (!batch.front().whole() && voxels > 0) {  // the estimate take_batch's time bound uses: recent updates weigh most
       const double sample = (applied_ms - std::min(applied_ms, waited)) / double(voxels);
       ms_per_voxel_ = ms_per_voxel_ > 0 ? 0.7 * ms_per_voxel_ + 0.3 * sample : sample;
     }
@@ -221,13 +279,16 @@ void MapReplica::run() {
       std::lock_guard lock(mutex_);
       stats_.apply_ms_total += applied_ms - std::min(applied_ms, waited);
       stats_.lock_wait_ms_total += waited;
+      stats_.version_note_ms_total += note_ms;
       stats_.lock_wait_ms_max = std::max(stats_.lock_wait_ms_max, waited);
       stats_.updates++;
       if (items > 1) stats_.scans_in_batches += items;
       stats_.largest_batch = std::max(stats_.largest_batch, items);
       stats_.ms_per_voxel = ms_per_voxel_;
-      stats_.pending_items -= std::min(stats_.pending_items, items);
-      stats_.pending_bytes -= std::min(stats_.pending_bytes, bytes);
+      if (drops == drops_) {  // else push dropped the queue it was counted in
+        stats_.pending_items -= std::min(stats_.pending_items, items);
+        stats_.pending_bytes -= std::min(stats_.pending_bytes, bytes);
+      }
       stats_.version = state_.version;
       applied_version_.store(state_.version, std::memory_order_release);
     }
@@ -282,6 +343,7 @@ std::shared_ptr<const ReplicaVersion> MapReplica::read_version(uint64_t min_vers
   versions_on_ = true;
   for (;;) {
     if (latest_ && latest_->version >= min_version) return latest_;
+    if (behind_) return nullptr;         // the reader copies the map of record until the rebuild caught up
     if (exited_) {                       // nothing changes the tree any more: the reader makes the version itself
       if (!caught_up()) return nullptr;  // it stopped behind the map of record
       lock.unlock();
@@ -299,12 +361,17 @@ std::shared_ptr<const ReplicaVersion> MapReplica::read_version(uint64_t min_vers
 bool MapReplica::wait_for(uint64_t version, double timeout_s) {
   std::unique_lock lock(mutex_);
   return progress_.wait_for(lock, std::chrono::duration<double>(timeout_s),
-                            [&] { return stop_ || stats_.version >= version; });
+                            [&] { return stop_ || behind_ || stats_.version >= version; });
 }
 
 bool MapReplica::stopped_behind() const {
   std::lock_guard lock(mutex_);
   return stop_ && !caught_up();
+}
+
+bool MapReplica::reads_record() const {
+  std::lock_guard lock(mutex_);
+  return behind_ || (stop_ && !caught_up());
 }
 
 ReplicaStats MapReplica::stats() const {
@@ -316,7 +383,7 @@ MapState& readable_map(MapState& map) {
   if (!map.replica) return map;
   // The map of record's id without its lock: a reader never holds the octree stage up.
   map.replica->wait_for(map.replica->record_version(), 1e9);
-  return map.replica->stopped_behind() ? map : map.replica->state();
+  return map.replica->reads_record() ? map : map.replica->state();
 }
 
 std::shared_ptr<const ReplicaVersion> readable_version(MapState& map) {
@@ -339,9 +406,9 @@ MapState* lock_for_short_read(MapState& map, uint64_t min_version, std::shared_l
   // A replica that caught up is the map of record's state: read it, and leave the map of
   // record's lock to stage 2 (every reader that takes it may hold stage 2 up).
   if (map.replica->caught_up() && try_replica()) return &replica;
-  // Else whichever is free now. Never wait for one while holding the other: stage 2 may be
-  // waiting (under the map lock) for the replica's thread to make room, and that thread for
-  // the replica's lock.
+  // Else whichever is free now. Never wait for one while holding the other: a rebuild's slice
+  // holds the map of record (shared) and may wait for nothing else, but the replica's thread
+  // waits for the replica's lock.
   lock = std::shared_lock(map.mutex, std::try_to_lock);
   if (lock.owns_lock()) return &map;
   if (try_replica()) return &replica;

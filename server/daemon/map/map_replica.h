@@ -16,11 +16,30 @@
 // Memory: one more tree; once a whole-map reader asked, the newest version (5 bytes a node)
 // and what older versions readers still hold do not share with it (at most the regions
 // changed since each); plus the voxel lists and steps not applied yet, at most
-// `max_pending_bytes`; past that, stage 2 waits for the replica (only while a reader holds
-// the replica longer than it takes the producers to send that much); plus one buffer of at
-// most `max_batch_voxels` voxels (8 bytes each), kept from batch to batch, and while versions
-// are on the change log of a batch (16 bytes a changed leaf, at most one per voxel) and the
-// changed cells since the last version (a 64-byte set per changed region).
+// `max_pending_bytes`; plus one buffer of at most `max_batch_voxels` voxels (8 bytes each),
+// kept from batch to batch, and while versions are on the change log of a batch (16 bytes a
+// changed leaf, at most one per voxel) and the changed cells since the last version (a
+// 64-byte set per changed region); while it rebuilds (below), the tree it rebuilds (up to
+// one more map) and the set of regions changed since their copy (8 bytes each, at most one
+// per region of the map).
+//
+// Without rebuilds (`rebuild_slice_nodes` 0, the default), past `max_pending_bytes` stage 2
+// waits for the replica's room, outside the map lock (wait_for_room).
+//
+// Falling behind (with rebuilds): stage 2 never waits for the replica. A change that finds the
+// queue over `max_pending_bytes` (a reader held the replica, or its thread is slower than the
+// producers)
+// marks the replica fallen behind (counted, ReplicaStats::behind_reason says why): the queued
+// lists are dropped, and from then on stage 2 only notes the regions (octree/region.h, depth
+// kRebuildRegionDepth) its scans touch (a step: all of them). The replica's thread rebuilds
+// a tree of its own from the map of record in slices (octree/versions/region_sync.h), each
+// under a short shared lock of the map of record and at most `rebuild_slice_nodes` copied
+// nodes, the regions changed since their copy copied again; the slice that finds none left
+// to copy has made a tree equal to the map of record at its state then (no change can come
+// in while it holds the lock), and hands it to the replica's thread as one change, as a
+// scan's list is. Meanwhile readers read the replica's state as it was (a state between two
+// whole scans, never changed by the rebuild) wherever that is new enough for them, else the
+// map of record (readable_map, readable_version, lock_for_short_read), until it caught up.
 //
 // Keeping up: scans waiting back to back (a reader held the replica, or it fell behind) are
 // applied as one list, their voxel lists one after the other. The batched octree stage applies
@@ -51,6 +70,7 @@
 #include <shared_mutex>
 #include <string>
 #include <thread>
+#include <unordered_set>
 
 #include <octomap/OcTree.h>
 
@@ -79,11 +99,20 @@ struct ReplicaStats {
   uint64_t version = 0;  // the replica's map state id
   uint64_t pending_items = 0, pending_bytes = 0;
   uint64_t max_pending_bytes_seen = 0;
-  double writer_waited_ms = 0;    // stage 2's total wait for room (the bound above)
-  uint64_t writer_waits = 0;      // the times stage 2 began such a wait (a test sees it begin)
-  double apply_ms_total = 0;      // the replica thread's own update time (its lock held)
-  double lock_wait_ms_total = 0;  // the replica thread's wait for its lock (readers inside)
+  double writer_waited_ms = 0;  // stage 2's total wait for room (without rebuilds: the bound above)
+  uint64_t writer_waits = 0;    // the times stage 2 began such a wait (a test sees it begin)
+  uint64_t fell_behind = 0;     // the times a change found the queue over the bound (stage 2 goes on)
+  uint64_t dropped_items = 0;   // the queued scans and steps those dropped
+  std::string behind_reason;    // of the last time: the queue then, and the bound
+  bool behind = false;          // rebuilding from the map of record now
+  uint64_t rebuild_slices = 0, rebuild_regions_copied = 0, rebuild_nodes_copied = 0;
+  uint64_t rebuilds_done = 0;                                 // rebuilds that caught up
+  double rebuild_hold_ms_total = 0, rebuild_hold_ms_max = 0;  // its slices' hold of the map of record (shared)
+  double apply_ms_total = 0;                                  // the replica thread's own update time (its lock held)
+  double lock_wait_ms_total = 0;                              // the replica thread's wait for its lock (readers inside)
   double lock_wait_ms_max = 0;
+  double idle_ms_total = 0;          // the replica thread's waits for work (the rest of its time: busy)
+  double version_note_ms_total = 0;  // its time noting, after each batch, what the next version writes
   uint64_t updates = 0;              // tree updates it made: one per batch of scans or per step
   uint64_t scans_in_batches = 0;     // scans applied together with others
   uint64_t largest_batch = 0;        // most scans in one update
@@ -102,7 +131,7 @@ struct ReplicaStats {
 class MapReplica {
  public:
   // Starts from a copy of `map` (its tree, id, epoch, scans, per-robot seqs): call before the
-  // pipeline runs, with nothing else changing the map.
+  // pipeline runs, with nothing else changing the map. A rebuild reads `map` (its lock shared).
   // `max_batch_voxels` 0: one scan per update. `nice`: how much the replica's thread lowers
   // its priority below the server's (core/thread_priority.h; its octree stage's helpers:
   // octree.helper_nice).
@@ -116,10 +145,15 @@ class MapReplica {
   // per voxel of the replica's recent scan updates, stays within it (no estimate yet: one scan),
   // so that the replica's lock is held about max(max_batch_ms, one scan) at a time and a query
   // turn that needs the replica waits behind no whole catch-up. 0: bounded by voxels only.
-  MapReplica(const MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
+  // `rebuild_slice_nodes` > 0: past `max_pending_bytes` it falls behind and rebuilds, each slice
+  // copying at most that many nodes (at least one region); 0: stage 2 waits for its room (the
+  // rule before; the default until the H200 compares them, docs/BENCHMARKS.md).
+  static constexpr uint64_t kDefaultRebuildSliceNodes = 0;
+  static constexpr unsigned kRebuildRegionDepth = 10;
+  MapReplica(MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
              uint64_t max_batch_voxels = kDefaultBatchVoxels, int nice = 0,
              std::optional<RegionGrid> version_grid = region_grid(11), bool version_cells = true,
-             double max_batch_ms = 0);
+             double max_batch_ms = 0, uint64_t rebuild_slice_nodes = kDefaultRebuildSliceNodes);
   ~MapReplica();
   MapReplica(const MapReplica&) = delete;
   MapReplica& operator=(const MapReplica&) = delete;
@@ -130,15 +164,15 @@ class MapReplica {
   void scan_applied(VoxelList& voxels, const MapState& map, const std::string& robot_lower);
   // Under the map lock, after the map of record applied `step`: the replica applies it too.
   void step_applied(MapStep step, const MapState& map);
-  // Stage 2, before it takes the map lock for a scan of `voxels` voxels: waits until the queue
-  // has room for it (counted in writer_waited_ms), so that while the replica is behind, stage 2
-  // waits without holding the map of record and queries go on reading it. scan_applied keeps
-  // its own wait for the rare case that another change took the room meanwhile.
-  void wait_for_room(size_t voxels);
 
   // The state readers read: lock its mutex (shared) to read tree, version, epoch, ...
   MapState& state() { return state_; }
-  // Waits until the replica reached `version` (or stopped); false on the timeout.
+  // Stage 2, before it takes the map lock for a scan of `voxels` voxels, without rebuilds:
+  // waits until the queue has room for it (counted in writer_waited_ms), so that stage 2 waits
+  // without holding the map of record and queries go on reading it. push keeps its own wait
+  // for the rare case that another change took the room meanwhile. With rebuilds: returns.
+  void wait_for_room(size_t voxels);
+  // Waits until the replica reached `version` (or stopped, or fell behind); false on the timeout.
   bool wait_for(uint64_t version, double timeout_s);
   // The map of record's state id as of the last change handed over (stage 2 hands each over
   // under the map lock right after counting it), read without the map of record's lock;
@@ -161,6 +195,8 @@ class MapReplica {
   void stop();
   // Stopped with changes of the map of record not applied: readers read the map of record.
   bool stopped_behind() const;
+  // Stopped behind, or fell behind and not caught up yet: whole-map readers read the map of record.
+  bool reads_record() const;
 
  private:
   struct Item {
@@ -171,10 +207,20 @@ class MapReplica {
     std::string robot;  // a scan's producer (lower case) and its newest scan
     MapState::NewestScan newest;
     uint64_t bytes = 0;
+    // or a rebuilt tree that takes the replica's place, with the map's state then
+    std::unique_ptr<octomap::OcTree> tree;
+    std::map<std::string, MapState::NewestScan> newest_all;
+    int64_t leaves = -1;
+    bool whole() const { return step || tree; }  // never joined with scans in a batch
   };
   static uint64_t scan_bytes(size_t voxels) { return voxels * sizeof(VoxelUpdate) + sizeof(Item); }
-  // Under mutex_ (`lock`): waits while `bytes` more would pass the bound (never for an empty queue).
+  // Under mutex_ (`lock`), without rebuilds: waits while `bytes` more would pass the bound
+  // (never for an empty queue).
   void wait_room_locked(std::unique_lock<std::mutex>& lock, uint64_t bytes);
+  // Under mutex_, while behind: notes the regions `item` changes (a step: all).
+  void mark_dirty_locked(const Item& item);
+  // One slice of the rebuild (map_replica_rebuild.cpp); returns how long it held the map of record (ms).
+  double rebuild_slice();
   void push(Item item);
   void run();
   // Under mutex_: the front item, and the scans right behind a scan up to max_batch_voxels_
@@ -182,12 +228,14 @@ class MapReplica {
   void take_batch(std::deque<Item>& batch);
   // Applies a batch to the tree and takes its last item's state (under state_.mutex), with
   // `log_changes` the leaves it changed in changes_. Returns how long it waited for that lock (ms).
-  double apply_batch(std::deque<Item>& batch, bool log_changes);
+  // A tree it replaced goes to `retired` (freed outside the lock).
+  double apply_batch(std::deque<Item>& batch, bool log_changes, std::unique_ptr<octomap::OcTree>& retired);
   // Makes a version of the tree as the replica's thread left it (after its last batch, or
   // after it exited) and publishes it.
   void make_version();
 
   MapState state_;
+  MapState& record_;  // the map of record, read by a rebuild
   OctreeStage stage_;
   uint64_t max_pending_bytes_;
   uint64_t max_batch_voxels_;
@@ -200,6 +248,16 @@ class MapReplica {
   std::deque<Item> queue_;
   bool stop_ = false;
   ReplicaStats stats_;
+  // Falling behind: set by push, cleared by the slice that caught up (under mutex_); the
+  // regions changed since their copy, or all; the tree being rebuilt (the replica's thread
+  // only); and a count of drops, so that a batch taken before one does not count its bytes
+  // off the queue after it.
+  bool behind_ = false, all_dirty_ = false;
+  std::unordered_set<RegionId> dirty_;
+  std::deque<Item> dropped_;  // freed by the replica's thread, not by stage 2 under the map lock
+  uint64_t drops_ = 0;
+  uint64_t rebuild_slice_nodes_;
+  std::unique_ptr<octomap::OcTree> rebuild_tree_;
   std::atomic<uint64_t> record_version_{0}, applied_version_{0};
   // Versions: on after the first read_version; the newest made; the version a reader waits for.
   bool has_versions_, version_cells_;
