@@ -102,8 +102,10 @@ void MapReplica::push(Item item) {
     mark_dirty_locked(item);
     return;  // one scan's list, freed by stage 2 (a backlog's lists go to the replica's thread)
   }
-  // One item always fits (an empty queue): the replica falls behind only with a backlog.
-  if (!queue_.empty() && stats_.pending_bytes + item.bytes > max_pending_bytes_) {
+  // One item always fits (an empty queue): the replica falls behind only with a backlog, and
+  // only under the rule with rebuilds (without it, the wait above returns past the bound only
+  // when the replica stops, and the item is queued as before).
+  if (rebuild_slice_nodes_ > 0 && !queue_.empty() && stats_.pending_bytes + item.bytes > max_pending_bytes_) {
     stats_.fell_behind++;
     stats_.dropped_items += queue_.size();
     stats_.behind_reason = std::to_string(queue_.size()) + " changes (" + std::to_string(stats_.pending_bytes) +
