@@ -105,25 +105,8 @@ void MapReplica::push(Item item) {
   // One item always fits (an empty queue): the replica falls behind only with a backlog, and
   // only under the rule with rebuilds (without it, the wait above returns past the bound only
   // when the replica stops, and the item is queued as before).
-  if (rebuild_slice_nodes_ > 0 && !queue_.empty() && stats_.pending_bytes + item.bytes > max_pending_bytes_) {
-    stats_.fell_behind++;
-    stats_.dropped_items += queue_.size();
-    stats_.behind_reason = std::to_string(queue_.size()) + " changes (" + std::to_string(stats_.pending_bytes) +
-                           " bytes) not applied yet and " + std::to_string(item.bytes) +
-                           " more would pass the bound of " + std::to_string(max_pending_bytes_) +
-                           " bytes: rebuilding from the map of record";
-    for (Item& it : queue_) dropped_.push_back(std::move(it));
-    dropped_.push_back(std::move(item));
-    queue_.clear();
-    stats_.pending_items = stats_.pending_bytes = 0;
-    drops_++;
-    behind_ = stats_.behind = true;
-    all_dirty_ = true;
-    dirty_.clear();
-    work_.notify_one();
-    progress_.notify_all();  // readers waiting for it read the map of record now
-    return;
-  }
+  if (rebuild_slice_nodes_ > 0 && !queue_.empty() && stats_.pending_bytes + item.bytes > max_pending_bytes_)
+    return fall_behind_locked(std::move(item));
   stats_.pending_items++;
   stats_.pending_bytes += item.bytes;
   stats_.max_pending_bytes_seen = std::max(stats_.max_pending_bytes_seen, stats_.pending_bytes);

@@ -147,7 +147,9 @@ class MapReplica {
   // turn that needs the replica waits behind no whole catch-up. 0: bounded by voxels only.
   // `rebuild_slice_nodes` > 0: past `max_pending_bytes` it falls behind and rebuilds, each slice
   // copying at most that many nodes (at least one region); 0: stage 2 waits for its room (the
-  // rule before; the default until the H200 compares them, docs/BENCHMARKS.md).
+  // rule before, and the default: on the H200 falling behind cost mapping far more, because
+  // whole-map readers copy the map of record while it rebuilds: docs/BENCHMARKS.md, "Readers
+  // and the read replica").
   static constexpr uint64_t kDefaultRebuildSliceNodes = 0;
   static constexpr unsigned kRebuildRegionDepth = 10;
   MapReplica(MapState& map, const OctreeUpdateOptions& octree, uint64_t max_pending_bytes,
@@ -217,6 +219,9 @@ class MapReplica {
   // Under mutex_ (`lock`), without rebuilds: waits while `bytes` more would pass the bound
   // (never for an empty queue).
   void wait_room_locked(std::unique_lock<std::mutex>& lock, uint64_t bytes);
+  // Under mutex_, with rebuilds, when `item` finds the queue over the bound: drops the queue
+  // and `item` (freed by the replica's thread), counts why, and marks every region to copy.
+  void fall_behind_locked(Item item);
   // Under mutex_, while behind: notes the regions `item` changes (a step: all).
   void mark_dirty_locked(const Item& item);
   // One slice of the rebuild (map_replica_rebuild.cpp); returns how long it held the map of record (ms).

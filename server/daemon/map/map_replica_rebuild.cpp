@@ -1,13 +1,33 @@
 // The read replica's rebuild after it fell behind (daemon/map/map_replica.h, "Falling
-// behind"): its slices, and the regions stage 2 notes meanwhile.
+// behind"): the fall, its slices, and the regions stage 2 notes meanwhile.
 #include <algorithm>
 #include <shared_mutex>
+#include <string>
 
 #include "core/clock.h"
 #include "daemon/map/map_replica.h"
 #include "octree/versions/region_sync.h"
 
 namespace ort::daemon {
+
+void MapReplica::fall_behind_locked(Item item) {
+  stats_.fell_behind++;
+  stats_.dropped_items += queue_.size();
+  stats_.behind_reason = std::to_string(queue_.size()) + " changes (" + std::to_string(stats_.pending_bytes) +
+                         " bytes) not applied yet and " + std::to_string(item.bytes) +
+                         " more would pass the bound of " + std::to_string(max_pending_bytes_) +
+                         " bytes: rebuilding from the map of record";
+  for (Item& it : queue_) dropped_.push_back(std::move(it));
+  dropped_.push_back(std::move(item));
+  queue_.clear();
+  stats_.pending_items = stats_.pending_bytes = 0;
+  drops_++;
+  behind_ = stats_.behind = true;
+  all_dirty_ = true;
+  dirty_.clear();
+  work_.notify_one();
+  progress_.notify_all();  // readers waiting for it read the map of record now
+}
 
 void MapReplica::mark_dirty_locked(const Item& item) {
   if (all_dirty_) return;
